@@ -1,0 +1,86 @@
+// Casts a scan pattern from a sensor pose against a scene: per beam, the nearest hit's distance,
+// body and triangle. All geometry is done relative to the sensor (DESIGN.md, decision 1).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "laser_raycast/core/scan_pattern.h"
+#include "laser_raycast/core/scene.h"
+#include "laser_raycast/core/triangle.h"
+
+namespace laser_raycast {
+namespace core {
+
+struct CastConfig {
+  TriangleMethod method = TriangleMethod::kWatertight;  // triangle test for meshes
+  bool cull_backfaces = false;  // one-sided triangles: a beam reaching a back face passes through
+  double tmin = 0.0;            // m, nearest accepted hit (>= 0)
+  double tmax = 30.0;  // m, farthest accepted hit (> tmin); bodies wholly beyond are skipped
+  bool planar_fast_path =
+      true;  // planar fans: slice meshes in the scan plane instead of tracing beams
+  bool compute_incidence = false;  // fill ScanResult::cos_incidence
+
+  // Throws std::invalid_argument naming the field and its value.
+  void validate() const;
+  bool operator==(const CastConfig& o) const;
+};
+
+struct CastStats {
+  int bodies = 0;          // bodies in the scene
+  int bodies_skipped = 0;  // frame pose unknown this scan
+  int bodies_culled = 0;   // bounding sphere beyond range, outside the fan, or off the scan plane
+  bool reused = false;  // nothing moved relative to the sensor: the previous geometry was returned
+};
+
+struct ScanResult {
+  std::vector<double> range;  // m; +inf: no hit in [tmin, tmax]; NaN: the beam could not be cast
+  std::vector<int> body;      // index of the body hit, -1 for none
+  std::vector<int> triangle;  // the triangle hit on a mesh body, -1 for a primitive or no hit
+  std::vector<double> cos_incidence;  // |cos| of the beam's angle to the surface normal (0 if no
+                                      // hit); filled only with CastConfig::compute_incidence
+  CastStats stats;
+};
+
+class Caster {
+ public:
+  // Casts pattern from world_from_sensor (both it and poses in the same common frame). Bodies whose
+  // frame is invalid are skipped. If world_from_sensor is not a finite rigid transform, every beam
+  // is NaN. If scene, pattern, config and every frame's pose relative to the sensor are unchanged
+  // since the previous call, the previous result is returned without casting (stats.reused).
+  const ScanResult& cast(const Scene& scene, const FramePoses& poses,
+                         const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
+                         const CastConfig& config);
+
+  // A body prepared for this scan: its pose relative to the sensor and its culling data.
+  struct ActiveBody {
+    int index;
+    Eigen::Isometry3d sensor_from_body;
+    Eigen::Matrix3d body_from_sensor_rot;  // rotates sensor-frame directions into the body frame
+    Eigen::Vector3d sensor_in_body;        // the sensor origin in the body frame
+    Eigen::Vector3d center;                // bounding sphere centre, sensor frame
+    double radius;
+  };
+
+ private:
+  bool unchanged(const Scene& scene, const std::vector<Eigen::Isometry3d>& sensor_from_frame,
+                 const std::vector<char>& valid, const ScanPattern& pattern,
+                 const CastConfig& config) const;
+
+  ScanResult result_;
+  std::vector<ActiveBody> active_;
+  // What the previous result was computed from.
+  bool has_previous_ = false;
+  std::uint64_t previous_scene_ = 0;
+  double previous_angle_min_ = 0, previous_increment_ = 0;
+  int previous_azimuths_ = 0;
+  std::vector<double> previous_elevations_;
+  CastConfig previous_config_;
+  std::vector<Eigen::Isometry3d> previous_relative_;
+  std::vector<char> previous_valid_;
+};
+
+}  // namespace core
+}  // namespace laser_raycast

@@ -1,0 +1,329 @@
+// Ray/triangle intersection: the watertight production test and the reference methods it is
+// measured against (the seed documents' two plane-then-barycentric tests, Cramer's rule,
+// Moller-Trumbore).
+//
+// Conventions shared by every method, so that they are interchangeable:
+// - A hit has t in [ray.tmin, tmax] (inclusive) and barycentrics u, v: the weights of b and c, so
+// the hit
+//   point is (1 - u - v) a + u b + v c. Points on edges and vertices are inside (>= 0 tests).
+// - The front face is the side that (b - a) x (c - a) points to. With cull_backfaces, a ray whose
+//   direction has a positive dot product with that normal (it sees the back) does not hit.
+// - No absolute epsilons. A ray parallel to the plane (denominator exactly 0) misses.
+// - Every accept test is written as "if (!(inside)) reject", so a NaN anywhere rejects: NaN input
+// never
+//   produces a hit.
+// - Degenerate triangles (cross product exactly zero: repeated or collinear vertices) never hit.
+// The free
+//   functions test for them; PreparedRay::intersect assumes the caller has filtered them out (the
+//   BVH does so once at build time).
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+#include "laser_raycast/core/ray.h"
+
+namespace laser_raycast {
+namespace core {
+
+template <typename T>
+struct TriangleHitT {
+  T t;
+  T u;  // weight of b
+  T v;  // weight of c
+};
+using TriangleHit = TriangleHitT<double>;
+
+enum class TriangleMethod { kSeedPlane, kSeedUv, kCramer, kMollerTrumbore, kWatertight };
+
+inline constexpr std::array<TriangleMethod, 5> kAllTriangleMethods = {
+    TriangleMethod::kSeedPlane, TriangleMethod::kSeedUv, TriangleMethod::kCramer,
+    TriangleMethod::kMollerTrumbore, TriangleMethod::kWatertight};
+
+// The method's name as used by parameters, the CLI and the benchmark: seed_plane, seed_uv, cramer,
+// moller_trumbore, watertight.
+const char* toString(TriangleMethod method);
+// Parses a name produced by toString(); false for anything else.
+bool parseTriangleMethod(const std::string& name, TriangleMethod* method);
+
+template <typename T>
+inline bool isDegenerateTriangle(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
+  const Vec3<T> n = (b - a).cross(c - a);
+  return n.x() == 0 && n.y() == 0 && n.z() == 0;
+}
+
+namespace detail {
+
+// a * b - c * d with the sign of the exact result (and 0 only when the exact result is 0).
+// For float the products are exact in double. For double, Kahan's algorithm with FMA has a relative
+// error of at most 2 ulp (Jeannerod, Louvet, Muller 2013), which preserves the sign.
+inline float exactSignDifferenceOfProducts(float a, float b, float c, float d) {
+  return static_cast<float>(double(a) * double(b) - double(c) * double(d));
+}
+inline double exactSignDifferenceOfProducts(double a, double b, double c, double d) {
+  const double cd = c * d;
+  const double cd_error = std::fma(-c, d, cd);  // cd - c * d, exactly
+  const double ab_minus_cd = std::fma(a, b, -cd);
+  return ab_minus_cd + cd_error;
+}
+
+}  // namespace detail
+
+// A ray prepared for testing many triangles with one method. intersect() takes the current far
+// limit so that closest-hit traversal can shrink it; it assumes a non-degenerate triangle.
+template <typename T, TriangleMethod M>
+class PreparedRay;
+
+// Seed 000: the plane H = [N, -N.A] with N = (B - A) x (C - B), t = -H.[V,1] / H.[W,0], then the
+// barycentrics from the in-plane perpendiculars pA = N x (C - B), pB = N x (A - C), pC = N x (B -
+// A). Kept as the seed writes it (with the complete-algorithm pB; the seed's prose once prints N x
+// (A - B)).
+template <typename T>
+class PreparedRay<T, TriangleMethod::kSeedPlane> {
+ public:
+  PreparedRay(const RayT<T>& ray, bool cull_backfaces) : ray_(ray), cull_(cull_backfaces) {}
+
+  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                           T tmax) const {
+    const Vec3<T> n = (b - a).cross(c - b);
+    const T h_w = -n.dot(a);
+    const T denom = n.dot(ray_.dir);  // H.[W,0]
+    if (!(denom != 0)) return std::nullopt;
+    if (cull_ && denom > 0) return std::nullopt;
+    const T t = -(n.dot(ray_.origin) + h_w) / denom;  // -H.[V,1] / H.[W,0]
+    if (!(t >= ray_.tmin && t <= tmax)) return std::nullopt;
+    const Vec3<T> p = ray_.origin + t * ray_.dir;
+    const Vec3<T> pa = n.cross(c - b);
+    const Vec3<T> pb = n.cross(a - c);
+    const Vec3<T> pc = n.cross(b - a);
+    const T wa = (p - b).dot(pa) / (a - b).dot(pa);
+    const T wb = (p - c).dot(pb) / (b - c).dot(pb);
+    const T wc = (p - a).dot(pc) / (c - a).dot(pc);
+    if (!(wa >= 0 && wb >= 0 && wc >= 0)) return std::nullopt;
+    return TriangleHitT<T>{t, wb, wc};
+  }
+
+ private:
+  RayT<T> ray_;
+  bool cull_;
+};
+
+// Seed 001: unit normal n = AC x AB, S = R + r (n.RA / n.r), then u, v from the dot products of AB,
+// AC, AS.
+template <typename T>
+class PreparedRay<T, TriangleMethod::kSeedUv> {
+ public:
+  PreparedRay(const RayT<T>& ray, bool cull_backfaces) : ray_(ray), cull_(cull_backfaces) {}
+
+  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                           T tmax) const {
+    const Vec3<T> ab = b - a;
+    const Vec3<T> ac = c - a;
+    Vec3<T> n = ac.cross(ab);
+    const T length = n.norm();
+    if (!(length > 0)) return std::nullopt;
+    n /= length;
+    const T n_dot_r = n.dot(ray_.dir);
+    if (!(n_dot_r != 0)) return std::nullopt;
+    // The seed's normal is AC x AB, the opposite of our front normal, so a back face has n.r < 0.
+    if (cull_ && n_dot_r < 0) return std::nullopt;
+    const T t = n.dot(a - ray_.origin) / n_dot_r;
+    if (!(t >= ray_.tmin && t <= tmax)) return std::nullopt;
+    const Vec3<T> as = ray_.origin + t * ray_.dir - a;
+    const T ab_as = ab.dot(as);
+    const T ac_ac = ac.dot(ac);
+    const T ab_ac = ab.dot(ac);
+    const T ac_as = ac.dot(as);
+    const T ab_ab = ab.dot(ab);
+    const T denom = ab_ab * ac_ac - ab_ac * ab_ac;
+    const T u = (ab_as * ac_ac - ab_ac * ac_as) / denom;
+    // The seed prints this numerator with the opposite sign, (AB.AS)(AB.AC) - (AB.AB)(AC.AS);
+    // solving AS = u AB + v AC by Cramer's rule gives the form below, the only one that passes the
+    // tests.
+    const T v = (ab_ab * ac_as - ab_ac * ab_as) / denom;
+    if (!(u >= 0 && v >= 0 && u + v <= 1)) return std::nullopt;
+    return TriangleHitT<T>{t, u, v};
+  }
+
+ private:
+  RayT<T> ray_;
+  bool cull_;
+};
+
+// Seed 003: [a - b, a - c, d] [beta, gamma, t]^T = a - p by Cramer's rule, det[x y z] = x . (y x
+// z).
+template <typename T>
+class PreparedRay<T, TriangleMethod::kCramer> {
+ public:
+  PreparedRay(const RayT<T>& ray, bool cull_backfaces) : ray_(ray), cull_(cull_backfaces) {}
+
+  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                           T tmax) const {
+    const Vec3<T> e1 = a - b;
+    const Vec3<T> e2 = a - c;
+    const Vec3<T> r = a - ray_.origin;
+    const Vec3<T> e2_x_d = e2.cross(ray_.dir);
+    const T m = e1.dot(e2_x_d);  // det[e1 e2 d] = d . ((b - a) x (c - a))
+    if (!(m != 0)) return std::nullopt;
+    if (cull_ && m > 0) return std::nullopt;
+    const T beta = r.dot(e2_x_d) / m;  // det[r e2 d]
+    const Vec3<T> e1_x_r = e1.cross(r);
+    const T gamma = ray_.dir.dot(e1_x_r) / m;  // det[e1 r d]
+    const T t = -e2.dot(e1_x_r) / m;           // det[e1 e2 r]
+    if (!(beta >= 0 && gamma >= 0 && beta + gamma <= 1)) return std::nullopt;
+    if (!(t >= ray_.tmin && t <= tmax)) return std::nullopt;
+    return TriangleHitT<T>{t, beta, gamma};
+  }
+
+ private:
+  RayT<T> ray_;
+  bool cull_;
+};
+
+// Moller & Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection" (1997), without its epsilon.
+template <typename T>
+class PreparedRay<T, TriangleMethod::kMollerTrumbore> {
+ public:
+  PreparedRay(const RayT<T>& ray, bool cull_backfaces) : ray_(ray), cull_(cull_backfaces) {}
+
+  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                           T tmax) const {
+    const Vec3<T> e1 = b - a;
+    const Vec3<T> e2 = c - a;
+    const Vec3<T> p = ray_.dir.cross(e2);
+    const T det = e1.dot(p);  // = -d . ((b - a) x (c - a)): positive for a front face
+    if (cull_ ? !(det > 0) : !(det != 0)) return std::nullopt;
+    const T inv_det = T(1) / det;
+    const Vec3<T> s = ray_.origin - a;
+    const T u = s.dot(p) * inv_det;
+    if (!(u >= 0 && u <= 1)) return std::nullopt;
+    const Vec3<T> q = s.cross(e1);
+    const T v = ray_.dir.dot(q) * inv_det;
+    if (!(v >= 0 && u + v <= 1)) return std::nullopt;
+    const T t = e2.dot(q) * inv_det;
+    if (!(t >= ray_.tmin && t <= tmax)) return std::nullopt;
+    return TriangleHitT<T>{t, u, v};
+  }
+
+ private:
+  RayT<T> ray_;
+  bool cull_;
+};
+
+// Woop, Benthin, Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013. The vertices are
+// moved into a frame where the ray starts at the origin and runs along +z, and the hit is decided
+// by the signs of three 2D edge functions. Neighbouring triangles evaluate a shared edge from the
+// same transformed vertices with the same formula, so the edge function of one is exactly the
+// negation of the other's: a ray can hit both but never slip between them. Where an edge function
+// rounds to exactly 0 it is recomputed with the exact sign (pbrt-v4 does this in double for float;
+// here double uses an FMA-based product difference).
+template <typename T>
+class PreparedRay<T, TriangleMethod::kWatertight> {
+ public:
+  PreparedRay(const RayT<T>& ray, bool cull_backfaces)
+      : origin_(ray.origin), tmin_(ray.tmin), cull_(cull_backfaces) {
+    // Permute so that z is the dimension where the direction is largest; swapping x and y when that
+    // component is negative keeps the winding (and so the front face) unchanged.
+    kz_ = 0;
+    if (std::abs(ray.dir.y()) > std::abs(ray.dir[kz_])) kz_ = 1;
+    if (std::abs(ray.dir.z()) > std::abs(ray.dir[kz_])) kz_ = 2;
+    kx_ = kz_ == 2 ? 0 : kz_ + 1;
+    ky_ = kx_ == 2 ? 0 : kx_ + 1;
+    if (ray.dir[kz_] < 0) std::swap(kx_, ky_);
+    // Shear that maps the direction to (0, 0, 1).
+    sx_ = ray.dir[kx_] / ray.dir[kz_];
+    sy_ = ray.dir[ky_] / ray.dir[kz_];
+    sz_ = T(1) / ray.dir[kz_];
+  }
+
+  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                           T tmax) const {
+    // Translate to the ray origin, then shear x and y (z is scaled only once the hit is known).
+    const Vec3<T> pa = a - origin_;
+    const Vec3<T> pb = b - origin_;
+    const Vec3<T> pc = c - origin_;
+    const T ax = pa[kx_] - sx_ * pa[kz_];
+    const T ay = pa[ky_] - sy_ * pa[kz_];
+    const T bx = pb[kx_] - sx_ * pb[kz_];
+    const T by = pb[ky_] - sy_ * pb[kz_];
+    const T cx = pc[kx_] - sx_ * pc[kz_];
+    const T cy = pc[ky_] - sy_ * pc[kz_];
+
+    // Edge functions: twice the signed areas of the sub-triangles opposite a, b and c.
+    T ea = cx * by - cy * bx;
+    T eb = ax * cy - ay * cx;
+    T ec = bx * ay - by * ax;
+    if (ea == 0 || eb == 0 || ec == 0) {
+      ea = detail::exactSignDifferenceOfProducts(cx, by, cy, bx);
+      eb = detail::exactSignDifferenceOfProducts(ax, cy, ay, cx);
+      ec = detail::exactSignDifferenceOfProducts(bx, ay, by, ax);
+    }
+    // Inside iff all three have one sign (zero counts as either).
+    if ((ea < 0 || eb < 0 || ec < 0) && (ea > 0 || eb > 0 || ec > 0)) return std::nullopt;
+    const T det = ea + eb + ec;            // positive for a front face
+    if (!(det != 0)) return std::nullopt;  // ray in the triangle's plane, or NaN
+    if (cull_ && det < 0) return std::nullopt;
+
+    // Scaled hit distance, then t.
+    const T az = sz_ * pa[kz_];
+    const T bz = sz_ * pb[kz_];
+    const T cz = sz_ * pc[kz_];
+    const T inv_det = T(1) / det;
+    const T t = (ea * az + eb * bz + ec * cz) * inv_det;
+    if (!(t >= tmin_ && t <= tmax)) return std::nullopt;
+    return TriangleHitT<T>{t, eb * inv_det, ec * inv_det};
+  }
+
+ private:
+  Vec3<T> origin_;
+  T tmin_;
+  bool cull_;
+  int kx_, ky_, kz_;
+  T sx_, sy_, sz_;
+};
+
+// Calls f(std::integral_constant<TriangleMethod, m>{}) for the runtime method m, so that hot loops
+// are compiled once per method.
+template <typename F>
+decltype(auto) dispatchTriangleMethod(TriangleMethod method, F&& f) {
+  switch (method) {
+    case TriangleMethod::kSeedPlane:
+      return f(std::integral_constant<TriangleMethod, TriangleMethod::kSeedPlane>{});
+    case TriangleMethod::kSeedUv:
+      return f(std::integral_constant<TriangleMethod, TriangleMethod::kSeedUv>{});
+    case TriangleMethod::kCramer:
+      return f(std::integral_constant<TriangleMethod, TriangleMethod::kCramer>{});
+    case TriangleMethod::kMollerTrumbore:
+      return f(std::integral_constant<TriangleMethod, TriangleMethod::kMollerTrumbore>{});
+    case TriangleMethod::kWatertight:
+    default:
+      return f(std::integral_constant<TriangleMethod, TriangleMethod::kWatertight>{});
+  }
+}
+
+// The single-triangle entry points, one free function per method (the method as a template
+// argument) and the same selected at run time. Both reject degenerate triangles, then run the
+// method.
+template <TriangleMethod M, typename T>
+std::optional<TriangleHitT<T>> intersectTriangle(const RayT<T>& ray, const Vec3<T>& a,
+                                                 const Vec3<T>& b, const Vec3<T>& c,
+                                                 bool cull_backfaces = false) {
+  if (isDegenerateTriangle(a, b, c)) return std::nullopt;
+  return PreparedRay<T, M>(ray, cull_backfaces).intersect(a, b, c, ray.tmax);
+}
+
+template <typename T>
+std::optional<TriangleHitT<T>> intersectTriangle(TriangleMethod method, const RayT<T>& ray,
+                                                 const Vec3<T>& a, const Vec3<T>& b,
+                                                 const Vec3<T>& c, bool cull_backfaces = false) {
+  return dispatchTriangleMethod(method, [&](auto m) {
+    return intersectTriangle<decltype(m)::value>(ray, a, b, c, cull_backfaces);
+  });
+}
+
+}  // namespace core
+}  // namespace laser_raycast

@@ -1,0 +1,99 @@
+// Turns URDF models and their meshes into a core::Scene (urdfdom + assimp; no roscpp). package://
+// URIs are resolved through a callback, so tests and tools pass plain paths or their own lookup.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "laser_raycast/core/scene.h"
+
+namespace laser_raycast {
+
+// Returns the directory of a ROS package, or nullopt if it is unknown.
+using PackageResolver = std::function<std::optional<std::string>(const std::string& package)>;
+
+// Which URDF geometry becomes the scene.
+enum class GeometrySource {
+  kVisual,  // "visual": each link's visual elements; a link without any uses its collision elements
+  kCollision,  // "collision": collision elements only
+};
+const char* toString(GeometrySource source);
+bool parseGeometrySource(const std::string& name, GeometrySource* source);
+
+// A bad model: the message names the file, the link and the problem.
+class SceneLoadError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct LoaderOptions {
+  GeometrySource geometry = GeometrySource::kVisual;  // which elements to load
+  bool skip_bad_geometry = false;  // a bad element is skipped with a warning instead of an error
+  std::string tf_prefix;  // prepended to every link name (frames and labels), e.g. "robot2/"
+  std::vector<std::string> ignore_links;  // links (without prefix) whose geometry is not loaded
+  core::BvhConfig bvh;                    // BVH build settings for the meshes
+};
+
+// A joint of the model, for forward kinematics (the CLI places links by joint values; the node uses
+// TF).
+struct ModelJoint {
+  enum class Type { kFixed, kRevolute, kContinuous, kPrismatic, kOther };
+  std::string name;
+  Type type = Type::kFixed;
+  std::string parent_link, child_link;                                  // with the tf_prefix
+  Eigen::Isometry3d parent_from_joint = Eigen::Isometry3d::Identity();  // the joint's <origin>
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();                      // unit, in the joint frame
+};
+
+// What one model contributed to the scene.
+struct LoadedModel {
+  std::string name;       // the URDF's robot name
+  std::string root_link;  // with the tf_prefix
+  std::vector<ModelJoint> joints;
+  // Every link (with the tf_prefix) -> the scene frame it moves with and its pose in that frame.
+  // Links joined by fixed joints share the frame of the topmost link of their fixed chain.
+  std::map<std::string, std::pair<std::string, Eigen::Isometry3d>> link_frames;
+  std::size_t links = 0, bodies = 0, triangles = 0;  // triangles over all mesh bodies
+  double load_seconds = 0;                           // parsing and reading meshes
+  double bvh_build_seconds = 0;       // building BVHs (meshes already in the cache cost nothing)
+  std::vector<std::string> warnings;  // elements skipped under skip_bad_geometry
+};
+
+class SceneLoader {
+ public:
+  explicit SceneLoader(PackageResolver resolver);
+
+  // Adds the model's geometry to scene: frames named after the (merged) links, labels after the
+  // links. base_dir is where relative mesh paths are looked up ("" for a URDF that came from a
+  // parameter: then a relative path is an error). Throws SceneLoadError.
+  LoadedModel addUrdfString(const std::string& urdf_xml, const std::string& base_dir,
+                            const LoaderOptions& options, core::Scene* scene);
+  // The same for a file; relative mesh paths are relative to the file's directory.
+  LoadedModel addUrdfFile(const std::string& path, const LoaderOptions& options,
+                          core::Scene* scene);
+
+  // The mesh at uri (package://, file://, absolute, or relative to base_dir), with the URDF scale
+  // and the Collada <unit> applied. Each (file, scale) is read and its BVH built once; later calls
+  // share it. Throws SceneLoadError naming the file and the problem.
+  std::shared_ptr<const core::Mesh> loadMesh(const std::string& uri, const std::string& base_dir,
+                                             const Eigen::Vector3d& scale,
+                                             const core::BvhConfig& bvh);
+
+  // Files read and BVHs built so far (each (file, scale) once).
+  std::size_t meshesLoaded() const { return cache_.size(); }
+
+ private:
+  PackageResolver resolver_;
+  std::map<std::pair<std::string, std::array<double, 3>>, std::shared_ptr<const core::Mesh>> cache_;
+  double last_bvh_seconds_ = 0;
+};
+
+}  // namespace laser_raycast

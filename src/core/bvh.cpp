@@ -1,0 +1,258 @@
+#include "laser_raycast/core/bvh.h"
+
+#include <algorithm>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+struct BuildTriangle {
+  Aabb bounds;
+  Eigen::Vector3d centroid;
+};
+
+struct BuildNode {
+  Aabb bounds;
+  std::uint32_t first = 0;  // inner: left child; leaf: first slot
+  std::uint32_t count = 0;  // leaf: triangle count
+};
+
+struct Task {
+  std::uint32_t node;
+  std::uint32_t begin, end;  // range in the order array
+  int depth;
+};
+
+struct Bin {
+  Aabb bounds;
+  std::uint32_t count = 0;
+};
+
+// Binned SAH (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies", 2007): for
+// each axis, centroids are binned and the split plane between bins with the lowest cost is chosen.
+class Builder {
+ public:
+  Builder(const std::vector<BuildTriangle>& tris, const BvhConfig& config)
+      : tris_(tris), config_(config), order_(tris.size()) {
+    std::iota(order_.begin(), order_.end(), 0u);
+  }
+
+  void run() {
+    nodes_.reserve(2 * tris_.size());
+    nodes_.emplace_back();
+    std::vector<Task> tasks{{0, 0, static_cast<std::uint32_t>(tris_.size()), 0}};
+    while (!tasks.empty()) {
+      const Task task = tasks.back();
+      tasks.pop_back();
+      depth_ = std::max(depth_, task.depth);
+      BuildNode& node = nodes_[task.node];
+      Aabb centroids;
+      for (std::uint32_t i = task.begin; i < task.end; ++i) {
+        node.bounds.grow(tris_[order_[i]].bounds);
+        centroids.grow(tris_[order_[i]].centroid);
+      }
+      const std::uint32_t count = task.end - task.begin;
+      const std::uint32_t mid = split(task, node.bounds, centroids);
+      if (mid == task.begin || mid == task.end) {
+        node.first = task.begin;
+        node.count = count;
+        continue;
+      }
+      const auto left = static_cast<std::uint32_t>(nodes_.size());
+      node.first = left;
+      node.count = 0;
+      nodes_.emplace_back();  // invalidates `node`
+      nodes_.emplace_back();
+      tasks.push_back({left + 1, mid, task.end, task.depth + 1});
+      tasks.push_back({left, task.begin, mid, task.depth + 1});
+    }
+  }
+
+  const std::vector<BuildNode>& nodes() const { return nodes_; }
+  const std::vector<std::uint32_t>& order() const { return order_; }
+  int depth() const { return depth_; }
+
+ private:
+  // Partitions [begin, end) and returns the split point; begin or end means "make a leaf".
+  std::uint32_t split(const Task& task, const Aabb& bounds, const Aabb& centroids) {
+    const std::uint32_t count = task.end - task.begin;
+    if (count <= 1 || task.depth >= config_.max_depth) return task.begin;
+    const int nbins = config_.bins;
+    const double leaf_cost = count;
+    double best_cost = std::numeric_limits<double>::infinity();
+    int best_axis = -1, best_bin = 0;
+    const Eigen::Vector3d extent = centroids.extent();
+    std::vector<Bin> bins(nbins);
+    std::vector<double> right_area(nbins);
+    std::vector<std::uint32_t> right_count(nbins);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(extent[axis] > 0)) continue;
+      const double scale = nbins / extent[axis];
+      std::fill(bins.begin(), bins.end(), Bin{});
+      for (std::uint32_t i = task.begin; i < task.end; ++i) {
+        const BuildTriangle& t = tris_[order_[i]];
+        Bin& bin = bins[binIndex(t.centroid[axis], centroids.lo[axis], scale)];
+        bin.bounds.grow(t.bounds);
+        ++bin.count;
+      }
+      // Sweep from the right, then from the left, to cost each of the nbins - 1 planes.
+      Aabb acc;
+      std::uint32_t n = 0;
+      for (int b = nbins - 1; b > 0; --b) {
+        acc.grow(bins[b].bounds);
+        n += bins[b].count;
+        right_area[b] = acc.halfArea();
+        right_count[b] = n;
+      }
+      acc = Aabb{};
+      n = 0;
+      for (int b = 0; b < nbins - 1; ++b) {
+        acc.grow(bins[b].bounds);
+        n += bins[b].count;
+        if (n == 0 || right_count[b + 1] == 0) continue;
+        const double cost = n * acc.halfArea() + right_count[b + 1] * right_area[b + 1];
+        if (cost < best_cost) {
+          best_cost = cost;
+          best_axis = axis;
+          best_bin = b;
+        }
+      }
+    }
+    const double area = bounds.halfArea();
+    const double split_cost = area > 0 ? config_.traversal_cost + best_cost / area
+                                       : std::numeric_limits<double>::infinity();
+    if (best_axis < 0) {
+      // All centroids coincide: no plane separates them. Halve by count if the leaf would be too
+      // big.
+      if (count <= static_cast<std::uint32_t>(config_.max_leaf_size)) return task.begin;
+      return task.begin + count / 2;
+    }
+    if (split_cost >= leaf_cost && count <= static_cast<std::uint32_t>(config_.max_leaf_size)) {
+      return task.begin;
+    }
+    const double scale = nbins / extent[best_axis];
+    const double lo = centroids.lo[best_axis];
+    const auto it = std::partition(
+        order_.begin() + task.begin, order_.begin() + task.end, [&](std::uint32_t i) {
+          return binIndex(tris_[i].centroid[best_axis], lo, scale) <= best_bin;
+        });
+    return static_cast<std::uint32_t>(it - order_.begin());
+  }
+
+  int binIndex(double c, double lo, double scale) const {
+    const int b = static_cast<int>((c - lo) * scale);
+    return std::min(std::max(b, 0), config_.bins - 1);
+  }
+
+  const std::vector<BuildTriangle>& tris_;
+  const BvhConfig& config_;
+  std::vector<std::uint32_t> order_;
+  std::vector<BuildNode> nodes_;
+  int depth_ = 0;
+};
+
+template <typename T>
+AabbT<T> castBounds(const Aabb& b) {
+  // Rounding to nearest is monotonic, so these are exactly the bounds of the rounded vertices.
+  AabbT<T> out;
+  out.lo = b.lo.cast<T>();
+  out.hi = b.hi.cast<T>();
+  return out;
+}
+
+}  // namespace
+
+void BvhConfig::validate() const {
+  std::ostringstream msg;
+  if (max_leaf_size < 1) {
+    msg << "BvhConfig.max_leaf_size must be >= 1, got " << max_leaf_size;
+  } else if (bins < 2 || bins > 256) {
+    msg << "BvhConfig.bins must be in [2, 256], got " << bins;
+  } else if (!(traversal_cost >= 0 && traversal_cost < 1e6)) {
+    msg << "BvhConfig.traversal_cost must be in [0, 1e6), got " << traversal_cost;
+  } else if (max_depth < 1 || max_depth > 62) {
+    msg << "BvhConfig.max_depth must be in [1, 62] (the traversal stack holds 64), got "
+        << max_depth;
+  } else {
+    return;
+  }
+  throw std::invalid_argument(msg.str());
+}
+
+template <typename T>
+BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
+                       const std::vector<TriangleIndices>& triangles, const BvhConfig& config) {
+  config.validate();
+  std::vector<BuildTriangle> build_tris;
+  std::vector<std::uint32_t> kept;  // original index of each build triangle
+  build_tris.reserve(triangles.size());
+  kept.reserve(triangles.size());
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    const TriangleIndices& tri = triangles[i];
+    // Test degeneracy on the vertices the BVH will store (float rounding can collapse a sliver).
+    const Vec3<T> a = vertices[tri[0]].cast<T>(), b = vertices[tri[1]].cast<T>(),
+                  c = vertices[tri[2]].cast<T>();
+    if (isDegenerateTriangle(a, b, c)) continue;
+    BuildTriangle bt;
+    for (const auto v : tri) bt.bounds.grow(vertices[v]);
+    bt.centroid = bt.bounds.center();
+    build_tris.push_back(bt);
+    kept.push_back(static_cast<std::uint32_t>(i));
+  }
+  BvhT<T> bvh;
+  if (build_tris.empty()) return bvh;
+
+  Builder builder(build_tris, config);
+  builder.run();
+  bvh.depth_ = builder.depth();
+  bvh.nodes_.reserve(builder.nodes().size());
+  for (const BuildNode& n : builder.nodes()) {
+    bvh.nodes_.push_back(Node{castBounds<T>(n.bounds), n.first, n.count});
+  }
+  bvh.triangle_ids_.reserve(build_tris.size());
+  bvh.vertices_.reserve(build_tris.size());
+  for (const std::uint32_t i : builder.order()) {
+    const TriangleIndices& tri = triangles[kept[i]];
+    bvh.triangle_ids_.push_back(kept[i]);
+    bvh.vertices_.push_back(
+        {vertices[tri[0]].cast<T>(), vertices[tri[1]].cast<T>(), vertices[tri[2]].cast<T>()});
+  }
+  return bvh;
+}
+
+template <typename T>
+std::optional<MeshHitT<T>> bruteForceClosestHit(TriangleMethod method,
+                                                const std::vector<Eigen::Vector3d>& vertices,
+                                                const std::vector<TriangleIndices>& triangles,
+                                                const RayT<T>& ray, bool cull_backfaces) {
+  std::optional<MeshHitT<T>> best;
+  RayT<T> r = ray;
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    const TriangleIndices& tri = triangles[i];
+    const auto hit = intersectTriangle(method, r, vertices[tri[0]].cast<T>().eval(),
+                                       vertices[tri[1]].cast<T>().eval(),
+                                       vertices[tri[2]].cast<T>().eval(), cull_backfaces);
+    if (hit) {
+      best = MeshHitT<T>{hit->t, hit->u, hit->v, static_cast<std::uint32_t>(i)};
+      r.tmax = hit->t;
+    }
+  }
+  return best;
+}
+
+template class BvhT<double>;
+template class BvhT<float>;
+template std::optional<MeshHitT<double>> bruteForceClosestHit(TriangleMethod,
+                                                              const std::vector<Eigen::Vector3d>&,
+                                                              const std::vector<TriangleIndices>&,
+                                                              const Ray&, bool);
+template std::optional<MeshHitT<float>> bruteForceClosestHit(TriangleMethod,
+                                                             const std::vector<Eigen::Vector3d>&,
+                                                             const std::vector<TriangleIndices>&,
+                                                             const RayF&, bool);
+
+}  // namespace core
+}  // namespace laser_raycast

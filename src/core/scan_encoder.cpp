@@ -1,0 +1,103 @@
+#include "laser_raycast/core/scan_encoder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace laser_raycast {
+namespace core {
+
+const char* toString(MinRangePolicy policy) {
+  switch (policy) {
+    case MinRangePolicy::kNegInf:
+      return "-inf";
+    case MinRangePolicy::kPassThrough:
+      return "pass_through";
+    case MinRangePolicy::kNan:
+      return "nan";
+  }
+  return "unknown";
+}
+
+bool parseMinRangePolicy(const std::string& name, MinRangePolicy* policy) {
+  for (const MinRangePolicy p :
+       {MinRangePolicy::kNegInf, MinRangePolicy::kPassThrough, MinRangePolicy::kNan}) {
+    if (name == toString(p)) {
+      *policy = p;
+      return true;
+    }
+  }
+  return false;
+}
+
+void EncoderConfig::validate() const {
+  std::ostringstream msg;
+  if (!(std::isfinite(range_min) && range_min >= 0)) {
+    msg << "range_min must be finite and >= 0, got " << range_min;
+  } else if (!(std::isfinite(range_max) && range_max > range_min)) {
+    msg << "range_max (" << range_max << " m) must be finite and greater than range_min ("
+        << range_min << " m)";
+  } else if (!(std::isfinite(noise_stddev) && noise_stddev >= 0)) {
+    msg << "noise_stddev must be finite and >= 0, got " << noise_stddev;
+  } else {
+    return;
+  }
+  throw std::invalid_argument(msg.str());
+}
+
+double classifyRange(double range, const EncoderConfig& config) {
+  if (std::isnan(range)) return range;
+  if (!(range <= config.range_max)) return std::numeric_limits<double>::infinity();
+  if (range < config.range_min) {
+    switch (config.min_range_policy) {
+      case MinRangePolicy::kNegInf:
+        return -std::numeric_limits<double>::infinity();
+      case MinRangePolicy::kNan:
+        return std::numeric_limits<double>::quiet_NaN();
+      case MinRangePolicy::kPassThrough:
+        // The cast started at range_min, so this only happens if the caller cast from 0.
+        return std::numeric_limits<double>::infinity();
+    }
+  }
+  return range;
+}
+
+ScanEncoder::ScanEncoder(const EncoderConfig& config)
+    : config_(config), rng_(config.noise_seed), noise_(0.0, 1.0) {
+  config_.validate();
+}
+
+void ScanEncoder::encode(const Scene& scene, const ScanResult& result,
+                         const std::vector<double>& reflectivity, EncodedScan* out) {
+  const std::size_t n = result.range.size();
+  out->ranges.resize(n);
+  out->labels.resize(n);
+  if (config_.intensity) {
+    if (result.cos_incidence.size() != n) {
+      throw std::invalid_argument("intensity needs the cast's cos_incidence (compute_incidence)");
+    }
+    out->intensities.assign(n, 0.0f);
+  } else {
+    out->intensities.clear();
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const int body = result.body[i];
+    const int label = body >= 0 ? scene.bodies()[body].label : -1;
+    out->labels[i] = label;
+    double r = classifyRange(result.range[i], config_);
+    const bool valid = std::isfinite(r);
+    if (valid && config_.noise_stddev > 0) {
+      r = std::clamp(r + config_.noise_stddev * noise_(rng_), config_.range_min, config_.range_max);
+    }
+    out->ranges[i] = static_cast<float>(r);  // the one rounding to float
+    if (config_.intensity && valid && label >= 0) {
+      const double rho = label < static_cast<int>(reflectivity.size()) ? reflectivity[label] : 1.0;
+      out->intensities[i] = static_cast<float>(rho * result.cos_incidence[i]);
+    }
+  }
+}
+
+}  // namespace core
+}  // namespace laser_raycast

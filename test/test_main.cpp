@@ -1,0 +1,7 @@
+// main() for the gtest executables: catkin_add_gtest does not supply one.
+#include <gtest/gtest.h>
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
