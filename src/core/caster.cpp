@@ -138,7 +138,9 @@ const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
   std::vector<Eigen::Isometry3d> sensor_from_frame(frame_count, Eigen::Isometry3d::Identity());
   std::vector<char> valid(frame_count, 0);
   for (std::size_t f = 0; f < frame_count; ++f) {
-    valid[f] = sensor_ok && poses.valid[f];
+    // A pose marked valid but not a finite rigid transform (FramePoses filled by hand rather than
+    // by resolveFramePoses) would be inverted by transposing its rotation: treat it as unknown.
+    valid[f] = sensor_ok && poses.valid[f] && isValidPose(poses.pose[f]);
     if (valid[f]) sensor_from_frame[f] = relativePose(world_from_sensor, poses.pose[f]);
   }
   if (sensor_ok && unchanged(scene, sensor_from_frame, valid, pattern, config)) {

@@ -62,11 +62,13 @@ std::optional<PrimitiveHit> intersect(const Ray& ray, const Box& box) {
     double t0 = (-half[k] - o) / d;
     double t1 = (half[k] - o) / d;
     if (t0 > t1) std::swap(t0, t1);
-    if (t0 > t_enter) {
+    // The first moving axis always sets the axes: when every distance overflows to +-inf, none is
+    // strictly beyond the initial +-inf, and the normals below would be indexed with -1.
+    if (enter_axis < 0 || t0 > t_enter) {
       t_enter = t0;
       enter_axis = k;
     }
-    if (t1 < t_exit) {
+    if (exit_axis < 0 || t1 < t_exit) {
       t_exit = t1;
       exit_axis = k;
     }
@@ -108,10 +110,14 @@ std::optional<PrimitiveHit> intersect(const Ray& ray, const Cylinder& cylinder) 
   const Eigen::Vector3d& d = ray.dir;
   const double r = cylinder.radius;
   const double h = cylinder.length * 0.5;
-  Nearest nearest{ray.tmin, ray.tmax, std::nullopt};
 
-  // Side: the circle in xy, accepted where |z| <= h. A ray parallel to the axis (a == 0) has no
-  // side hit; if it runs exactly along the side surface it meets the rim of a cap instead.
+  // The solid is the infinite tube x^2 + y^2 <= r^2 cut by the slab |z| <= h. Each gives the
+  // interval of t where the ray is inside it; the surface is crossed where the intersection of the
+  // two intervals begins and ends, on whichever surface bounds it there (the box's slab test, with
+  // the tube as one slab). Testing each surface's hit point against the other surface instead (|z|
+  // <= h for the side, inside the disc for a cap) lets rounding reject both near the rim, and rays
+  // slip out between side and cap.
+  double tube_in = -kInf, tube_out = kInf;
   const double a = d.x() * d.x() + d.y() * d.y();
   if (a > 0) {
     const double b = o.x() * d.x() + o.y() * d.y();
@@ -119,24 +125,35 @@ std::optional<PrimitiveHit> intersect(const Ray& ray, const Cylinder& cylinder) 
     const Eigen::Vector2d f(o.x() - (b / a) * d.x(), o.y() - (b / a) * d.y());
     const double fn = f.norm();
     const double discriminant = a * (r - fn) * (r + fn);
-    double t0, t1;
-    if (solveQuadratic(a, b, c, discriminant, &t0, &t1)) {
-      for (const double t : {t0, t1}) {
-        const Eigen::Vector3d p = o + t * d;
-        if (std::abs(p.z()) <= h) nearest.offer(t, Eigen::Vector3d(p.x() / r, p.y() / r, 0.0));
-      }
-    }
+    if (!solveQuadratic(a, b, c, discriminant, &tube_in, &tube_out)) return std::nullopt;
+  } else if (o.x() * o.x() + o.y() * o.y() > r * r) {
+    // Parallel to the axis and outside the tube. A ray exactly on the side surface is inside: it
+    // meets the rim of a cap.
+    return std::nullopt;
   }
-
-  // Caps: the planes z = +-h, accepted inside the disc.
+  double slab_in = -kInf, slab_out = kInf;
   if (d.z() != 0) {
-    for (const double zc : {-h, h}) {
-      const double t = (zc - o.z()) / d.z();
-      const double x = o.x() + t * d.x();
-      const double y = o.y() + t * d.y();
-      if (x * x + y * y <= r * r) nearest.offer(t, Eigen::Vector3d(0.0, 0.0, zc > 0 ? 1.0 : -1.0));
-    }
+    slab_in = (-h - o.z()) / d.z();
+    slab_out = (h - o.z()) / d.z();
+    if (slab_in > slab_out) std::swap(slab_in, slab_out);
+  } else if (std::abs(o.z()) > h) {
+    return std::nullopt;  // parallel to the caps, outside the slab
   }
+  const bool enter_side = tube_in > slab_in;  // otherwise through a cap
+  const bool exit_side = tube_out < slab_out;
+  const double t_enter = enter_side ? tube_in : slab_in;
+  const double t_exit = exit_side ? tube_out : slab_out;
+  if (!(t_enter <= t_exit)) return std::nullopt;
+
+  auto side_normal = [&](double t) {
+    const Eigen::Vector3d p = o + t * d;
+    return Eigen::Vector3d(p.x() / r, p.y() / r, 0.0);
+  };
+  // Through a cap the ray enters against its normal and leaves along it.
+  const Eigen::Vector3d cap_exit_normal(0.0, 0.0, d.z() > 0 ? 1.0 : -1.0);
+  Nearest nearest{ray.tmin, ray.tmax, std::nullopt};
+  nearest.offer(t_enter, enter_side ? side_normal(t_enter) : Eigen::Vector3d(-cap_exit_normal));
+  if (!nearest.hit) nearest.offer(t_exit, exit_side ? side_normal(t_exit) : cap_exit_normal);
   return nearest.hit;
 }
 

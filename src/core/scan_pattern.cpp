@@ -1,5 +1,6 @@
 #include "laser_raycast/core/scan_pattern.h"
 
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -39,8 +40,10 @@ void FanSpec::validate() const {
     }
     const double n = std::round((angle_max - angle_min) / angle_increment) + 1;
     if (!(n <= kMaxBeams)) {
-      msg << "angle_increment " << angle_increment << " rad gives " << n << " beams over ["
-          << angle_min << ", " << angle_max << "] rad; at most " << kMaxBeams << " are allowed";
+      msg << "angle_increment " << angle_increment << " rad gives " << std::fixed
+          << std::setprecision(0) << n << std::defaultfloat << std::setprecision(6)
+          << " beams over [" << angle_min << ", " << angle_max << "] rad; at most " << kMaxBeams
+          << " are allowed";
       fail(msg);
     }
   } else if (samples < 2 || samples > kMaxBeams) {

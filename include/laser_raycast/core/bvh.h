@@ -4,7 +4,9 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -105,10 +107,24 @@ std::optional<MeshHitT<T>> BvhT<T>::traverse(const RayT<T>& ray, bool cull_backf
   std::optional<MeshHitT<T>> best;
   if (nodes_.empty()) return best;
   const PreparedRay<T, M> prepared(ray, cull_backfaces);
-  const SlabRay<T> slab(ray);
+  // Boxes are culled against [tmin, tmax] widened by 64 ulps of |t| plus the ray's reach (the
+  // farthest root-box coordinate, in units of t); the triangle tests still use the exact interval.
+  // A triangle's t is rounded differently from its box's entry and exit, with an error that scales
+  // with the vertices' distance (pbrt-v4 bounds the watertight test's by a few tens of ulps of it),
+  // and where a hit lies in a box face (axis-aligned walls, flat leaves) nothing else separates the
+  // two: unwidened, a hit at exactly tmax or tmin, or the nearer of two hits ulps apart in
+  // different leaves, was lost.
+  constexpr T kWiden = 64 * std::numeric_limits<T>::epsilon();
+  const AabbT<T>& root = nodes_[0].bounds;
+  const T reach =
+      (root.lo - ray.origin).cwiseAbs().cwiseMax((root.hi - ray.origin).cwiseAbs()).maxCoeff() /
+      ray.dir.cwiseAbs().maxCoeff();
+  SlabRay<T> slab(ray);
+  slab.tmin = ray.tmin - (std::abs(ray.tmin) + reach) * kWiden;
   T tmax = ray.tmax;
+  T cull_tmax = tmax + (std::abs(tmax) + reach) * kWiden;
   T t_root;
-  if (!slabTest(slab, nodes_[0].bounds, tmax, &t_root)) return best;
+  if (!slabTest(slab, root, cull_tmax, &t_root)) return best;
 
   // Each entry remembers its box's entry distance, so a box found farther than a later hit is
   // skipped.
@@ -121,7 +137,7 @@ std::optional<MeshHitT<T>> BvhT<T>::traverse(const RayT<T>& ray, bool cull_backf
   stack[top++] = Entry{0, t_root};
   while (top > 0) {
     const Entry entry = stack[--top];
-    if (entry.t_entry > tmax) continue;
+    if (entry.t_entry > cull_tmax) continue;
     const Node& node = nodes_[entry.node];
     if (node.isLeaf()) {
       for (std::uint32_t slot = node.first; slot < node.first + node.count; ++slot) {
@@ -131,6 +147,7 @@ std::optional<MeshHitT<T>> BvhT<T>::traverse(const RayT<T>& ray, bool cull_backf
           best = MeshHitT<T>{hit->t, hit->u, hit->v, triangle_ids_[slot]};
           if (kAnyHit) return best;
           tmax = hit->t;
+          cull_tmax = tmax + (std::abs(tmax) + reach) * kWiden;
         }
       }
       continue;
@@ -138,8 +155,8 @@ std::optional<MeshHitT<T>> BvhT<T>::traverse(const RayT<T>& ray, bool cull_backf
     // Visit the nearer child first; push the farther one underneath it.
     const std::uint32_t left = node.first, right = node.first + 1;
     T t_left, t_right;
-    const bool hit_left = slabTest(slab, nodes_[left].bounds, tmax, &t_left);
-    const bool hit_right = slabTest(slab, nodes_[right].bounds, tmax, &t_right);
+    const bool hit_left = slabTest(slab, nodes_[left].bounds, cull_tmax, &t_left);
+    const bool hit_right = slabTest(slab, nodes_[right].bounds, cull_tmax, &t_right);
     if (hit_left && hit_right) {
       if (t_left <= t_right) {
         stack[top++] = Entry{right, t_right};

@@ -54,6 +54,9 @@ class Caster {
                          const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
                          const CastConfig& config);
 
+  // Drops the remembered inputs, so that the next cast() computes even if nothing moved (timing).
+  void forget() { has_previous_ = false; }
+
   // A body prepared for this scan: its pose relative to the sensor and its culling data.
   struct ActiveBody {
     int index;

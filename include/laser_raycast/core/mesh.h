@@ -23,7 +23,8 @@ class Mesh {
   const std::vector<TriangleIndices>& triangles() const { return triangles_; }
   const Bvh& bvh() const { return bvh_; }
   const Aabb& bounds() const { return bounds_; }
-  // A sphere containing every vertex: centre of the bounds, radius to the farthest vertex.
+  // A sphere containing every vertex that a triangle uses: centre of their bounds, radius to the
+  // farthest of them.
   const Eigen::Vector3d& sphereCenter() const { return sphere_center_; }
   double sphereRadius() const { return sphere_radius_; }
   std::size_t degenerateTriangleCount() const {

@@ -42,7 +42,8 @@ struct EncoderConfig {
 };
 
 // REP 117 for one noise-free range from the caster: a hit in [range_min, range_max] is itself, a
-// hit closer than range_min follows the policy, no hit is +Inf, NaN stays NaN.
+// hit closer than range_min follows the policy, no hit is +Inf, NaN stays NaN. Under pass_through the
+// cast starts at range_min (castTmin()), so no closer range comes from it; one passed anyway is +Inf.
 double classifyRange(double range, const EncoderConfig& config);
 
 struct EncodedScan {

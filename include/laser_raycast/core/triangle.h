@@ -20,6 +20,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -225,7 +226,12 @@ template <typename T>
 class PreparedRay<T, TriangleMethod::kWatertight> {
  public:
   PreparedRay(const RayT<T>& ray, bool cull_backfaces)
-      : origin_(ray.origin), tmin_(ray.tmin), cull_(cull_backfaces) {
+      : origin_(ray.origin),
+        // An invalid ray gets tmin = NaN, so that no t passes the range test. An infinite
+        // direction component would otherwise give sz_ = 0 and a hit at t = 0 on every triangle
+        // the ray's line crosses.
+        tmin_(isValidRay(ray) ? ray.tmin : std::numeric_limits<T>::quiet_NaN()),
+        cull_(cull_backfaces) {
     // Permute so that z is the dimension where the direction is largest; swapping x and y when that
     // component is negative keeps the winding (and so the front face) unchanged.
     kz_ = 0;
