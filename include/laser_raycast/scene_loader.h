@@ -73,9 +73,11 @@ class SceneLoader {
 
   // Adds the model's geometry to scene: frames named after the (merged) links, labels after the
   // links. base_dir is where relative mesh paths are looked up ("" for a URDF that came from a
-  // parameter: then a relative path is an error). Throws SceneLoadError.
+  // parameter: then a relative path is an error). source names the URDF in error messages (e.g.
+  // "parameter /robot_description"). Throws SceneLoadError.
   LoadedModel addUrdfString(const std::string& urdf_xml, const std::string& base_dir,
-                            const LoaderOptions& options, core::Scene* scene);
+                            const LoaderOptions& options, core::Scene* scene,
+                            const std::string& source = "<URDF string>");
   // The same for a file; relative mesh paths are relative to the file's directory.
   LoadedModel addUrdfFile(const std::string& path, const LoaderOptions& options,
                           core::Scene* scene);
@@ -91,6 +93,10 @@ class SceneLoader {
   std::size_t meshesLoaded() const { return cache_.size(); }
 
  private:
+  // Both public add functions end here; source names the URDF in messages.
+  LoadedModel addUrdf(const std::string& urdf_xml, const std::string& base_dir,
+                      const std::string& source, const LoaderOptions& options, core::Scene* scene);
+
   PackageResolver resolver_;
   std::map<std::pair<std::string, std::array<double, 3>>, std::shared_ptr<const core::Mesh>> cache_;
   double last_bvh_seconds_ = 0;
