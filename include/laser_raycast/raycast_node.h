@@ -1,0 +1,69 @@
+// The ROS wrapper: parameters, scene loading, TF and pose input, timers, and the LaserScan and
+// label publishers around the core. main() and the nodelet only construct it and call init().
+#pragma once
+
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <topic_tools/shape_shifter.h>
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/scan_pattern.h"
+#include "laser_raycast/core/scene.h"
+#include "laser_raycast/node_params.h"
+
+namespace laser_raycast {
+
+class RaycastNode {
+ public:
+  RaycastNode(ros::NodeHandle nh, ros::NodeHandle pnh);
+
+  // Reads and validates the parameters, loads the scene, and starts publishing. Returns false after
+  // logging (ROS_FATAL) what is wrong: a bad parameter, a missing URDF, or bad geometry.
+  bool init();
+
+ private:
+  bool loadScene();
+  void onTimer(const ros::TimerEvent& event);
+  void onPose(const topic_tools::ShapeShifter::ConstPtr& msg);
+  // The pose of frame_id in fixed_frame for this scan; false (after a throttled warning) if
+  // unknown.
+  bool sensorPose(const ros::Time& stamp, const ros::Time& deadline, Eigen::Isometry3d* pose);
+  // A TF look-up of `frame` in fixed_frame at stamp, waiting until deadline at most.
+  bool lookup(const std::string& frame, const ros::Time& stamp, const ros::Time& deadline,
+              Eigen::Isometry3d* pose, std::string* error);
+
+  ros::NodeHandle nh_, pnh_;
+  NodeParams params_;
+  core::Scene scene_;
+  std::unique_ptr<core::ScanPattern> pattern_;
+  core::CastConfig cast_config_;
+  core::Caster caster_;
+  std::unique_ptr<core::ScanEncoder> encoder_;
+  std::vector<double> reflectivity_by_label_;
+  core::FramePoses frame_poses_;
+  core::EncodedScan encoded_;
+
+  tf2_ros::Buffer tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::Publisher scan_pub_, labels_pub_;
+  ros::Subscriber pose_sub_;
+  ros::Timer timer_;
+
+  // The latest pose from pose_topic (of pose_frame, in fixed_frame), guarded for multi-threaded
+  // nodelet managers.
+  std::mutex pose_mutex_;
+  std::optional<Eigen::Isometry3d> topic_pose_;
+
+  std::uint64_t scans_ = 0, scans_skipped_ = 0, missing_link_poses_ = 0;
+};
+
+}  // namespace laser_raycast

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Quick start command (2): install what is missing, build, run every test (gtest and rostest), print a
+# summary, exit non-zero on any failure or if no test ran. .ci/run calls exactly this.
+#
+# Tests that use the real third-party scene in ../shared/data (beside the clone) run when it is present and
+# are skipped otherwise; LASER_RAYCAST_REQUIRE_SHARED_DATA=1 turns its absence into a failure.
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+
+install_missing "${APT_PACKAGES[@]}"
+build_workspace
+source_workspace
+
+shared_data=$(cd "$REPO_DIR/.." && pwd)/shared/data
+if [ -d "$shared_data/tb3_world_data" ]; then
+  export LASER_RAYCAST_SHARED_DATA=$shared_data
+  export ROS_PACKAGE_PATH=$ROS_PACKAGE_PATH:$shared_data
+  log "using shared test data in $shared_data"
+else
+  log "no ../shared/data: tests on the TurtleBot3 scene will be skipped"
+fi
+
+rm -rf "$WS_DIR/build/test_results"
+status=0
+(cd "$WS_DIR" && catkin_make -j"$JOBS" run_tests >&2) || status=$?
+if [ $status -ne 0 ]; then
+  log "building or running the tests failed (catkin_make run_tests exit $status)"
+fi
+
+summary=$(catkin_test_results --verbose "$WS_DIR/build/test_results") || status=1
+echo "$summary"
+total=$(echo "$summary" | sed -n 's/^Summary: \([0-9]*\) tests.*/\1/p' | tail -n 1)
+if [ -z "$total" ] || [ "$total" -eq 0 ]; then
+  log "FAILED: no tests ran"
+  exit 1
+fi
+if [ $status -ne 0 ]; then
+  log "FAILED"
+  exit 1
+fi
+log "all $total tests passed"

@@ -1,0 +1,331 @@
+#include "laser_raycast/raycast_node.h"
+
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <ros/package.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+
+#include "laser_raycast/ScanLabels.h"
+#include "laser_raycast/core/pose.h"
+#include "laser_raycast/scene_loader.h"
+
+namespace laser_raycast {
+namespace {
+
+std::optional<std::string> rosPackagePath(const std::string& package) {
+  const std::string path = ros::package::getPath(package);
+  if (path.empty()) return std::nullopt;
+  return path;
+}
+
+// A URDF file given as a path or a package:// URI.
+std::string resolveModelFile(const std::string& file) {
+  const std::string scheme = "package://";
+  if (file.compare(0, scheme.size(), scheme) != 0) return file;
+  const std::string rest = file.substr(scheme.size());
+  const std::string package = rest.substr(0, rest.find('/'));
+  const auto dir = rosPackagePath(package);
+  if (!dir) return file;  // the loader reports the unreadable file
+  return *dir + rest.substr(package.size());
+}
+
+// A pose from a message: finite, with a quaternion within 1% of unit length (normalised here;
+// farther off is a bad message, not rounding).
+bool poseFromMsg(const geometry_msgs::Pose& msg, Eigen::Isometry3d* pose) {
+  const Eigen::Vector3d t(msg.position.x, msg.position.y, msg.position.z);
+  Eigen::Quaterniond q(msg.orientation.w, msg.orientation.x, msg.orientation.y, msg.orientation.z);
+  const double norm = q.norm();
+  if (!t.allFinite() || !(std::abs(norm - 1.0) <= 0.01)) return false;
+  q.coeffs() /= norm;
+  pose->setIdentity();
+  pose->linear() = q.toRotationMatrix();
+  pose->translation() = t;
+  return true;
+}
+
+std::string joinFirst(const std::vector<std::string>& names, std::size_t n) {
+  std::ostringstream s;
+  for (std::size_t i = 0; i < names.size() && i < n; ++i) s << (i ? ", " : "") << names[i];
+  if (names.size() > n) s << ", ... (" << names.size() - n << " more)";
+  return s.str();
+}
+
+}  // namespace
+
+RaycastNode::RaycastNode(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(std::move(nh)), pnh_(std::move(pnh)) {}
+
+bool RaycastNode::init() {
+  std::string error;
+  if (!readNodeParams(pnh_, &params_, &error)) {
+    ROS_FATAL_STREAM(error);
+    return false;
+  }
+  pattern_ = std::make_unique<core::ScanPattern>(params_.fan);
+  encoder_ = std::make_unique<core::ScanEncoder>(params_.encoder);
+  cast_config_.method = params_.method;
+  cast_config_.cull_backfaces = params_.cull_backfaces;
+  cast_config_.tmin = params_.encoder.castTmin();
+  cast_config_.tmax = params_.encoder.castTmax();
+  cast_config_.compute_incidence = params_.encoder.intensity;
+  if (!loadScene()) return false;
+
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh_);
+  scan_pub_ = nh_.advertise<sensor_msgs::LaserScan>("scan", 10);
+  labels_pub_ = nh_.advertise<laser_raycast::ScanLabels>("scan_labels", 10);
+  if (!params_.pose_topic.empty()) {
+    pose_sub_ = nh_.subscribe(params_.pose_topic, 10, &RaycastNode::onPose, this);
+  }
+  timer_ = nh_.createTimer(ros::Duration(1.0 / params_.rate), &RaycastNode::onTimer, this);
+  ROS_INFO_STREAM("laser_raycast: "
+                  << pattern_->size() << " beams from " << pattern_->angleMin() << " to "
+                  << pattern_->angleMax() << " rad at " << params_.rate << " Hz in frame '"
+                  << params_.frame_id << "', sensor pose from "
+                  << (params_.pose_topic.empty() ? "TF" : "topic " + params_.pose_topic)
+                  << "; publishing " << scan_pub_.getTopic());
+  return true;
+}
+
+bool RaycastNode::loadScene() {
+  SceneLoader loader(rosPackagePath);
+  std::set<std::string> all_links;
+  for (std::size_t i = 0; i < params_.models.size(); ++i) {
+    const ModelSource& model = params_.models[i];
+    LoaderOptions options;
+    options.geometry = params_.geometry;
+    options.skip_bad_geometry = params_.skip_bad_geometry;
+    options.tf_prefix = model.tf_prefix;
+    // ~ignore_links may name links with or without this model's prefix.
+    for (const std::string& link : params_.ignore_links) {
+      options.ignore_links.push_back(link);
+      if (!model.tf_prefix.empty() &&
+          link.compare(0, model.tf_prefix.size(), model.tf_prefix) == 0) {
+        options.ignore_links.push_back(link.substr(model.tf_prefix.size()));
+      }
+    }
+    LoadedModel loaded;
+    try {
+      if (!model.param.empty()) {
+        std::string xml;
+        if (!nh_.getParam(model.param, xml)) {
+          ROS_FATAL_STREAM("~models[" << i << "]: parameter " << nh_.resolveName(model.param)
+                                      << " is not set or is not a string: no URDF to load");
+          return false;
+        }
+        loaded = loader.addUrdfString(xml, "", options, &scene_,
+                                      "parameter " + nh_.resolveName(model.param));
+      } else {
+        loaded = loader.addUrdfFile(resolveModelFile(model.file), options, &scene_);
+      }
+    } catch (const SceneLoadError& e) {
+      // The message starts with the URDF's source (file or parameter).
+      ROS_FATAL_STREAM(e.what() << (params_.skip_bad_geometry
+                                        ? ""
+                                        : " (set ~skip_bad_geometry to skip bad elements)"));
+      return false;
+    }
+    for (const std::string& warning : loaded.warnings) {
+      ROS_WARN_STREAM("skipped: " << warning);
+    }
+    for (const auto& link : loaded.link_frames) all_links.insert(link.first);
+    ROS_INFO(
+        "model '%s' (%s): %zu links, %zu bodies, %zu triangles; loaded in %.3f s, BVHs built "
+        "in %.3f s",
+        loaded.name.c_str(), model.describe().c_str(), loaded.links, loaded.bodies,
+        loaded.triangles, loaded.load_seconds, loaded.bvh_build_seconds);
+  }
+  for (const std::string& link : params_.ignore_links) {
+    bool found = all_links.count(link) > 0;
+    for (const ModelSource& model : params_.models)
+      found |= all_links.count(model.tf_prefix + link) > 0;
+    if (!found) ROS_WARN_STREAM("~ignore_links: no model has a link '" << link << "'");
+  }
+
+  // Reflectivity per label (labels are the links, with their TF prefix).
+  const auto& labels = scene_.labels();
+  for (const auto& entry : params_.reflectivity) {
+    if (std::find(labels.begin(), labels.end(), entry.first) == labels.end()) {
+      ROS_FATAL_STREAM("~reflectivity names link '"
+                       << entry.first
+                       << "', which has no geometry in any model (links "
+                          "with geometry: "
+                       << joinFirst(labels, 20) << ")");
+      return false;
+    }
+  }
+  reflectivity_by_label_.clear();
+  for (const std::string& label : labels) {
+    const auto it = params_.reflectivity.find(label);
+    reflectivity_by_label_.push_back(
+        it != params_.reflectivity.end() ? it->second : params_.default_reflectivity);
+  }
+  if (scene_.bodies().empty()) {
+    ROS_WARN("the scene has no geometry: every beam will report +Inf");
+  }
+  return true;
+}
+
+bool RaycastNode::lookup(const std::string& frame, const ros::Time& stamp,
+                         const ros::Time& deadline, Eigen::Isometry3d* pose, std::string* error) {
+  if (frame == params_.fixed_frame) {
+    pose->setIdentity();
+    return true;
+  }
+  const ros::Duration timeout = std::max(ros::Duration(0), deadline - ros::Time::now());
+  try {
+    *pose = tf2::transformToEigen(
+        tf_buffer_.lookupTransform(params_.fixed_frame, frame, stamp, timeout));
+    return true;
+  } catch (const tf2::TransformException& e) {
+    *error = e.what();
+    return false;
+  }
+}
+
+bool RaycastNode::sensorPose(const ros::Time& stamp, const ros::Time& deadline,
+                             Eigen::Isometry3d* pose) {
+  std::string error;
+  if (params_.pose_topic.empty()) {
+    if (lookup(params_.frame_id, stamp, deadline, pose, &error)) return true;
+    ROS_WARN_THROTTLE(5, "no transform from '%s' to '%s' at t = %.3f: scan skipped (%s)",
+                      params_.frame_id.c_str(), params_.fixed_frame.c_str(), stamp.toSec(),
+                      error.c_str());
+    return false;
+  }
+  Eigen::Isometry3d world_from_pose_frame;
+  {
+    std::lock_guard<std::mutex> lock(pose_mutex_);
+    if (!topic_pose_) {
+      ROS_WARN_THROTTLE(5, "no pose received yet on %s: scan skipped",
+                        pose_sub_.getTopic().c_str());
+      return false;
+    }
+    world_from_pose_frame = *topic_pose_;
+  }
+  if (params_.pose_frame.empty() || params_.pose_frame == params_.frame_id) {
+    *pose = world_from_pose_frame;
+    return true;
+  }
+  // The sensor relative to the frame whose pose the topic gives (usually a static mount).
+  const ros::Duration timeout = std::max(ros::Duration(0), deadline - ros::Time::now());
+  try {
+    const Eigen::Isometry3d pose_frame_from_sensor = tf2::transformToEigen(
+        tf_buffer_.lookupTransform(params_.pose_frame, params_.frame_id, stamp, timeout));
+    *pose = world_from_pose_frame * pose_frame_from_sensor;
+    return true;
+  } catch (const tf2::TransformException& e) {
+    ROS_WARN_THROTTLE(5, "no transform from '%s' to '%s' at t = %.3f: scan skipped (%s)",
+                      params_.frame_id.c_str(), params_.pose_frame.c_str(), stamp.toSec(),
+                      e.what());
+    return false;
+  }
+}
+
+void RaycastNode::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
+  const std::string& type = msg->getDataType();
+  std_msgs::Header header;
+  geometry_msgs::Pose pose_msg;
+  if (type == "geometry_msgs/PoseStamped") {
+    const auto m = msg->instantiate<geometry_msgs::PoseStamped>();
+    header = m->header;
+    pose_msg = m->pose;
+  } else if (type == "geometry_msgs/PoseWithCovarianceStamped") {
+    const auto m = msg->instantiate<geometry_msgs::PoseWithCovarianceStamped>();
+    header = m->header;
+    pose_msg = m->pose.pose;
+  } else {
+    ROS_ERROR_THROTTLE(10,
+                       "~pose_topic %s carries %s; expected geometry_msgs/PoseStamped or "
+                       "geometry_msgs/PoseWithCovarianceStamped (message ignored)",
+                       pose_sub_.getTopic().c_str(), type.c_str());
+    return;
+  }
+  Eigen::Isometry3d pose;
+  if (!poseFromMsg(pose_msg, &pose)) {
+    ROS_WARN_THROTTLE(5, "pose on %s is not finite or its quaternion is not unit length: ignored",
+                      pose_sub_.getTopic().c_str());
+    return;
+  }
+  // A pose given in another frame is brought into fixed_frame with TF at its own stamp.
+  if (!header.frame_id.empty() && header.frame_id != params_.fixed_frame) {
+    try {
+      pose = tf2::transformToEigen(
+                 tf_buffer_.lookupTransform(params_.fixed_frame, header.frame_id, header.stamp)) *
+             pose;
+    } catch (const tf2::TransformException& e) {
+      ROS_WARN_THROTTLE(5, "pose on %s is in '%s', which has no transform to '%s': ignored (%s)",
+                        pose_sub_.getTopic().c_str(), header.frame_id.c_str(),
+                        params_.fixed_frame.c_str(), e.what());
+      return;
+    }
+  }
+  std::lock_guard<std::mutex> lock(pose_mutex_);
+  topic_pose_ = pose;
+}
+
+void RaycastNode::onTimer(const ros::TimerEvent&) {
+  const ros::Time stamp = ros::Time::now();
+  if (stamp.isZero()) return;  // simulated time has not started
+  const ros::Time deadline = stamp + ros::Duration(params_.tf_timeout);
+
+  Eigen::Isometry3d world_from_sensor;
+  if (!sensorPose(stamp, deadline, &world_from_sensor)) {
+    ++scans_skipped_;
+    return;
+  }
+  std::vector<std::string> missing;
+  std::string first_error;
+  core::resolveFramePoses(
+      scene_,
+      [&](const std::string& frame, Eigen::Isometry3d& pose) {
+        std::string error;
+        if (lookup(frame, stamp, deadline, &pose, &error)) return true;
+        missing.push_back(frame);
+        if (first_error.empty()) first_error = error;
+        return false;
+      },
+      &frame_poses_);
+  if (!missing.empty()) {
+    missing_link_poses_ += missing.size();
+    ROS_WARN_THROTTLE(5,
+                      "%zu of %zu link frames have no transform to '%s' at t = %.3f; their "
+                      "geometry is skipped this scan (%lu skipped so far): %s (%s)",
+                      missing.size(), scene_.frames().size(), params_.fixed_frame.c_str(),
+                      stamp.toSec(), static_cast<unsigned long>(missing_link_poses_),
+                      joinFirst(missing, 5).c_str(), first_error.c_str());
+  }
+
+  const core::ScanResult& result =
+      caster_.cast(scene_, frame_poses_, world_from_sensor, *pattern_, cast_config_);
+  encoder_->encode(scene_, result, reflectivity_by_label_, &encoded_);
+
+  sensor_msgs::LaserScan scan;
+  scan.header.stamp = stamp;  // every beam is cast at this instant
+  scan.header.frame_id = params_.frame_id;
+  scan.angle_min = static_cast<float>(pattern_->angleMin());
+  scan.angle_max = static_cast<float>(pattern_->angleMax());
+  scan.angle_increment = static_cast<float>(pattern_->angleIncrement());
+  scan.time_increment = 0.0f;  // instantaneous: all beams share the stamp
+  scan.scan_time = static_cast<float>(1.0 / params_.rate);
+  scan.range_min = static_cast<float>(params_.encoder.range_min);
+  scan.range_max = static_cast<float>(params_.encoder.range_max);
+  scan.ranges = encoded_.ranges;
+  scan.intensities = encoded_.intensities;
+  scan_pub_.publish(scan);
+
+  if (labels_pub_.getNumSubscribers() > 0) {
+    laser_raycast::ScanLabels labels;
+    labels.header = scan.header;
+    labels.link_names = scene_.labels();
+    labels.labels.assign(encoded_.labels.begin(), encoded_.labels.end());
+    labels_pub_.publish(labels);
+  }
+  ++scans_;
+}
+
+}  // namespace laser_raycast

@@ -1,0 +1,304 @@
+// The offline CLI cast_scan, run as a user would: each flag, the CSV format, and each exit status.
+// Expected ranges are worked out by hand in test/data/cli_joints.urdf and node_scene.urdf.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "run_command.h"
+
+namespace {
+
+const std::string kData = std::string(LASER_RAYCAST_SOURCE_DIR) + "/test/data/";
+// Four beams: -pi/2, 0, pi/2, pi.
+const std::string kFour =
+    " --angle-min -1.5707963267948966 --angle-max 3.141592653589793 --samples 4";
+
+struct CliRun {
+  int status = -1;
+  std::string out, err;
+};
+
+CliRun runCli(const std::string& args) {
+  const std::string err_file = ::testing::TempDir() + "cast_scan_stderr.txt";
+  const auto result =
+      laser_raycast_test::runCommand(std::string(CAST_SCAN_PATH) + " " + args + " 2>" + err_file);
+  CliRun run;
+  run.status = result.status;
+  run.out = result.output;
+  std::ifstream err(err_file);
+  std::stringstream s;
+  s << err.rdbuf();
+  run.err = s.str();
+  return run;
+}
+
+struct Row {
+  int index;
+  double angle;
+  std::string range;  // as printed
+  std::string link;
+};
+
+// Parses the CSV, checking the header and the shape of every row.
+std::vector<Row> parse(const std::string& csv) {
+  std::istringstream in(csv);
+  std::string line;
+  std::vector<Row> rows;
+  if (!std::getline(in, line) || line != "index,angle,range,link") {
+    ADD_FAILURE() << "bad header: '" << line << "'";
+    return rows;
+  }
+  while (std::getline(in, line)) {
+    std::vector<std::string> fields;
+    std::stringstream ls(line);
+    std::string f;
+    while (std::getline(ls, f, ',')) fields.push_back(f);
+    if (!line.empty() && line.back() == ',') fields.push_back("");
+    if (fields.size() != 4) {
+      ADD_FAILURE() << "bad row: '" << line << "'";
+      continue;
+    }
+    rows.push_back(Row{std::stoi(fields[0]), std::stod(fields[1]), fields[2], fields[3]});
+  }
+  return rows;
+}
+
+double value(const Row& row) { return std::stod(row.range); }
+
+TEST(CastScan, FourBeamsAtHandComputedRanges) {
+  const CliRun run = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0" + kFour);
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parse(run.out);
+  ASSERT_EQ(rows.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(rows[i].index, i);
+    EXPECT_NEAR(rows[i].angle, -M_PI / 2 + i * M_PI / 2, 1e-8);
+  }
+  EXPECT_NEAR(value(rows[0]), 0.9, 1e-8);
+  EXPECT_EQ(rows[0].link, "slider");
+  EXPECT_NEAR(value(rows[1]), 1.9, 1e-8);
+  EXPECT_EQ(rows[1].link, "arm");
+  EXPECT_EQ(rows[2].range, "inf");
+  EXPECT_EQ(rows[2].link, "");
+  EXPECT_NEAR(value(rows[3]), 1.45, 1e-8);
+  EXPECT_EQ(rows[3].link, "plate");
+}
+
+TEST(CastScan, NineSignificantDigits) {
+  // 1.9 prints as "1.9"; at yaw 0.04 the arm's face is 1.9 / cos(0.04) m away: 9 significant
+  // digits.
+  const CliRun run = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0.04" + kFour);
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parse(run.out);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_TRUE(std::regex_match(rows[1].range, std::regex("^[0-9]\\.[0-9]{8}$"))) << rows[1].range;
+  EXPECT_NEAR(value(rows[1]), 1.9 / std::cos(0.04), 5e-9);
+}
+
+TEST(CastScan, DefaultsAre360BeamsOverTheFullTurn) {
+  const CliRun run = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parse(run.out);
+  ASSERT_EQ(rows.size(), 360u);
+  EXPECT_NEAR(rows.front().angle, -M_PI, 1e-8);
+  EXPECT_NEAR(rows.back().angle, M_PI, 1e-8);
+}
+
+TEST(CastScan, AngleIncrementGivesRoundedBeamCount) {
+  // (0.5 - 0) / 0.1 = 5 -> 6 beams.
+  const CliRun run = runCli("--urdf " + kData +
+                            "cli_joints.urdf --sensor 0,0,0,0,0,0 --angle-min 0 --angle-max 0.5 "
+                            "--angle-increment 0.1");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parse(run.out);
+  ASSERT_EQ(rows.size(), 6u);
+  EXPECT_NEAR(rows[5].angle, 0.5, 1e-8);
+}
+
+TEST(CastScan, SensorPoseIsXyzRollPitchYaw) {
+  // Yaw pi/2: beam 0 (sensor +x) looks along world +y, where nothing is; beam "-pi/2" looks along
+  // +x.
+  const CliRun run =
+      runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,1.5707963267948966" + kFour);
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parse(run.out);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_NEAR(value(rows[0]), 1.9, 1e-8);
+  EXPECT_EQ(rows[1].range, "inf");
+  // Roll pi: the scan plane is flipped, so the beam at +pi/2 looks along world -y at the slider.
+  const CliRun flipped =
+      runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,3.141592653589793,0,0" + kFour);
+  const auto f = parse(flipped.out);
+  ASSERT_EQ(f.size(), 4u);
+  EXPECT_NEAR(value(f[2]), 0.9, 1e-8);
+  // Translation: 0.5 m towards the arm.
+  const CliRun moved = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0.5,0,0,0,0,0" + kFour);
+  EXPECT_NEAR(value(parse(moved.out)[1]), 1.4, 1e-8);
+}
+
+TEST(CastScan, ModelPoseAfterAt) {
+  const CliRun run =
+      runCli("--urdf " + kData + "cli_joints.urdf@0.5,0,0,0,0,0 --sensor 0,0,0,0,0,0" + kFour);
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NEAR(value(parse(run.out)[1]), 2.4, 1e-8);
+}
+
+TEST(CastScan, JointsMoveLinks) {
+  // swing = pi/2 carries the arm to +y; slide = 0.5 pushes the slider 0.5 m further along -y.
+  const CliRun run = runCli("--urdf " + kData +
+                            "cli_joints.urdf --sensor 0,0,0,0,0,0 --joint swing=1.5707963267948966 "
+                            "--joint slide=0.5" +
+                            kFour);
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parse(run.out);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_NEAR(value(rows[0]), 1.4, 1e-8);
+  EXPECT_EQ(rows[1].range, "inf");
+  EXPECT_NEAR(value(rows[2]), 1.9, 1e-8);
+  EXPECT_EQ(rows[2].link, "arm");
+  // Several values after one --joint.
+  const CliRun both = runCli("--urdf " + kData +
+                             "cli_joints.urdf --sensor 0,0,0,0,0,0 --joint "
+                             "swing=1.5707963267948966 slide=0.5" +
+                             kFour);
+  EXPECT_EQ(both.out, run.out);
+}
+
+TEST(CastScan, GeometryCollision) {
+  // At pi - 0.5 rad the beam passes beside the 1 m visual plate but meets the 3 m collision plate
+  // at x = -1.45: t = 1.45 / cos(0.5).
+  const std::string beam =
+      " --angle-min 2.641592653589793 --angle-max 2.741592653589793 --samples 2";
+  const CliRun visual = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0" + beam);
+  const CliRun collision = runCli(
+      "--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0 --geometry collision" + beam);
+  ASSERT_EQ(visual.status, 0) << visual.err;
+  ASSERT_EQ(collision.status, 0) << collision.err;
+  EXPECT_EQ(parse(visual.out)[0].range, "inf");
+  EXPECT_NEAR(value(parse(collision.out)[0]), 1.45 / std::cos(0.5), 1e-8);
+}
+
+TEST(CastScan, RangeLimitsFollowRep117) {
+  const CliRun run =
+      runCli("--urdf " + kData +
+             "cli_joints.urdf --sensor 0,0,0,0,0,0 --range-min 1.0 --range-max 1.5" + kFour);
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parse(run.out);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[0].range, "-inf");  // slider at 0.9 < range_min
+  EXPECT_EQ(rows[0].link, "slider");
+  EXPECT_EQ(rows[1].range, "inf");  // arm at 1.9 > range_max
+  EXPECT_NEAR(value(rows[3]), 1.45, 1e-8);
+}
+
+TEST(CastScan, EveryMethodGivesTheSameScan) {
+  // From beside the origin's "mover" sphere, so that beams reach the mesh plate and the primitives.
+  const std::string base = "--urdf " + kData + "node_scene.urdf --sensor 0.5,0,0,0,0,0.1";
+  const CliRun reference = runCli(base);
+  ASSERT_EQ(reference.status, 0) << reference.err;
+  for (const char* method : {"seed_plane", "seed_uv", "cramer", "moller_trumbore", "watertight"}) {
+    const CliRun run = runCli(base + " --method " + method);
+    EXPECT_EQ(run.status, 0) << method << ": " << run.err;
+    EXPECT_EQ(parse(run.out).size(), 360u) << method;
+    // The mesh plate is hit away from its edges at this yaw, so all methods agree to the printed
+    // digit.
+    EXPECT_EQ(run.out, reference.out) << method;
+  }
+}
+
+TEST(CastScan, SeveralModelsKeepTheirLinkNames) {
+  // node_scene.urdf (package:// mesh) lifted 5 m is out of the plane; a second copy of cli_joints
+  // 10 m away is behind the first one's arm.
+  const CliRun run = runCli("--urdf " + kData + "cli_joints.urdf --urdf " + kData +
+                            "cli_joints.urdf@10,0,0,0,0,0 --urdf " + kData +
+                            "node_scene.urdf@0,0,5,0,0,0 --sensor 0,0,0,0,0,0" + kFour);
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parse(run.out);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_NEAR(value(rows[1]), 1.9, 1e-8);
+  EXPECT_EQ(rows[1].link, "arm");
+  EXPECT_NEAR(value(rows[3]), 1.45, 1e-8);
+}
+
+TEST(CastScan, PackageUrisResolveThroughRosPackagePath) {
+  // node_scene.urdf's plate is package://laser_raycast/test/data/wall_plate.stl. Its floating
+  // "mover" (r 0.25 m) stays at the origin without joint values, so the sensor sits at x = 0.5
+  // beside it.
+  const CliRun run = runCli("--urdf " + kData + "node_scene.urdf --sensor 0.5,0,0,0,0,0" + kFour);
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parse(run.out);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_NEAR(value(rows[0]), 2.9, 1e-6);
+  EXPECT_EQ(rows[0].link, "wall_link");
+  EXPECT_NEAR(value(rows[1]), 2.0, 1e-8);
+  EXPECT_EQ(rows[1].link, "box_link");
+  EXPECT_NEAR(value(rows[3]), 0.25, 1e-8);
+  EXPECT_EQ(rows[3].link, "mover");
+}
+
+TEST(CastScan, RepeatReportsTheMedianCastTime) {
+  const CliRun run = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0 --repeat 5");
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_TRUE(std::regex_search(run.err, std::regex("(^|\n)cast_ns_per_scan_median=[0-9]+\n")))
+      << run.err;
+  EXPECT_EQ(parse(run.out).size(), 360u);
+}
+
+TEST(CastScan, HelpExitsZero) {
+  const CliRun run = runCli("--help");
+  EXPECT_EQ(run.status, 0);
+  EXPECT_NE(run.out.find("usage: cast_scan"), std::string::npos);
+}
+
+// Exit status 2 for bad arguments, with a message naming the problem and nothing on stdout.
+void expectBadArguments(const std::string& args, const std::string& mention) {
+  const CliRun run = runCli(args);
+  EXPECT_EQ(run.status, 2) << args << "\n" << run.err;
+  EXPECT_NE(run.err.find(mention), std::string::npos) << args << "\n" << run.err;
+  EXPECT_EQ(run.out, "") << args;
+}
+
+TEST(CastScan, BadArgumentsExitTwo) {
+  const std::string model = "--urdf " + kData + "cli_joints.urdf ";
+  expectBadArguments("", "--urdf");
+  expectBadArguments(model, "--sensor");
+  expectBadArguments(model + "--sensor 0,0,0", "--sensor");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,nan", "--sensor");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --bogus 1", "--bogus");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples 1", "samples");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples ten", "--samples");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples 10 --angle-increment 0.1", "not both");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-increment -0.1", "angle_increment");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-min 1 --angle-max 0", "angle_max");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min 2 --range-max 1", "--range-max");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min -1", "--range-min");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --geometry hull", "--geometry");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --method fast", "--method");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint elbow=1", "elbow");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint plate_fix=1", "plate_fix");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint swing", "NAME=VALUE");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --repeat", "--repeat");
+}
+
+// Exit status 3 for bad scene input, naming the file.
+void expectBadScene(const std::string& urdf, const std::string& mention) {
+  const CliRun run = runCli("--urdf " + urdf + " --sensor 0,0,0,0,0,0");
+  EXPECT_EQ(run.status, 3) << urdf << "\n" << run.err;
+  EXPECT_NE(run.err.find(mention), std::string::npos) << run.err;
+  EXPECT_EQ(run.out, "");
+}
+
+TEST(CastScan, BadSceneExitsThree) {
+  expectBadScene("/nonexistent/robot.urdf", "/nonexistent/robot.urdf");
+  expectBadScene(kData + "malformed.urdf", "malformed.urdf");
+  expectBadScene(kData + "bad_mesh.urdf", "does_not_exist.stl");
+}
+
+}  // namespace
