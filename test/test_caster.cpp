@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/fan_slicer.h"
+#include "laser_raycast/core/pose.h"
 
 using namespace laser_raycast::core;
 
@@ -763,6 +765,20 @@ int misses(const ScanResult& r) {
   return n;
 }
 
+// How many of the mesh's outline segments each beam crosses, nearest or not. From a point of a
+// star-shaped outline's kernel it is exactly one per beam: more would be a shared segment endpoint
+// counted twice (a double hit), fewer a leak.
+std::vector<int> crossingsPerBeam(const Mesh& mesh, const Eigen::Isometry3d& world_from_sensor,
+                                  const ScanPattern& pattern) {
+  const int n = pattern.size();
+  std::vector<double> range(n, std::numeric_limits<double>::infinity());
+  std::vector<int> body(n, -1), triangle(n, -1), crossings(n, 0);
+  sliceMesh(mesh, relativePose(world_from_sensor, Eigen::Isometry3d::Identity()), pattern, 0.0,
+            std::numeric_limits<double>::infinity(), false, 0,
+            DepthBuffer{&range, &body, &triangle, &crossings});
+  return crossings;
+}
+
 }  // namespace
 
 // Closed meshes with a vertex row exactly at the sensor's height: the scan plane runs through rows
@@ -796,6 +812,10 @@ TEST(Caster, FastPathIsWatertightThroughVertexRows) {
       const ScanResult general = cast(scene, poses, sensor, pattern, config(false));
       ASSERT_EQ(misses(fast), 0) << "mesh " << casts << " sensor " << s;
       ASSERT_EQ(misses(general), 0) << "mesh " << casts << " sensor " << s;
+      const std::vector<int> crossings = crossingsPerBeam(*mesh, sensor, pattern);
+      for (int i = 0; i < pattern.size(); ++i) {
+        ASSERT_EQ(crossings[i], 1) << "mesh " << casts << " sensor " << s << " beam " << i;
+      }
       for (int i = 0; i < pattern.size(); ++i)
         ASSERT_TRUE(near(fast.range[i], general.range[i], 1e-9));
     }
@@ -825,6 +845,13 @@ TEST(Caster, FastPathIsWatertightThroughVertices) {
         const ScanResult r =
             cast(scene, poses, Eigen::Isometry3d::Identity(), pattern, config(fast));
         ASSERT_EQ(misses(r), 0) << "n " << n << " every " << every << (fast ? " fast" : " general");
+        if (fast) {
+          // Every corner is a shared endpoint that a beam runs through exactly.
+          const std::vector<int> crossings =
+              crossingsPerBeam(*std::get<std::shared_ptr<const Mesh>>(scene.bodies()[0].shape),
+                               Eigen::Isometry3d::Identity(), pattern);
+          for (int i = 0; i < n; ++i) ASSERT_EQ(crossings[i], 1) << "n " << n << " beam " << i;
+        }
         // The beams through a corner measure exactly its radius.
         for (int i = 0; i < n; i += every) {
           ASSERT_NEAR(r.range[i], (i / every) % 2 ? 2.0 : 4.0, 1e-12) << i;

@@ -12,10 +12,13 @@ bool lexicographicLess(const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
   return p.z() < q.z();
 }
 
-// Where edge (p, q) crosses the plane, given the vertices' signed distances (of opposite strict
-// signs). The vertices are put in lexicographic order first, so both triangles sharing the edge get
-// the same bits.
+// Where edge (p, q) crosses the plane, given the vertices' signed distances, sp <= 0 < sq or the
+// other way round. A vertex on the plane (distance 0) is its own crossing, bit for bit. Otherwise
+// the vertices are put in lexicographic order first, so both triangles sharing the edge get the
+// same bits.
 Eigen::Vector3d edgeCrossing(Eigen::Vector3d p, double sp, Eigen::Vector3d q, double sq) {
+  if (sp == 0) return p;
+  if (sq == 0) return q;
   if (lexicographicLess(q, p)) {
     std::swap(p, q);
     std::swap(sp, sq);
@@ -68,24 +71,19 @@ void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, cons
     const auto& v = slots[slot];
     const double s[3] = {normal.dot(v[0]) + offset, normal.dot(v[1]) + offset,
                          normal.dot(v[2]) + offset};
-    if ((s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0)) return;
-
-    // Segment endpoints: vertices on the plane, and crossings of edges whose ends are strictly
-    // apart. Two points for a triangle that crosses; one (a vertex touching the plane: skipped, its
-    // neighbours carry it in a closed mesh) or three (lying in the plane: skipped, like a ray in a
-    // triangle's plane).
-    Eigen::Vector3d points[3];
+    // A vertex exactly on the plane counts as just below it (the plane nudged up by an
+    // infinitesimal): an edge lying in the plane is then cut once, by the triangle above it, not
+    // twice; a triangle touching the plane from below, or lying in it, is not cut (as a ray in a
+    // triangle's plane misses it); one touching it from above gives a zero-length segment, skipped
+    // below. Every crossing triangle has exactly two edges with one end below and one above.
+    const bool above[3] = {s[0] > 0, s[1] > 0, s[2] > 0};
+    if (above[0] == above[1] && above[1] == above[2]) return;  // also NaN: never above
+    Eigen::Vector3d points[2];
     int count = 0;
     for (int k = 0; k < 3; ++k) {
-      if (s[k] == 0) points[count++] = v[k];
-    }
-    for (int k = 0; k < 3; ++k) {
       const int j = k == 2 ? 0 : k + 1;
-      if ((s[k] < 0 && s[j] > 0) || (s[k] > 0 && s[j] < 0)) {
-        points[count++] = edgeCrossing(v[k], s[k], v[j], s[j]);
-      }
+      if (above[k] != above[j]) points[count++] = edgeCrossing(v[k], s[k], v[j], s[j]);
     }
-    if (count != 2) return;
 
     // Endpoints in the scan plane (sensor x, y).
     const Eigen::Vector2d p(rot.row(0).dot(points[0]) + trans.x(),
@@ -111,13 +109,19 @@ void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, cons
         const double side_p = dx * p.y() - dy * p.x();
         const double side_q = dx * q.y() - dy * q.x();
         if (!((side_p <= 0 && side_q >= 0) || (side_p >= 0 && side_q <= 0))) continue;
-        if (side_p == side_q)
-          continue;  // both on the line: the beam runs along the triangle's plane
+        // Both on the line: the beam runs along the triangle's plane.
+        if (side_p == side_q) continue;
+        // Exactly through an endpoint: the beam counts for the segment whose other end lies on its
+        // left (as if nudged to the right), so for exactly one of the two segments sharing a point
+        // where the outline crosses the beam.
+        if (side_p == 0 ? !(side_q > 0) : (side_q == 0 && !(side_p > 0))) continue;
         const double along_p = dx * p.x() + dy * p.y();
         const double along_q = dx * q.x() + dy * q.y();
         const double t = along_p + (side_p / (side_p - side_q)) * (along_q - along_p);
-        if (!(t >= tmin && t <= tmax && t < range[i])) continue;
+        if (!(t >= tmin && t <= tmax)) continue;
         if (cull_backfaces && dx * front.x() + dy * front.y() > 0) continue;
+        if (buffer.crossings) ++(*buffer.crossings)[i];
+        if (!(t < range[i])) continue;
         range[i] = t;
         (*buffer.body)[i] = body_index;
         (*buffer.triangle)[i] = static_cast<int>(ids[slot]);

@@ -4,18 +4,18 @@
 //
 // Conventions shared by every method, so that they are interchangeable:
 // - A hit has t in [ray.tmin, tmax] (inclusive) and barycentrics u, v: the weights of b and c, so
-// the hit
-//   point is (1 - u - v) a + u b + v c. Points on edges and vertices are inside (>= 0 tests).
+//   the hit point is (1 - u - v) a + u b + v c.
+// - Edges and vertices: the reference methods count a point on an edge or vertex as inside (>= 0
+//   tests), so a ray through a shared edge hits both triangles, or, after rounding, neither. The
+//   watertight method gives each shared edge and vertex to exactly one of the triangles around it.
 // - The front face is the side that (b - a) x (c - a) points to. With cull_backfaces, a ray whose
 //   direction has a positive dot product with that normal (it sees the back) does not hit.
 // - No absolute epsilons. A ray parallel to the plane (denominator exactly 0) misses.
 // - Every accept test is written as "if (!(inside)) reject", so a NaN anywhere rejects: NaN input
-// never
-//   produces a hit.
+//   never produces a hit.
 // - Degenerate triangles (cross product exactly zero: repeated or collinear vertices) never hit.
-// The free
-//   functions test for them; PreparedRay::intersect assumes the caller has filtered them out (the
-//   BVH does so once at build time).
+//   The free functions test for them; PreparedRay::intersect assumes the caller has filtered them
+//   out (the BVH does so once at build time).
 #pragma once
 
 #include <array>
@@ -61,7 +61,9 @@ namespace detail {
 
 // a * b - c * d with the sign of the exact result (and 0 only when the exact result is 0).
 // For float the products are exact in double. For double, Kahan's algorithm with FMA has a relative
-// error of at most 2 ulp (Jeannerod, Louvet, Muller 2013), which preserves the sign.
+// error of at most 2 ulp (Jeannerod, Louvet, Muller 2013), which preserves the sign. Slow for
+// double without hardware FMA: edgeFunction() calls it only where rounding could have changed the
+// sign.
 inline float exactSignDifferenceOfProducts(float a, float b, float c, float d) {
   return static_cast<float>(double(a) * double(b) - double(c) * double(d));
 }
@@ -70,6 +72,32 @@ inline double exactSignDifferenceOfProducts(double a, double b, double c, double
   const double cd_error = std::fma(-c, d, cd);  // cd - c * d, exactly
   const double ab_minus_cd = std::fma(a, b, -cd);
   return ab_minus_cd + cd_error;
+}
+
+// An edge function a * b - c * d with its exact sign. The rounded difference is kept where rounding
+// cannot have changed its sign (the products' rounding errors total at most u (|ab| + |cd|), and
+// the subtraction's own rounding keeps the sign); otherwise it is recomputed. The two triangles
+// sharing an edge evaluate it with the pairs swapped: the same rounded products, so the same branch
+// and exactly opposite signs, and 0 for both only when the ray meets the edge exactly. An
+// evaluation that used the exact sign in one triangle and the rounded one in its neighbour could
+// let a ray slip between.
+template <typename T>
+inline T edgeFunction(T a, T b, T c, T d) {
+  const T ab = a * b;
+  const T cd = c * d;
+  const T e = ab - cd;
+  if (std::abs(e) > std::numeric_limits<T>::epsilon() * (std::abs(ab) + std::abs(cd))) return e;
+  return exactSignDifferenceOfProducts(a, b, c, d);
+}
+
+// Whether a triangle owns a boundary point on its edge with direction (dx, dy) (the edge as
+// traversed by a triangle that faces the ray, reversed for one that does not; the ray at the origin
+// of the projection). It does iff the ray, nudged by a fixed infinitesimal offset, passes inside:
+// the same rule for every triangle, so exactly one of two neighbours owns their shared edge, and
+// one triangle of a fan its shared vertex (rasterisation's top-left rule is this idea).
+template <typename T>
+inline bool ownsBoundary(T dx, T dy) {
+  return dy > 0 || (dy == 0 && dx > 0);
 }
 
 }  // namespace detail
@@ -218,10 +246,11 @@ class PreparedRay<T, TriangleMethod::kMollerTrumbore> {
 // Woop, Benthin, Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013. The vertices are
 // moved into a frame where the ray starts at the origin and runs along +z, and the hit is decided
 // by the signs of three 2D edge functions. Neighbouring triangles evaluate a shared edge from the
-// same transformed vertices with the same formula, so the edge function of one is exactly the
-// negation of the other's: a ray can hit both but never slip between them. Where an edge function
-// rounds to exactly 0 it is recomputed with the exact sign (pbrt-v4 does this in double for float;
-// here double uses an FMA-based product difference).
+// same transformed vertices, with its sign computed exactly (detail::edgeFunction; pbrt-v4
+// recomputes in double only where a float edge function is exactly 0), so a ray never slips between
+// them; and a ray exactly on a shared edge or vertex that it crosses hits exactly one of the
+// triangles around it (detail::ownsBoundary; on a silhouette, where the surface only touches the
+// ray, none or two).
 template <typename T>
 class PreparedRay<T, TriangleMethod::kWatertight> {
  public:
@@ -259,20 +288,24 @@ class PreparedRay<T, TriangleMethod::kWatertight> {
     const T cx = pc[kx_] - sx_ * pc[kz_];
     const T cy = pc[ky_] - sy_ * pc[kz_];
 
-    // Edge functions: twice the signed areas of the sub-triangles opposite a, b and c.
-    T ea = cx * by - cy * bx;
-    T eb = ax * cy - ay * cx;
-    T ec = bx * ay - by * ax;
-    if (ea == 0 || eb == 0 || ec == 0) {
-      ea = detail::exactSignDifferenceOfProducts(cx, by, cy, bx);
-      eb = detail::exactSignDifferenceOfProducts(ax, cy, ay, cx);
-      ec = detail::exactSignDifferenceOfProducts(bx, ay, by, ax);
-    }
-    // Inside iff all three have one sign (zero counts as either).
+    // Edge functions, with exact signs: twice the signed areas of the sub-triangles opposite a, b
+    // and c, seen along the ray.
+    const T ea = detail::edgeFunction(cx, by, cy, bx);
+    const T eb = detail::edgeFunction(ax, cy, ay, cx);
+    const T ec = detail::edgeFunction(bx, ay, by, ax);
+    // Inside iff all three have one sign; zeros (the ray exactly on an edge) are settled below.
     if ((ea < 0 || eb < 0 || ec < 0) && (ea > 0 || eb > 0 || ec > 0)) return std::nullopt;
     const T det = ea + eb + ec;            // positive for a front face
     if (!(det != 0)) return std::nullopt;  // ray in the triangle's plane, or NaN
     if (cull_ && det < 0) return std::nullopt;
+    if (ea == 0 || eb == 0 || ec == 0) {
+      // On an edge or a vertex: hit only if this triangle owns it. The edges are oriented as a
+      // front-facing triangle traverses them, so the rule does not depend on the winding.
+      const T s = det > 0 ? T(1) : T(-1);
+      if (ea == 0 && !detail::ownsBoundary(s * (cx - bx), s * (cy - by))) return std::nullopt;
+      if (eb == 0 && !detail::ownsBoundary(s * (ax - cx), s * (ay - cy))) return std::nullopt;
+      if (ec == 0 && !detail::ownsBoundary(s * (bx - ax), s * (by - ay))) return std::nullopt;
+    }
 
     // Scaled hit distance, then t.
     const T az = sz_ * pa[kz_];
