@@ -28,7 +28,8 @@ log "running the demo (duration ${duration} s; 0 = until Ctrl-C)"
 demo_log=$(mktemp /tmp/laser_raycast_demo.XXXXXX.log)
 # Our nodes' lines, without roslaunch's start-up chatter; the whole log stays in $demo_log.
 set +e
-roslaunch laser_raycast demo.launch duration:="$duration" gui:="$gui" 2>&1 | tee "$demo_log" |
+ROSCONSOLE_STDOUT_LINE_BUFFERED=1 roslaunch laser_raycast demo.launch duration:="$duration" gui:="$gui" 2>&1 |
+  tee "$demo_log" |
   grep --line-buffered -E '^\[demo\]|model .*links|ERROR|FATAL|WARN'
 set -e
 if grep -qE '^\[demo\] [1-9][0-9]* scans received' "$demo_log" || [ "$duration" = 0 ]; then
