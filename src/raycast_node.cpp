@@ -170,16 +170,16 @@ bool RaycastNode::loadScene() {
   return true;
 }
 
-bool RaycastNode::lookup(const std::string& frame, const ros::Time& stamp,
-                         const ros::Time& deadline, Eigen::Isometry3d* pose, std::string* error) {
-  if (frame == params_.fixed_frame) {
+bool RaycastNode::lookup(const std::string& target, const std::string& frame,
+                         const ros::Time& stamp, const ros::Time& deadline, Eigen::Isometry3d* pose,
+                         std::string* error) {
+  if (frame == target) {
     pose->setIdentity();
     return true;
   }
   const ros::Duration timeout = std::max(ros::Duration(0), deadline - ros::Time::now());
   try {
-    *pose = tf2::transformToEigen(
-        tf_buffer_.lookupTransform(params_.fixed_frame, frame, stamp, timeout));
+    *pose = tf2::transformToEigen(tf_buffer_.lookupTransform(target, frame, stamp, timeout));
     return true;
   } catch (const tf2::TransformException& e) {
     *error = e.what();
@@ -189,41 +189,36 @@ bool RaycastNode::lookup(const std::string& frame, const ros::Time& stamp,
 
 bool RaycastNode::sensorPose(const ros::Time& stamp, const ros::Time& deadline,
                              Eigen::Isometry3d* pose) {
-  std::string error;
-  if (params_.pose_topic.empty()) {
-    if (lookup(params_.frame_id, stamp, deadline, pose, &error)) return true;
-    ROS_WARN_THROTTLE(5, "no transform from '%s' to '%s' at t = %.3f: scan skipped (%s)",
-                      params_.frame_id.c_str(), params_.fixed_frame.c_str(), stamp.toSec(),
-                      error.c_str());
-    return false;
-  }
-  Eigen::Isometry3d world_from_pose_frame;
-  {
+  // Without a pose topic the sensor is a TF frame like any other; with one, the topic gives the
+  // pose of pose_frame, and TF (usually a static mount) the sensor relative to it.
+  Eigen::Isometry3d world_from_pose_frame = Eigen::Isometry3d::Identity();
+  std::string pose_frame = params_.fixed_frame;
+  if (!params_.pose_topic.empty()) {
     std::lock_guard<std::mutex> lock(pose_mutex_);
     if (!topic_pose_) {
-      ROS_WARN_THROTTLE(5, "no pose received yet on %s: scan skipped",
-                        pose_sub_.getTopic().c_str());
+      ROS_WARN_THROTTLE(5, "no pose received yet on %s: scan skipped (%lu of %lu so far)",
+                        pose_sub_.getTopic().c_str(),
+                        static_cast<unsigned long>(scans_skipped_ + 1),
+                        static_cast<unsigned long>(scans_ + scans_skipped_ + 1));
       return false;
     }
     world_from_pose_frame = *topic_pose_;
+    pose_frame = params_.pose_frame.empty() ? params_.frame_id : params_.pose_frame;
   }
-  if (params_.pose_frame.empty() || params_.pose_frame == params_.frame_id) {
-    *pose = world_from_pose_frame;
-    return true;
-  }
-  // The sensor relative to the frame whose pose the topic gives (usually a static mount).
-  const ros::Duration timeout = std::max(ros::Duration(0), deadline - ros::Time::now());
-  try {
-    const Eigen::Isometry3d pose_frame_from_sensor = tf2::transformToEigen(
-        tf_buffer_.lookupTransform(params_.pose_frame, params_.frame_id, stamp, timeout));
-    *pose = world_from_pose_frame * pose_frame_from_sensor;
-    return true;
-  } catch (const tf2::TransformException& e) {
-    ROS_WARN_THROTTLE(5, "no transform from '%s' to '%s' at t = %.3f: scan skipped (%s)",
-                      params_.frame_id.c_str(), params_.pose_frame.c_str(), stamp.toSec(),
-                      e.what());
+  std::string error;
+  Eigen::Isometry3d pose_frame_from_sensor;
+  if (!lookup(pose_frame, params_.frame_id, stamp, deadline, &pose_frame_from_sensor, &error)) {
+    ROS_WARN_THROTTLE(
+        5,
+        "no transform from '%s' to '%s' at t = %.3f: scan skipped (%lu of %lu so far; "
+        "%s)",
+        params_.frame_id.c_str(), pose_frame.c_str(), stamp.toSec(),
+        static_cast<unsigned long>(scans_skipped_ + 1),
+        static_cast<unsigned long>(scans_ + scans_skipped_ + 1), error.c_str());
     return false;
   }
+  *pose = world_from_pose_frame * pose_frame_from_sensor;
+  return true;
 }
 
 void RaycastNode::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
@@ -284,7 +279,7 @@ void RaycastNode::onTimer(const ros::TimerEvent&) {
       scene_,
       [&](const std::string& frame, Eigen::Isometry3d& pose) {
         std::string error;
-        if (lookup(frame, stamp, deadline, &pose, &error)) return true;
+        if (lookup(params_.fixed_frame, frame, stamp, deadline, &pose, &error)) return true;
         missing.push_back(frame);
         if (first_error.empty()) first_error = error;
         return false;

@@ -37,9 +37,10 @@ class RaycastNode {
   // The pose of frame_id in fixed_frame for this scan; false (after a throttled warning) if
   // unknown.
   bool sensorPose(const ros::Time& stamp, const ros::Time& deadline, Eigen::Isometry3d* pose);
-  // A TF look-up of `frame` in fixed_frame at stamp, waiting until deadline at most.
-  bool lookup(const std::string& frame, const ros::Time& stamp, const ros::Time& deadline,
-              Eigen::Isometry3d* pose, std::string* error);
+  // The pose of `frame` in `target` from TF at stamp, waiting until deadline at most (identity if
+  // they are the same frame); false with the reason in *error.
+  bool lookup(const std::string& target, const std::string& frame, const ros::Time& stamp,
+              const ros::Time& deadline, Eigen::Isometry3d* pose, std::string* error);
 
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
@@ -63,6 +64,7 @@ class RaycastNode {
   std::mutex pose_mutex_;
   std::optional<Eigen::Isometry3d> topic_pose_;
 
+  // Reported in the throttled warnings.
   std::uint64_t scans_ = 0, scans_skipped_ = 0, missing_link_poses_ = 0;
 };
 
