@@ -145,6 +145,10 @@ TEST(EncoderConfig, ValidateNamesFieldAndValue) {
   expectMentions(message(c), {"range_max", "inf"});
   c = encoderConfig(0, kNan);
   expectMentions(message(c), {"range_max", "nan"});
+  // Finite in double but +Inf as a float: a valid reading would be published as "no return".
+  c = encoderConfig(0, 1e39);
+  expectMentions(message(c), {"range_max", "1e+39", "float"});
+  EXPECT_NO_THROW(encoderConfig(0, std::numeric_limits<float>::max()).validate());
   c = EncoderConfig{};
   c.noise_stddev = -0.01;
   expectMentions(message(c), {"noise_stddev", "-0.01"});

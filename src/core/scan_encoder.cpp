@@ -39,6 +39,10 @@ void EncoderConfig::validate() const {
   } else if (!(std::isfinite(range_max) && range_max > range_min)) {
     msg << "range_max (" << range_max << " m) must be finite and greater than range_min ("
         << range_min << " m)";
+  } else if (!(range_max <= std::numeric_limits<float>::max())) {
+    // Ranges are published as float: beyond this a valid reading would round to +Inf (no return).
+    msg << "range_max (" << range_max << " m) must be representable as a float (at most "
+        << std::numeric_limits<float>::max() << " m)";
   } else if (!(std::isfinite(noise_stddev) && noise_stddev >= 0)) {
     msg << "noise_stddev must be finite and >= 0, got " << noise_stddev;
   } else {

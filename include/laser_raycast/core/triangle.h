@@ -311,8 +311,17 @@ class PreparedRay<T, TriangleMethod::kWatertight> {
     const T az = sz_ * pa[kz_];
     const T bz = sz_ * pb[kz_];
     const T cz = sz_ * pc[kz_];
+    const T scaled_t = ea * az + eb * bz + ec * cz;
     const T inv_det = T(1) / det;
-    const T t = (ea * az + eb * bz + ec * cz) * inv_det;
+    // A det below 1 / max (subnormal: a triangle ~1e-154 m across in double, or a small one seen
+    // nearly edge-on) makes 1 / det infinite; then divide, or t and u, v come out infinite and a
+    // ray with tmax = +inf accepts t = +inf.
+    if (!(std::abs(inv_det) <= std::numeric_limits<T>::max())) {
+      const T t = scaled_t / det;
+      if (!(t >= tmin_ && t <= tmax)) return std::nullopt;
+      return TriangleHitT<T>{t, eb / det, ec / det};
+    }
+    const T t = scaled_t * inv_det;
     if (!(t >= tmin_ && t <= tmax)) return std::nullopt;
     return TriangleHitT<T>{t, eb * inv_det, ec * inv_det};
   }
