@@ -1,0 +1,211 @@
+#include "bench_methods.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <type_traits>
+
+namespace laser_raycast {
+namespace bench {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kDeg = M_PI / 180;
+
+template <typename T>
+const std::vector<core::RayT<T>>& raysOf(const WorkloadRays& w);
+template <>
+const std::vector<core::Ray>& raysOf<double>(const WorkloadRays& w) {
+  return w.rays;
+}
+template <>
+const std::vector<core::RayF>& raysOf<float>(const WorkloadRays& w) {
+  return w.rays_f;
+}
+template <typename T>
+const std::vector<double>& scaleOf(const WorkloadRays& w) {
+  return std::is_same<T, double>::value ? w.scale : w.scale_f;
+}
+
+// Closest hit through the BVH, exactly as the caster traverses a mesh.
+template <typename T, core::TriangleMethod M>
+Pass bvhPass(const core::BvhT<T>& bvh) {
+  return [&bvh](const WorkloadRays& w, const std::vector<int>& idx, std::vector<double>* out) {
+    const auto& rays = raysOf<T>(w);
+    const auto& scale = scaleOf<T>(w);
+    for (const int i : idx) {
+      const auto hit = bvh.template closestHit<M>(rays[i]);
+      (*out)[i] = hit ? static_cast<double>(hit->t) * scale[i] : kInf;
+    }
+  };
+}
+
+// Brute force: every non-degenerate triangle (the BVH's filtered copy, in its precision) tested
+// with one prepared ray, the nearest kept by shrinking tmax. This is core::bruteForceClosestHit's
+// loop without its per-call degeneracy test and method dispatch, so the row measures the
+// intersector itself.
+template <typename T, core::TriangleMethod M>
+Pass brutePass(const core::BvhT<T>& bvh) {
+  return [&bvh](const WorkloadRays& w, const std::vector<int>& idx, std::vector<double>* out) {
+    const auto& rays = raysOf<T>(w);
+    const auto& scale = scaleOf<T>(w);
+    const auto& tris = bvh.triangleVertices();
+    for (const int i : idx) {
+      const core::PreparedRay<T, M> prepared(rays[i], false);
+      T tmax = rays[i].tmax;
+      bool hit = false;
+      for (const auto& tri : tris) {
+        if (const auto h = prepared.intersect(tri[0], tri[1], tri[2], tmax)) {
+          tmax = h->t;
+          hit = true;
+        }
+      }
+      (*out)[i] = hit ? static_cast<double>(tmax) * scale[i] : kInf;
+    }
+  };
+}
+
+// The pipeline as the node runs it: one Caster::cast per sensor pose over the whole pattern.
+// forget() first, so that an unchanged pose does not return the previous result.
+Pass pipelinePass(const BenchScene& scene) {
+  auto caster = std::make_shared<core::Caster>();
+  return
+      [caster, &scene](const WorkloadRays& w, const std::vector<int>&, std::vector<double>* out) {
+        core::CastConfig config;
+        config.tmin = 0;
+        config.tmax = w.tmax;
+        const std::size_t beams = static_cast<std::size_t>(w.pattern->size());
+        for (std::size_t p = 0; p < w.sensors.size(); ++p) {
+          caster->forget();
+          const core::ScanResult& result =
+              caster->cast(scene.scene, scene.frame_poses, w.sensors[p], *w.pattern, config);
+          std::copy(result.range.begin(), result.range.end(), out->begin() + p * beams);
+        }
+      };
+}
+
+template <typename T>
+const core::BvhT<T>& bvhOf(const SceneGeometry& g);
+template <>
+const core::Bvh& bvhOf<double>(const SceneGeometry& g) {
+  return g.bvh;
+}
+template <>
+const core::BvhF& bvhOf<float>(const SceneGeometry& g) {
+  return g.bvh_f;
+}
+
+// Row order within a method: double BVH, double brute, float BVH, float brute.
+template <typename T, core::TriangleMethod M>
+void addMethodRows(const SceneGeometry& g, std::vector<Method>* out) {
+  const std::string base =
+      std::string(core::toString(M)) + (std::is_same<T, float>::value ? "_f32" : "");
+  const std::size_t triangles = g.scene->soup.triangles.size();
+  out->push_back(Method{base + "_bvh", false, false, triangles, bvhPass<T, M>(bvhOf<T>(g))});
+  out->push_back(Method{base + "_brute", true, false, triangles, brutePass<T, M>(bvhOf<T>(g))});
+}
+
+}  // namespace
+
+const std::vector<Workload>& workloads() {
+  static const std::vector<Workload> list = [] {
+    Workload fan2d;
+    fan2d.name = "fan2d";
+    fan2d.fan.angle_min = -135 * kDeg;
+    fan2d.fan.angle_max = 135 * kDeg;
+    fan2d.fan.samples = 1081;
+    fan2d.elevations = {0.0};
+    fan2d.full_poses = 6;
+    fan2d.quick_poses = 2;
+
+    Workload rings3d;
+    rings3d.name = "rings3d";
+    rings3d.fan.angle_min = -M_PI;
+    rings3d.fan.angle_max = M_PI - 2 * M_PI / 1024;
+    rings3d.fan.samples = 1024;
+    for (int k = 0; k < 64; ++k) rings3d.elevations.push_back((-22.5 + 45.0 * k / 63) * kDeg);
+    rings3d.full_poses = 6;
+    rings3d.quick_poses = 1;
+    return std::vector<Workload>{fan2d, rings3d};
+  }();
+  return list;
+}
+
+WorkloadRays makeRays(const BenchScene& scene, const Workload& workload, int pose_count,
+                      double tmax) {
+  WorkloadRays w;
+  w.workload = &workload;
+  w.pattern = std::make_unique<core::ScanPattern>(workload.fan, workload.elevations);
+  w.tmax = tmax;
+  const int count = std::min<int>(pose_count, static_cast<int>(scene.sensor_poses.size()));
+  w.poses.assign(scene.sensor_poses.begin(), scene.sensor_poses.begin() + count);
+  for (const SensorPose& p : w.poses) {
+    const Eigen::Isometry3d sensor = toIsometry(p.exact());
+    w.sensors.push_back(sensor);
+    for (const Eigen::Vector3d& d : w.pattern->directions()) {
+      core::Ray ray;
+      ray.origin = sensor.translation();
+      ray.dir = sensor.linear() * d;
+      ray.tmin = 0;
+      ray.tmax = tmax;
+      const core::RayF ray_f = core::toFloat(ray);
+      w.rays.push_back(ray);
+      w.rays_f.push_back(ray_f);
+      w.scale.push_back(ray.dir.norm());
+      w.scale_f.push_back(ray_f.dir.cast<double>().norm());
+    }
+  }
+  return w;
+}
+
+std::vector<Method> coreMethods(const SceneGeometry& g) {
+  std::vector<Method> methods;
+  for (const core::TriangleMethod m : core::kAllTriangleMethods) {
+    core::dispatchTriangleMethod(m, [&](auto method) {
+      constexpr core::TriangleMethod M = decltype(method)::value;
+      addMethodRows<double, M>(g, &methods);
+      addMethodRows<float, M>(g, &methods);
+    });
+  }
+  methods.push_back(
+      Method{"pipeline", false, true, g.scene->scene.triangleCount(), pipelinePass(*g.scene)});
+  return methods;
+}
+
+std::vector<std::string> coreMethodNames() {
+  std::vector<std::string> names;
+  for (const core::TriangleMethod m : core::kAllTriangleMethods) {
+    for (const std::string precision : {"", "_f32"}) {
+      for (const std::string kind : {"_bvh", "_brute"}) {
+        names.push_back(core::toString(m) + precision + kind);
+      }
+    }
+  }
+  names.push_back("pipeline");
+  return names;
+}
+
+double timePass(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
+                std::vector<double>* dist, int reps, double min_batch_seconds) {
+  using Clock = std::chrono::steady_clock;
+  auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
+  // The first pass warms caches and gives the distances the errors are computed from.
+  const auto t0 = Clock::now();
+  pass(w, rays, dist);
+  const double first = seconds(Clock::now() - t0);
+  const int per_batch =
+      std::max(1, static_cast<int>(std::ceil(min_batch_seconds / std::max(first, 1e-9))));
+  std::vector<double> scratch(dist->size());
+  std::vector<double> per_pass;
+  for (int r = 0; r < reps; ++r) {
+    const auto start = Clock::now();
+    for (int k = 0; k < per_batch; ++k) pass(w, rays, &scratch);
+    per_pass.push_back(seconds(Clock::now() - start) / per_batch);
+  }
+  std::nth_element(per_pass.begin(), per_pass.begin() + per_pass.size() / 2, per_pass.end());
+  return per_pass[per_pass.size() / 2];
+}
+
+}  // namespace bench
+}  // namespace laser_raycast

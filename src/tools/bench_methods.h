@@ -1,0 +1,79 @@
+// The benchmark's rows: the workloads (beam patterns from several sensor poses), the rays each
+// method gets, every method as one "pass" over a set of rays, and the timing of a pass.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench_scenes.h"
+#include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/scan_pattern.h"
+
+namespace laser_raycast {
+namespace bench {
+
+struct Workload {
+  std::string name;
+  core::FanSpec fan;
+  std::vector<double> elevations;  // rad; {0} for a planar fan
+  int full_poses, quick_poses;     // sensor poses used (a prefix of the scene's list)
+};
+
+// fan2d: 1081 beams over 270 degrees; rings3d: 64 rings from -22.5 to +22.5 degrees elevation x
+// 1024 azimuths over the full turn.
+const std::vector<Workload>& workloads();
+
+// Every beam of a workload from each sensor pose, pose-major, as the triangle methods and peers get
+// them: world-frame rays in double, and the same rounded to float. A method's distance is its t
+// times the length of the direction it was given (scale, scale_f).
+struct WorkloadRays {
+  const Workload* workload = nullptr;
+  std::unique_ptr<core::ScanPattern> pattern;
+  std::vector<SensorPose> poses;
+  std::vector<Eigen::Isometry3d> sensors;  // the poses rounded to double (what the pipeline gets)
+  std::vector<core::Ray> rays;
+  std::vector<core::RayF> rays_f;
+  std::vector<double> scale, scale_f;
+  double tmax = 0;
+};
+
+WorkloadRays makeRays(const BenchScene& scene, const Workload& workload, int pose_count,
+                      double tmax);
+
+// One pass: casts the rays with the given indices, writing each one's distance (m, +inf for no
+// hit) into dist[index].
+using Pass =
+    std::function<void(const WorkloadRays&, const std::vector<int>&, std::vector<double>*)>;
+
+struct Method {
+  std::string name;
+  bool brute = false;         // too slow for every ray: gets a deterministic subset
+  bool pipeline = false;      // measured against the pipeline reference
+  std::size_t triangles = 0;  // triangles in the geometry it is given
+  Pass pass;
+};
+
+// The soup's BVHs, in both precisions, and the scene (for the pipeline); built once per scene.
+struct SceneGeometry {
+  const BenchScene* scene = nullptr;
+  core::Bvh bvh;
+  core::BvhF bvh_f;
+};
+
+// The core's methods: every intersector in double and float, brute force and BVH, then the
+// pipeline (Caster::cast, with Caster::forget() before every cast so nothing is reused).
+std::vector<Method> coreMethods(const SceneGeometry& geometry);
+// Their names, in the same order, for --list-methods.
+std::vector<std::string> coreMethodNames();
+
+// Runs pass once over rays (its result is kept in dist), then `reps` timed batches of passes, each
+// batch repeated until it lasts at least min_batch_seconds; returns the median seconds per pass.
+// Single-threaded, std::chrono::steady_clock.
+double timePass(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
+                std::vector<double>* dist, int reps, double min_batch_seconds);
+
+}  // namespace bench
+}  // namespace laser_raycast

@@ -1,0 +1,25 @@
+// The peers, on the same soup and the same float rays as the core's float methods, single-threaded:
+// Embree 3 (rtcIntersect1; default scene flags and RTC_SCENE_FLAG_ROBUST) and Bullet
+// (btBvhTriangleMeshShape::performRaycast with a btTriangleRaycastCallback). Each is compiled in
+// only when CMake found it (LASER_RAYCAST_HAVE_EMBREE, LASER_RAYCAST_HAVE_BULLET); without it there
+// are simply no rows for it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "bench_methods.h"
+
+namespace laser_raycast {
+namespace bench {
+
+// The peers' rows for a soup (each holds its own acceleration structure, built here). Throws
+// std::runtime_error if a peer reports an error.
+std::vector<Method> peerMethods(const MeshData& soup);
+// Their names, in the same order, for --list-methods.
+std::vector<std::string> peerMethodNames();
+// The peers compiled in, with their versions (e.g. "Embree 3.13.5, Bullet 3.24"), or "none".
+std::string peerVersions();
+
+}  // namespace bench
+}  // namespace laser_raycast

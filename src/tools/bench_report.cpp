@@ -1,0 +1,130 @@
+#include "bench_report.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <utility>
+
+namespace laser_raycast {
+namespace bench {
+namespace {
+
+// The spacing of floats at x (x > 0): the unit the max_ulp column counts in.
+double floatUlp(double x) {
+  const float f = static_cast<float>(x);
+  if (!(f >= std::numeric_limits<float>::min())) return std::numeric_limits<float>::denorm_min();
+  return std::ldexp(1.0, std::ilogb(f) - 23);
+}
+
+std::string format(const char* spec, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, spec, value);
+  return buffer;
+}
+
+std::ofstream openForWriting(const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  return out;
+}
+
+}  // namespace
+
+const char* const kCsvHeader =
+    "workload,scene,method,triangles,rays,ns_per_ray,mrays_per_s,max_abs_err_m,p99_abs_err_m,"
+    "max_ulp,leaks,false_hits";
+
+ErrorStats compareWithReference(const std::vector<double>& dist, const std::vector<Real>& reference,
+                                const std::vector<int>& rays) {
+  ErrorStats stats;
+  std::vector<double> errors;
+  errors.reserve(rays.size());
+  for (const int i : rays) {
+    const bool ref_hit = std::isfinite(static_cast<double>(reference[i]));
+    const bool hit = std::isfinite(dist[i]);  // NaN (a beam that could not be cast) is no hit
+    if (ref_hit && !hit) ++stats.leaks;
+    if (hit && !ref_hit) ++stats.false_hits;
+    if (!(hit && ref_hit)) continue;
+    const double error = static_cast<double>(std::fabs(static_cast<Real>(dist[i]) - reference[i]));
+    errors.push_back(error);
+    stats.max_abs_err_m = std::max(stats.max_abs_err_m, error);
+    stats.max_ulp = std::max(stats.max_ulp, error / floatUlp(static_cast<double>(reference[i])));
+  }
+  if (!errors.empty()) {
+    // The 99th percentile: the smallest error at least 99% of the beams are within.
+    const std::size_t k =
+        static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(errors.size()))) - 1;
+    std::nth_element(errors.begin(), errors.begin() + k, errors.end());
+    stats.p99_abs_err_m = errors[k];
+  }
+  return stats;
+}
+
+void writeCsv(const std::string& path, const std::vector<Row>& rows) {
+  std::ofstream out = openForWriting(path);
+  out << kCsvHeader << "\n";
+  for (const Row& r : rows) {
+    out << r.workload << "," << r.scene << "," << r.method << "," << r.triangles << "," << r.rays
+        << "," << format("%.6g", r.ns_per_ray) << "," << format("%.6g", 1000.0 / r.ns_per_ray)
+        << "," << format("%.6g", r.errors.max_abs_err_m) << ","
+        << format("%.6g", r.errors.p99_abs_err_m) << "," << format("%.6g", r.errors.max_ulp) << ","
+        << r.errors.leaks << "," << r.errors.false_hits << "\n";
+  }
+  if (!out) throw std::runtime_error("writing " + path + " failed");
+}
+
+void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
+                   const std::string& run_info) {
+  std::map<std::pair<std::string, std::string>, double> embree;
+  for (const Row& r : rows) {
+    if (r.method == "embree_default") embree[{r.workload, r.scene}] = r.ns_per_ray;
+  }
+  std::ofstream out = openForWriting(path);
+  out << run_info << "\n";
+  out << "| workload | scene | method | triangles | rays | ns_per_ray | mrays_per_s | "
+         "max_abs_err_m | p99_abs_err_m | max_ulp | leaks | false_hits | vs_embree |\n";
+  out << "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: "
+         "|\n";
+  for (const Row& r : rows) {
+    const auto it = embree.find({r.workload, r.scene});
+    const std::string vs = it == embree.end() ? "n/a" : format("%.3g", it->second / r.ns_per_ray);
+    out << "| " << r.workload << " | " << r.scene << " | " << r.method << " | " << r.triangles
+        << " | " << r.rays << " | " << format("%.4g", r.ns_per_ray) << " | "
+        << format("%.4g", 1000.0 / r.ns_per_ray) << " | " << format("%.3g", r.errors.max_abs_err_m)
+        << " | " << format("%.3g", r.errors.p99_abs_err_m) << " | "
+        << format("%.3g", r.errors.max_ulp) << " | " << r.errors.leaks << " | "
+        << r.errors.false_hits << " | " << vs << " |\n";
+  }
+  if (!out) throw std::runtime_error("writing " + path + " failed");
+}
+
+std::string runPlot(const std::string& script, const std::string& csv, const std::string& png) {
+  // Debian's interpreter, which has python3-matplotlib, not whichever python3 is first on PATH.
+  const char* const python = "/usr/bin/python3";
+  if (access(python, X_OK) != 0) return std::string(python) + " is not there";
+  if (access(script.c_str(), R_OK) != 0) return "the plot script " + script + " is not there";
+  const pid_t pid = fork();
+  if (pid < 0) return "fork failed";
+  if (pid == 0) {
+    execl(python, python, script.c_str(), csv.c_str(), png.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return "waitpid failed";
+  if (!WIFEXITED(status)) return python + std::string(" ") + script + " was killed";
+  if (WEXITSTATUS(status) != 0) {
+    return python + std::string(" ") + script + " exited with status " +
+           std::to_string(WEXITSTATUS(status)) + " (is python3-matplotlib installed?)";
+  }
+  return "";
+}
+
+}  // namespace bench
+}  // namespace laser_raycast

@@ -1,0 +1,46 @@
+// The benchmark's results: per-row error statistics against the reference, and the three outputs
+// (results.csv, results.md, pareto.png through scripts/plot_pareto).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "bench_meshes.h"
+
+namespace laser_raycast {
+namespace bench {
+
+struct ErrorStats {
+  double max_abs_err_m = 0;  // over the beams where both the method and the reference hit
+  double p99_abs_err_m = 0;
+  double max_ulp = 0;   // the largest error in units of the float spacing at the reference range
+  long leaks = 0;       // the method misses where the reference hits
+  long false_hits = 0;  // the method hits where the reference misses
+};
+
+// Compares the method's distances with the reference's at the given ray indices (+inf: no hit).
+ErrorStats compareWithReference(const std::vector<double>& dist, const std::vector<Real>& reference,
+                                const std::vector<int>& rays);
+
+struct Row {
+  std::string workload, scene, method;
+  std::size_t triangles = 0, rays = 0;
+  double ns_per_ray = 0;
+  ErrorStats errors;
+};
+
+// The stable header of results.csv.
+extern const char* const kCsvHeader;
+
+void writeCsv(const std::string& path, const std::vector<Row>& rows);
+// The table of results.csv plus vs_embree (embree_default's ns_per_ray over the row's, same
+// workload and scene), after a few lines that say how the run was made (run_info, markdown).
+void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
+                   const std::string& run_info);
+
+// Runs /usr/bin/python3 script csv png. Returns "" on success, else what went wrong.
+std::string runPlot(const std::string& script, const std::string& csv, const std::string& png);
+
+}  // namespace bench
+}  // namespace laser_raycast

@@ -1,0 +1,148 @@
+// The benchmark tool run as a user would: `bench --quick --out DIR`. Checks the outputs' format
+// (a stable interface), that every method has a row for every workload and scene that ran, and
+// that the production rows (watertight_bvh, pipeline) neither leak nor hit what is not there.
+// Never timings: the machine may be busy. The quick run takes up to about 2 minutes; catkin
+// ignores a gtest TIMEOUT, so the command itself is bounded by timeout(1) at 15 minutes.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "run_command.h"
+
+namespace {
+
+const std::string kBench = BENCH_PATH;
+const char* const kHeader =
+    "workload,scene,method,triangles,rays,ns_per_ray,mrays_per_s,max_abs_err_m,p99_abs_err_m,"
+    "max_ulp,leaks,false_hits";
+
+std::vector<std::string> splitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty()) lines.push_back(line);
+  }
+  return lines;
+}
+
+std::vector<std::string> splitFields(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream s(line);
+  std::string field;
+  while (std::getline(s, field, ',')) fields.push_back(field);
+  if (!line.empty() && line.back() == ',') fields.push_back("");
+  return fields;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The whole field must be a finite number.
+bool parseDouble(const std::string& text, double* value) {
+  char* end = nullptr;
+  *value = std::strtod(text.c_str(), &end);
+  return !text.empty() && *end == '\0' && std::isfinite(*value);
+}
+
+// The whole field must be a non-negative integer.
+bool parseCount(const std::string& text, long* value) {
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) return false;
+  *value = std::strtol(text.c_str(), nullptr, 10);
+  return true;
+}
+
+TEST(BenchSmoke, BadArgumentsExitWithTwo) {
+  EXPECT_EQ(laser_raycast_test::runCommand(kBench + " --no-such-flag 2>/dev/null").status, 2);
+  EXPECT_EQ(laser_raycast_test::runCommand(kBench + " --scene nowhere 2>/dev/null").status, 2);
+  EXPECT_EQ(laser_raycast_test::runCommand(kBench + " --scene 2>/dev/null").status, 2);
+}
+
+TEST(BenchSmoke, ListsTheCoreMethods) {
+  const auto result = laser_raycast_test::runCommand(kBench + " --list-methods");
+  ASSERT_EQ(result.status, 0);
+  const auto lines = splitLines(result.output);
+  const std::set<std::string> methods(lines.begin(), lines.end());
+  for (const std::string m : {"seed_plane", "seed_uv", "cramer", "moller_trumbore", "watertight"}) {
+    for (const std::string variant : {"_bvh", "_brute", "_f32_bvh", "_f32_brute"}) {
+      EXPECT_EQ(methods.count(m + variant), 1u) << m + variant;
+    }
+  }
+  EXPECT_EQ(methods.count("pipeline"), 1u);
+}
+
+TEST(BenchSmoke, QuickRunWritesEveryRow) {
+  const auto listed = laser_raycast_test::runCommand(kBench + " --list-methods");
+  ASSERT_EQ(listed.status, 0);
+  const std::vector<std::string> methods = splitLines(listed.output);
+
+  const std::string dir = ::testing::TempDir() + "bench_smoke_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  const std::string log = dir + ".log";
+  const auto run = laser_raycast_test::runCommand("timeout 900 " + kBench + " --quick --out " +
+                                                  dir + " 2>" + log);
+  ASSERT_EQ(run.status, 0) << readFile(log);
+
+  const auto lines = splitLines(readFile(dir + "/results.csv"));
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], kHeader);
+
+  std::map<std::pair<std::string, std::string>, std::set<std::string>> ran;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const auto f = splitFields(lines[i]);
+    ASSERT_EQ(f.size(), 12u) << lines[i];
+    const std::string& method = f[2];
+    ran[{f[0], f[1]}].insert(method);
+    long triangles, rays, leaks, false_hits;
+    double ns, mrays, max_err, p99_err, max_ulp;
+    EXPECT_TRUE(parseCount(f[3], &triangles)) << lines[i];
+    EXPECT_TRUE(parseCount(f[4], &rays) && rays > 0) << lines[i];
+    EXPECT_TRUE(parseDouble(f[5], &ns) && ns > 0) << lines[i];
+    EXPECT_TRUE(parseDouble(f[6], &mrays) && mrays > 0) << lines[i];
+    EXPECT_TRUE(parseDouble(f[7], &max_err) && max_err >= 0) << lines[i];
+    EXPECT_TRUE(parseDouble(f[8], &p99_err) && p99_err >= 0 && p99_err <= max_err) << lines[i];
+    EXPECT_TRUE(parseDouble(f[9], &max_ulp) && max_ulp >= 0) << lines[i];
+    EXPECT_TRUE(parseCount(f[10], &leaks)) << lines[i];
+    EXPECT_TRUE(parseCount(f[11], &false_hits)) << lines[i];
+    if (method == "watertight_bvh" || method == "pipeline") {
+      EXPECT_EQ(leaks, 0) << lines[i];
+      EXPECT_EQ(false_hits, 0) << lines[i];
+    }
+  }
+
+  // Every method for every workload and scene that ran; every generated scene in both workloads
+  // (tb3 runs only where its data is).
+  for (const auto& [key, present] : ran) {
+    for (const std::string& m : methods) {
+      EXPECT_EQ(present.count(m), 1u) << m << " missing for " << key.first << ", " << key.second;
+    }
+    EXPECT_EQ(present.size(), methods.size()) << key.first << ", " << key.second;
+  }
+  for (const std::string scene : {"sphere", "box_room", "million", "vertex_rows"}) {
+    for (const std::string workload : {"fan2d", "rings3d"}) {
+      EXPECT_EQ(ran.count({workload, scene}), 1u) << workload << ", " << scene;
+    }
+  }
+
+  EXPECT_FALSE(readFile(dir + "/results.md").empty());
+  const std::string png = readFile(dir + "/pareto.png");
+  ASSERT_GT(png.size(), 8u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(log);
+}
+
+}  // namespace
