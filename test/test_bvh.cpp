@@ -587,31 +587,36 @@ TEST(Bvh, AllCentroidsEqual) {
 // vertices are the mesh's (rounded to float for BvhF).
 template <typename T>
 void checkStructure(const BvhT<T>& bvh, const Soup& s) {
-  const auto& nodes = bvh.nodes();
-  ASSERT_FALSE(nodes.empty());
+  using Child = typename BvhT<T>::Child;
   std::vector<int> seen(s.triangles.size(), 0);
   auto contains = [](const AabbT<T>& outer, const Vec3<T>& p) {
     return (outer.lo.array() <= p.array()).all() && (p.array() <= outer.hi.array()).all();
   };
-  for (const auto& node : nodes) {
-    if (node.isLeaf()) {
-      for (std::uint32_t slot = node.first; slot < node.first + node.count; ++slot) {
+  // Walk from the root with each subtree's box (the exact bounds at the root, then the float boxes
+  // stored in the parents): every vertex must lie in the box of the leaf holding it.
+  std::vector<std::pair<Child, AabbT<T>>> todo{{bvh.root(), bvh.bounds()}};
+  std::size_t inner = 0;
+  while (!todo.empty()) {
+    const auto [child, box] = todo.back();
+    todo.pop_back();
+    if (child.isLeaf()) {
+      for (std::uint32_t slot = child.index; slot < child.index + child.count; ++slot) {
         const std::uint32_t id = bvh.triangleIds()[slot];
         ++seen[id];
         for (int k = 0; k < 3; ++k) {
           const Vec3<T> v = s.vertices[s.triangles[id][k]].cast<T>();
           EXPECT_EQ(bvh.triangleVertices()[slot][k], v);
-          EXPECT_TRUE(contains(node.bounds, v));
+          EXPECT_TRUE(contains(box, v));
         }
       }
-    } else {
-      ASSERT_LT(node.first + 1, nodes.size());
-      for (const auto child : {node.first, node.first + 1}) {
-        EXPECT_TRUE(contains(node.bounds, nodes[child].bounds.lo));
-        EXPECT_TRUE(contains(node.bounds, nodes[child].bounds.hi));
-      }
+      continue;
     }
+    ASSERT_LT(child.index, bvh.nodes().size());
+    ++inner;
+    const auto& node = bvh.nodes()[child.index];
+    for (int k = 0; k < 2; ++k) todo.emplace_back(node.child[k], node.box(k));
   }
+  EXPECT_EQ(inner, bvh.nodes().size());  // every inner node is reached exactly once
   for (std::size_t i = 0; i < s.triangles.size(); ++i) {
     const auto& tri = s.triangles[i];
     const bool degenerate = isDegenerateTriangle<T>(
@@ -689,8 +694,10 @@ TEST(Bvh, EmptyBuildHitsNothing) {
 }
 
 // visit() calls leaf() for exactly the slots of the leaves whose box passes the predicate, once
-// each. An overlap test is monotone (a child overlaps only if its parent does), so the expected set
-// is read straight from nodes().
+// each. An overlap test is monotone (a child overlaps only if its parent does: the float boxes
+// stored in the nodes nest, being outward roundings of nested boxes), so the expected set is read
+// straight from nodes(), plus the root's exact box, which a child's rounded box may exceed by an
+// ulp.
 TEST(Bvh, VisitReachesExactlyTheLeavesThatPass) {
   std::mt19937_64 rng(8);
   const Soup s = spreadSoup(rng, 2000);
@@ -704,10 +711,15 @@ TEST(Bvh, VisitReachesExactlyTheLeavesThatPass) {
       return (box.lo.array() <= (c + h).array()).all() && (box.hi.array() >= (c - h).array()).all();
     };
     std::multiset<std::uint32_t> expected, visited;
+    ASSERT_FALSE(bvh.root().isLeaf());
     for (const auto& node : bvh.nodes()) {
-      if (!node.isLeaf() || !overlaps(node.bounds)) continue;
-      for (std::uint32_t slot = node.first; slot < node.first + node.count; ++slot)
-        expected.insert(slot);
+      for (int k = 0; k < 2; ++k) {
+        const auto leaf = node.child[k];
+        if (!leaf.isLeaf() || !overlaps(bvh.bounds()) || !overlaps(node.box(k))) continue;
+        for (std::uint32_t slot = leaf.index; slot < leaf.index + leaf.count; ++slot) {
+          expected.insert(slot);
+        }
+      }
     }
     int calls = 0;
     bvh.visit(

@@ -1,6 +1,8 @@
 #include "laser_raycast/core/bvh.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -163,6 +165,17 @@ AabbT<T> castBounds(const Aabb& b) {
   return out;
 }
 
+// The largest float <= x, and the smallest float >= x: a float box that contains the exact one (and
+// the float-rounded vertices' box, since rounding to nearest is monotonic).
+float floatAtMost(double x) {
+  constexpr float kMax = std::numeric_limits<float>::max();
+  if (x > kMax) return kMax;
+  if (x < -kMax) return -std::numeric_limits<float>::infinity();
+  const float f = static_cast<float>(x);
+  return f > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+float floatAtLeast(double x) { return -floatAtMost(-x); }
+
 }  // namespace
 
 void BvhConfig::validate() const {
@@ -208,9 +221,37 @@ BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
   Builder builder(build_tris, config);
   builder.run();
   bvh.depth_ = builder.depth();
-  bvh.nodes_.reserve(builder.nodes().size());
-  for (const BuildNode& n : builder.nodes()) {
-    bvh.nodes_.push_back(Node{castBounds<T>(n.bounds), n.first, n.count});
+  const std::vector<BuildNode>& tree = builder.nodes();
+  bvh.bounds_ = castBounds<T>(tree[0].bounds);
+  // Inner nodes depth first, each holding its children's boxes; the two children of a node get
+  // adjacent indices.
+  if (tree[0].count > 0) {
+    bvh.root_ = Child{tree[0].first, tree[0].count};
+  } else {
+    bvh.nodes_.reserve(tree.size() / 2);
+    bvh.nodes_.emplace_back();
+    bvh.root_ = Child{0, 0};
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> todo{{0, 0}};  // (build node, node)
+    while (!todo.empty()) {
+      const auto [from, to] = todo.back();
+      todo.pop_back();
+      for (int k = 0; k < 2; ++k) {
+        const std::uint32_t build_child = tree[from].first + k;
+        const BuildNode& child = tree[build_child];
+        Child ref{child.first, child.count};
+        if (child.count == 0) {
+          ref.index = static_cast<std::uint32_t>(bvh.nodes_.size());
+          bvh.nodes_.emplace_back();
+          todo.emplace_back(build_child, ref.index);
+        }
+        Node& node = bvh.nodes_[to];
+        node.child[k] = ref;
+        for (int a = 0; a < 3; ++a) {
+          node.lo[k][a] = floatAtMost(child.bounds.lo[a]);
+          node.hi[k][a] = floatAtLeast(child.bounds.hi[a]);
+        }
+      }
+    }
   }
   bvh.triangle_ids_.reserve(build_tris.size());
   bvh.vertices_.reserve(build_tris.size());

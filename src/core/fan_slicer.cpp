@@ -26,12 +26,6 @@ Eigen::Vector3d edgeCrossing(Eigen::Vector3d p, double sp, Eigen::Vector3d q, do
   return p + (q - p) * (sp / (sp - sq));  // sp and sq differ in sign: no cancellation
 }
 
-double wrapToTurn(double angle) {
-  double a = std::fmod(angle, 2 * M_PI);
-  if (a < 0) a += 2 * M_PI;
-  return a;
-}
-
 }  // namespace
 
 void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
@@ -93,15 +87,21 @@ void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, cons
     Eigen::Vector3d front = Eigen::Vector3d::Zero();
     if (cull_backfaces) front = rot * (v[1] - v[0]).cross(v[2] - v[0]);
 
-    // The beams that can see the segment: the shorter arc between its endpoints' bearings.
-    const double bearing_p = std::atan2(p.y(), p.x());
-    const double bearing_q = std::atan2(q.y(), q.x());
+    // The beams that can see the segment: the shorter arc between its endpoints' bearings, widened
+    // for their approximation (twice the error each side also covers a tiny sweep whose sign the
+    // approximation flipped). A segment passing beside the sensor, within the error of half a
+    // turn, could be either arc: then every beam is tried.
+    const double bearing_p = approxAtan2(p.y(), p.x());
+    const double bearing_q = approxAtan2(q.y(), q.x());
     double sweep = bearing_q - bearing_p;
     if (sweep > M_PI) sweep -= 2 * M_PI;
     if (sweep < -M_PI) sweep += 2 * M_PI;
-    const double start = wrapToTurn((sweep >= 0 ? bearing_p : bearing_q) - fan.angleMin());
-
-    forEachBeamRange(fan, start, std::abs(sweep), [&](int first, int last) {
+    const double pad = 4 * kBearingError;
+    const bool ambiguous = std::abs(sweep) > M_PI - 2 * pad;
+    const double start =
+        ambiguous ? 0.0 : wrapToTurn((sweep >= 0 ? bearing_p : bearing_q) - pad - fan.angleMin());
+    const double width = ambiguous ? 2 * M_PI : std::abs(sweep) + 2 * pad;
+    forEachBeamRange(fan, start, width, [&](int first, int last) {
       for (int i = first; i <= last; ++i) {
         const double dx = dirs[i].x(), dy = dirs[i].y();
         // Which side of the beam's line each endpoint is on; a shared endpoint gives the same value

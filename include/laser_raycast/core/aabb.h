@@ -4,6 +4,10 @@
 #include <algorithm>
 #include <limits>
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 #include "laser_raycast/core/ray.h"
 
 namespace laser_raycast {
@@ -67,22 +71,71 @@ struct SlabRay {
 // the origin is strictly inside or outside that slab, and NaN when it lies exactly on a face. The
 // comparisons below are ordered so that a NaN never tightens the interval: the ray is then treated
 // as inside that slab, which is the conservative answer for a ray lying in a box face.
-template <typename T>
-inline bool slabTest(const SlabRay<T>& ray, const AabbT<T>& box, T tmax, T* t_entry) {
+// The box is given as its corners' coordinates (B may be float for a double ray: the box is then
+// converted exactly).
+template <typename T, typename B>
+inline bool slabTest(const SlabRay<T>& ray, const B* lo, const B* hi, T tmax, T* t_entry) {
   T tnear = ray.tmin;
-  T tfar = tmax;
+  T tfar = std::numeric_limits<T>::infinity();
   for (int k = 0; k < 3; ++k) {
-    const T t0 = (box.lo[k] - ray.origin[k]) * ray.inv_dir[k];
-    const T t1 = (box.hi[k] - ray.origin[k]) * ray.inv_dir[k];
-    const T near_k =
-        t1 < t0 ? t1 : t0;        // NaN in t1 keeps t0; NaN in t0 stays NaN and is ignored below
-    T far_k = t0 > t1 ? t0 : t1;  // likewise, NaN in t0 picks t1
-    far_k *= 1 + 2 * roundingGamma<T>(3);
+    const T t0 = (static_cast<T>(lo[k]) - ray.origin[k]) * ray.inv_dir[k];
+    const T t1 = (static_cast<T>(hi[k]) - ray.origin[k]) * ray.inv_dir[k];
+    // NaN in t1 keeps t0; NaN in t0 stays NaN and is ignored below.
+    const T near_k = t1 < t0 ? t1 : t0;
+    const T far_k = t0 > t1 ? t0 : t1;        // likewise, NaN in t0 picks t1
     tnear = near_k > tnear ? near_k : tnear;  // NaN never replaces tnear
     tfar = far_k < tfar ? far_k : tfar;       // NaN never replaces tfar
   }
+  // Enlarging the nearest exit equals enlarging each exit (rounding is monotonic), for one
+  // multiply.
+  tfar *= 1 + 2 * roundingGamma<T>(3);
+  tfar = tfar < tmax ? tfar : tmax;
   *t_entry = tnear;
   return tnear <= tfar;
+}
+
+// The same test for two boxes at once (lo[k] and hi[k] are box k's corners): a BVH node's two
+// children. With SSE2 the two boxes share each instruction; the comparisons map one to one onto
+// minpd/maxpd, which return their second operand when either is NaN, exactly as the scalar selects
+// above do.
+template <typename T, typename B>
+inline void slabTestPair(const SlabRay<T>& ray, const B (*lo)[3], const B (*hi)[3], T tmax,
+                         T* t_entry0, T* t_entry1, bool* hit0, bool* hit1) {
+  *hit0 = slabTest(ray, lo[0], hi[0], tmax, t_entry0);
+  *hit1 = slabTest(ray, lo[1], hi[1], tmax, t_entry1);
+}
+
+#ifdef __SSE2__
+template <typename B>
+inline void slabTestPair(const SlabRay<double>& ray, const B (*lo)[3], const B (*hi)[3],
+                         double tmax, double* t_entry0, double* t_entry1, bool* hit0, bool* hit1) {
+  __m128d tnear = _mm_set1_pd(ray.tmin);
+  __m128d tfar = _mm_set1_pd(std::numeric_limits<double>::infinity());
+  for (int k = 0; k < 3; ++k) {
+    const __m128d origin = _mm_set1_pd(ray.origin[k]);
+    const __m128d inv = _mm_set1_pd(ray.inv_dir[k]);
+    const __m128d t0 = _mm_mul_pd(_mm_sub_pd(_mm_set_pd(lo[1][k], lo[0][k]), origin), inv);
+    const __m128d t1 = _mm_mul_pd(_mm_sub_pd(_mm_set_pd(hi[1][k], hi[0][k]), origin), inv);
+    const __m128d near_k = _mm_min_pd(t1, t0);  // t1 < t0 ? t1 : t0
+    const __m128d far_k = _mm_max_pd(t0, t1);   // t0 > t1 ? t0 : t1
+    tnear = _mm_max_pd(near_k, tnear);          // near_k > tnear ? near_k : tnear
+    tfar = _mm_min_pd(far_k, tfar);             // far_k < tfar ? far_k : tfar
+  }
+  tfar = _mm_mul_pd(tfar, _mm_set1_pd(1 + 2 * roundingGamma<double>(3)));
+  tfar = _mm_min_pd(tfar, _mm_set1_pd(tmax));
+  const int hits = _mm_movemask_pd(_mm_cmple_pd(tnear, tfar));
+  double entries[2];
+  _mm_storeu_pd(entries, tnear);
+  *t_entry0 = entries[0];
+  *t_entry1 = entries[1];
+  *hit0 = (hits & 1) != 0;
+  *hit1 = (hits & 2) != 0;
+}
+#endif
+
+template <typename T>
+inline bool slabTest(const SlabRay<T>& ray, const AabbT<T>& box, T tmax, T* t_entry) {
+  return slabTest(ray, box.lo.data(), box.hi.data(), tmax, t_entry);
 }
 
 }  // namespace core

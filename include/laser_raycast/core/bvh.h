@@ -39,12 +39,30 @@ using MeshHit = MeshHitT<double>;
 template <typename T>
 class BvhT {
  public:
-  struct Node {
-    AabbT<T> bounds;
-    std::uint32_t
-        first;  // inner node: index of the left child (the right one follows); leaf: first slot
-    std::uint32_t count;  // number of triangles in a leaf; 0 for an inner node
+  // A subtree: an inner node (count == 0, index into nodes()) or a leaf (count triangle slots from
+  // index on).
+  // Trivially constructible, so that a traversal's stack of them costs nothing to set up.
+  struct Child {
+    std::uint32_t index;
+    std::uint32_t count;
     bool isLeaf() const { return count > 0; }
+  };
+
+  // An inner node holds its two children's boxes, so that deciding where to go next reads one cache
+  // line (traversal is memory-bound). The boxes are float, rounded outward: they contain the exact
+  // boxes, so a slab test in double against them is as conservative as against the exact ones.
+  struct alignas(64) Node {
+    float lo[2][3];
+    float hi[2][3];
+    Child child[2];
+    AabbT<T> box(int k) const {
+      AabbT<T> b;
+      for (int a = 0; a < 3; ++a) {
+        b.lo[a] = static_cast<T>(lo[k][a]);
+        b.hi[a] = static_cast<T>(hi[k][a]);
+      }
+      return b;
+    }
   };
 
   BvhT() = default;
@@ -55,13 +73,16 @@ class BvhT {
   static BvhT build(const std::vector<Eigen::Vector3d>& vertices,
                     const std::vector<TriangleIndices>& triangles, const BvhConfig& config = {});
 
+  // The inner nodes, depth first (a parent before its children); the tree starts at root().
   const std::vector<Node>& nodes() const { return nodes_; }
+  Child root() const { return root_; }
   // Triangle slots in leaf order: the original triangle index, and its vertices copied for
   // locality.
   const std::vector<std::uint32_t>& triangleIds() const { return triangle_ids_; }
   const std::vector<std::array<Vec3<T>, 3>>& triangleVertices() const { return vertices_; }
-  AabbT<T> bounds() const { return nodes_.empty() ? AabbT<T>{} : nodes_[0].bounds; }
-  bool empty() const { return nodes_.empty(); }
+  // The exact bounds of every stored vertex.
+  const AabbT<T>& bounds() const { return bounds_; }
+  bool empty() const { return vertices_.empty(); }
   int depth() const { return depth_; }
 
   // Nearest hit with t in [ray.tmin, ray.tmax], by method M.
@@ -72,7 +93,7 @@ class BvhT {
   template <TriangleMethod M>
   bool anyHit(const RayT<T>& ray, bool cull_backfaces = false) const;
 
-  // Depth-first walk over the nodes whose box satisfies descend(bounds); calls leaf(slot) for each
+  // Depth-first walk over the subtrees whose box satisfies descend(box); calls leaf(slot) for each
   // triangle slot of every such leaf. Used by queries that are not rays (the planar fan slices
   // meshes with it).
   template <class Descend, class Leaf>
@@ -83,6 +104,8 @@ class BvhT {
   std::optional<MeshHitT<T>> traverse(const RayT<T>& ray, bool cull_backfaces) const;
 
   std::vector<Node> nodes_;
+  Child root_{0, 0};
+  AabbT<T> bounds_;
   std::vector<std::uint32_t> triangle_ids_;
   std::vector<std::array<Vec3<T>, 3>> vertices_;
   int depth_ = 0;
@@ -105,7 +128,7 @@ template <typename T>
 template <TriangleMethod M, bool kAnyHit>
 std::optional<MeshHitT<T>> BvhT<T>::traverse(const RayT<T>& ray, bool cull_backfaces) const {
   std::optional<MeshHitT<T>> best;
-  if (nodes_.empty()) return best;
+  if (empty()) return best;
   const PreparedRay<T, M> prepared(ray, cull_backfaces);
   // Boxes are culled against [tmin, tmax] widened by 64 ulps of |t| plus the ray's reach (the
   // farthest root-box coordinate, in units of t); the triangle tests still use the exact interval.
@@ -115,32 +138,33 @@ std::optional<MeshHitT<T>> BvhT<T>::traverse(const RayT<T>& ray, bool cull_backf
   // two: unwidened, a hit at exactly tmax or tmin, or the nearer of two hits ulps apart in
   // different leaves, was lost.
   constexpr T kWiden = 64 * std::numeric_limits<T>::epsilon();
-  const AabbT<T>& root = nodes_[0].bounds;
-  const T reach =
-      (root.lo - ray.origin).cwiseAbs().cwiseMax((root.hi - ray.origin).cwiseAbs()).maxCoeff() /
-      ray.dir.cwiseAbs().maxCoeff();
+  const T reach = (bounds_.lo - ray.origin)
+                      .cwiseAbs()
+                      .cwiseMax((bounds_.hi - ray.origin).cwiseAbs())
+                      .maxCoeff() /
+                  ray.dir.cwiseAbs().maxCoeff();
   SlabRay<T> slab(ray);
   slab.tmin = ray.tmin - (std::abs(ray.tmin) + reach) * kWiden;
   T tmax = ray.tmax;
   T cull_tmax = tmax + (std::abs(tmax) + reach) * kWiden;
   T t_root;
-  if (!slabTest(slab, root, cull_tmax, &t_root)) return best;
+  if (!slabTest(slab, bounds_, cull_tmax, &t_root)) return best;
 
   // Each entry remembers its box's entry distance, so a box found farther than a later hit is
   // skipped.
   struct Entry {
-    std::uint32_t node;
+    Child child;
     T t_entry;
   };
   Entry stack[64];
   int top = 0;
-  stack[top++] = Entry{0, t_root};
+  stack[top++] = Entry{root_, t_root};
   while (top > 0) {
     const Entry entry = stack[--top];
     if (entry.t_entry > cull_tmax) continue;
-    const Node& node = nodes_[entry.node];
-    if (node.isLeaf()) {
-      for (std::uint32_t slot = node.first; slot < node.first + node.count; ++slot) {
+    if (entry.child.isLeaf()) {
+      const std::uint32_t end = entry.child.index + entry.child.count;
+      for (std::uint32_t slot = entry.child.index; slot < end; ++slot) {
         const auto& tri = vertices_[slot];
         const auto hit = prepared.intersect(tri[0], tri[1], tri[2], tmax);
         if (hit) {
@@ -153,22 +177,22 @@ std::optional<MeshHitT<T>> BvhT<T>::traverse(const RayT<T>& ray, bool cull_backf
       continue;
     }
     // Visit the nearer child first; push the farther one underneath it.
-    const std::uint32_t left = node.first, right = node.first + 1;
-    T t_left, t_right;
-    const bool hit_left = slabTest(slab, nodes_[left].bounds, cull_tmax, &t_left);
-    const bool hit_right = slabTest(slab, nodes_[right].bounds, cull_tmax, &t_right);
-    if (hit_left && hit_right) {
-      if (t_left <= t_right) {
-        stack[top++] = Entry{right, t_right};
-        stack[top++] = Entry{left, t_left};
+    const Node& node = nodes_[entry.child.index];
+    T t0, t1;
+    bool hit0, hit1;
+    slabTestPair(slab, node.lo, node.hi, cull_tmax, &t0, &t1, &hit0, &hit1);
+    if (hit0 && hit1) {
+      if (t0 <= t1) {
+        stack[top++] = Entry{node.child[1], t1};
+        stack[top++] = Entry{node.child[0], t0};
       } else {
-        stack[top++] = Entry{left, t_left};
-        stack[top++] = Entry{right, t_right};
+        stack[top++] = Entry{node.child[0], t0};
+        stack[top++] = Entry{node.child[1], t1};
       }
-    } else if (hit_left) {
-      stack[top++] = Entry{left, t_left};
-    } else if (hit_right) {
-      stack[top++] = Entry{right, t_right};
+    } else if (hit0) {
+      stack[top++] = Entry{node.child[0], t0};
+    } else if (hit1) {
+      stack[top++] = Entry{node.child[1], t1};
     }
   }
   return best;
@@ -189,18 +213,19 @@ bool BvhT<T>::anyHit(const RayT<T>& ray, bool cull_backfaces) const {
 template <typename T>
 template <class Descend, class Leaf>
 void BvhT<T>::visit(Descend&& descend, Leaf&& leaf) const {
-  if (nodes_.empty()) return;
-  std::uint32_t stack[64];
+  if (empty() || !descend(bounds_)) return;
+  Child stack[64];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = root_;
   while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (!descend(node.bounds)) continue;
-    if (node.isLeaf()) {
-      for (std::uint32_t slot = node.first; slot < node.first + node.count; ++slot) leaf(slot);
-    } else {
-      stack[top++] = node.first + 1;
-      stack[top++] = node.first;
+    const Child child = stack[--top];
+    if (child.isLeaf()) {
+      for (std::uint32_t slot = child.index; slot < child.index + child.count; ++slot) leaf(slot);
+      continue;
+    }
+    const Node& node = nodes_[child.index];
+    for (const int k : {1, 0}) {  // the first child on top
+      if (descend(node.box(k))) stack[top++] = node.child[k];
     }
   }
 }

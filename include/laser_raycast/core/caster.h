@@ -65,6 +65,12 @@ class Caster {
     Eigen::Vector3d sensor_in_body;        // the sensor origin in the body frame
     Eigen::Vector3d center;                // bounding sphere centre, sensor frame
     double radius;
+    double near;  // no point of the body is nearer to the sensor than this (m)
+    // The directions the bounding sphere covers: an azimuth interval (from angle_min, as
+    // forEachBeamRange takes it) unless it surrounds the z axis, and an elevation interval.
+    bool azimuth_limited;
+    double azimuth_start, azimuth_width;
+    double elevation_lo, elevation_hi;
   };
 
  private:
