@@ -23,6 +23,7 @@ class World {
  public:
   World() {
     scan_sub_ = nh_.subscribe("scan", 10, &World::onScan, this);
+    tuned_sub_ = nh_.subscribe("scan_tuned", 10, &World::onTuned, this);
     labels_sub_ = nh_.subscribe("scan_labels", 10, &World::onLabels, this);
     tf_timer_ = nh_.createTimer(ros::Duration(0.02), &World::publishTf, this);
   }
@@ -51,6 +52,22 @@ class World {
     return sensor_msgs::LaserScan();
   }
 
+  // The newest scan of the "tuned" node (intensities, reflectivity, an ignored link) taken at least
+  // `stamp`.
+  sensor_msgs::LaserScan tunedScanAfter(const ros::Time& stamp) {
+    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(20.0);
+    while (ros::ok() && ros::WallTime::now() < give_up) {
+      ros::spinOnce();
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (tuned_ && tuned_->header.stamp >= stamp) return *tuned_;
+      }
+      ros::WallDuration(0.005).sleep();
+    }
+    ADD_FAILURE() << "no scan on " << tuned_sub_.getTopic();
+    return sensor_msgs::LaserScan();
+  }
+
   laser_raycast::ScanLabels::ConstPtr labelsFor(const ros::Time& stamp) {
     const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(10.0);
     while (ros::ok() && ros::WallTime::now() < give_up) {
@@ -68,6 +85,10 @@ class World {
   void onScan(const sensor_msgs::LaserScan::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     scan_ = msg;
+  }
+  void onTuned(const sensor_msgs::LaserScan::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tuned_ = msg;
   }
   void onLabels(const laser_raycast::ScanLabels::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -100,12 +121,12 @@ class World {
   }
 
   ros::NodeHandle nh_;
-  ros::Subscriber scan_sub_, labels_sub_;
+  ros::Subscriber scan_sub_, labels_sub_, tuned_sub_;
   ros::Timer tf_timer_;
   tf2_ros::TransformBroadcaster broadcaster_;
   std::mutex mutex_;
   std::array<double, 3> laser_{0, 0, 0}, mover_{0, 0, 5};
-  sensor_msgs::LaserScan::ConstPtr scan_;
+  sensor_msgs::LaserScan::ConstPtr scan_, tuned_;
   laser_raycast::ScanLabels::ConstPtr labels_;
 };
 
@@ -119,6 +140,9 @@ class NodeScanTest : public ::testing::Test {
   }
   laser_raycast::ScanLabels::ConstPtr labelsFor(const ros::Time& stamp) {
     return world->labelsFor(stamp);
+  }
+  sensor_msgs::LaserScan tunedScanAfter(const ros::Time& stamp) {
+    return world->tunedScanAfter(stamp);
   }
 };
 
@@ -196,6 +220,23 @@ TEST_F(NodeScanTest, SurfacesCloserThanRangeMinAreMinusInf) {
   // 0.1 m from the box face, below range_min = 0.2 m: REP 117 "too close" with the default policy.
   const sensor_msgs::LaserScan scan = scanWith(2.4, 0, 0, 0, 0, 5);
   expectRange(scan, 4, -kInf);
+}
+
+// ~intensity reflectivity, ~reflectivity {box_link: 0.5}, ~ignore_links [sphere_link]. Intensity is
+// the link's reflectivity times the cosine of the incidence angle; the beams at 0 and pi/2 meet the
+// box face and the cylinder head-on (cos 1), and the cylinder has the default reflectivity 1.
+TEST_F(NodeScanTest, IntensityReflectivityAndIgnoredLinks) {
+  const sensor_msgs::LaserScan plain = scanWith(0, 0, 0, 0, 0, 5);
+  const sensor_msgs::LaserScan scan = tunedScanAfter(plain.header.stamp);
+  ASSERT_EQ(scan.ranges.size(), 8u);
+  ASSERT_EQ(scan.intensities.size(), 8u);
+  expectRange(scan, 4, 2.5);
+  EXPECT_NEAR(scan.intensities[4], 0.5, 1e-6);  // box_link
+  expectRange(scan, 6, 3.5);
+  EXPECT_NEAR(scan.intensities[6], 1.0, 1e-6);  // cyl_link
+  expectRange(scan, 0, kInf);                   // sphere_link is ignored: nothing behind it
+  EXPECT_EQ(scan.intensities[0], 0.0f);
+  EXPECT_EQ(scan.intensities[1], 0.0f);  // no hit
 }
 
 }  // namespace
