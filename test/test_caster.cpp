@@ -12,11 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "expect_invalid.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/fan_slicer.h"
 #include "laser_raycast/core/pose.h"
 
 using namespace laser_raycast::core;
+using laser_raycast::test::expectMentions;
+using laser_raycast::test::invalidMessage;
 
 namespace {
 
@@ -1590,17 +1593,7 @@ TEST(Caster, TminHidesNearerSurfaces) {
 
 // CastConfig::validate names the field and the value; cast() validates.
 TEST(CastConfig, ValidateNamesFieldAndValue) {
-  auto message = [](const CastConfig& c) -> std::string {
-    try {
-      c.validate();
-    } catch (const std::invalid_argument& e) {
-      return e.what();
-    }
-    return "<no exception>";
-  };
-  auto expectMentions = [](const std::string& msg, const std::vector<std::string>& needles) {
-    for (const auto& n : needles) EXPECT_NE(msg.find(n), std::string::npos) << msg << " / " << n;
-  };
+  auto message = [](const CastConfig& c) { return invalidMessage([&] { c.validate(); }); };
   CastConfig c;
   EXPECT_NO_THROW(c.validate());
   c.tmin = -0.5;

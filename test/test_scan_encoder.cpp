@@ -10,9 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "expect_invalid.h"
 #include "laser_raycast/core/scan_encoder.h"
 
 using namespace laser_raycast::core;
+using laser_raycast::test::expectMentions;
+using laser_raycast::test::invalidMessage;
 
 namespace {
 
@@ -117,17 +120,7 @@ TEST(MinRangePolicy, StringRoundTrip) {
 }
 
 TEST(EncoderConfig, ValidateNamesFieldAndValue) {
-  auto message = [](const EncoderConfig& c) -> std::string {
-    try {
-      c.validate();
-    } catch (const std::invalid_argument& e) {
-      return e.what();
-    }
-    return "<no exception>";
-  };
-  auto expectMentions = [](const std::string& msg, const std::vector<std::string>& needles) {
-    for (const auto& n : needles) EXPECT_NE(msg.find(n), std::string::npos) << msg << " / " << n;
-  };
+  auto message = [](const EncoderConfig& c) { return invalidMessage([&] { c.validate(); }); };
   EXPECT_NO_THROW(EncoderConfig{}.validate());
   EXPECT_NO_THROW(encoderConfig(0, 0.001).validate());
   EncoderConfig c;

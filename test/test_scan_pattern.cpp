@@ -8,9 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "expect_invalid.h"
 #include "laser_raycast/core/scan_pattern.h"
 
 using namespace laser_raycast::core;
+using laser_raycast::test::expectMentions;
+using laser_raycast::test::invalidMessage;
 
 namespace {
 
@@ -31,25 +34,6 @@ FanSpec bySamples(double min, double max, int samples) {
   fan.angle_max = max;
   fan.samples = samples;
   return fan;
-}
-
-// The message of the std::invalid_argument that f throws, or a marker if it throws nothing.
-template <class F>
-std::string invalidMessage(F&& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "<no exception>";
-}
-
-// Every needle must occur in the message.
-void expectMentions(const std::string& message, const std::vector<std::string>& needles) {
-  for (const auto& needle : needles) {
-    EXPECT_NE(message.find(needle), std::string::npos)
-        << "message \"" << message << "\" lacks \"" << needle << "\"";
-  }
 }
 
 void expectFanInvalid(const FanSpec& fan, const std::vector<std::string>& needles) {
