@@ -12,10 +12,12 @@
 #include <string>
 #include <vector>
 
+#include "expect_invalid.h"
 #include "laser_raycast/core/bvh.h"
 #include "laser_raycast/core/mesh.h"
 
 using namespace laser_raycast::core;
+using laser_raycast::test::expectMentions;
 
 namespace {
 
@@ -744,14 +746,7 @@ TEST(Bvh, VisitReachesExactlyTheLeavesThatPass) {
 namespace {
 
 void expectInvalid(const BvhConfig& config, const std::string& field, const std::string& value) {
-  try {
-    config.validate();
-    ADD_FAILURE() << "no exception for " << field << " = " << value;
-  } catch (const std::invalid_argument& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find(field), std::string::npos) << msg;
-    EXPECT_NE(msg.find(value), std::string::npos) << msg;
-  }
+  expectMentions(laser_raycast::test::invalidMessage([&] { config.validate(); }), {field, value});
   // build() validates too.
   const std::vector<Eigen::Vector3d> v = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
                                           Eigen::Vector3d(0, 1, 0)};
@@ -834,12 +829,7 @@ TEST(Bvh, MaxDepthTreeTraversesCorrectly) {
 namespace {
 
 std::string invalidMessage(std::vector<Eigen::Vector3d> v, std::vector<TriangleIndices> t) {
-  try {
-    Mesh mesh(std::move(v), std::move(t));
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "<no exception>";
+  return laser_raycast::test::invalidMessage([&] { Mesh mesh(std::move(v), std::move(t)); });
 }
 
 }  // namespace

@@ -13,12 +13,15 @@
 #include <vector>
 
 #include "expect_invalid.h"
+#include "fan_specs.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/fan_slicer.h"
 #include "laser_raycast/core/pose.h"
 
 using namespace laser_raycast::core;
 using laser_raycast::test::expectMentions;
+using laser_raycast::test::fanByIncrement;
+using laser_raycast::test::fanBySamples;
 using laser_raycast::test::invalidMessage;
 
 namespace {
@@ -238,22 +241,6 @@ Scene sceneWithFrame(const std::string& frame = "world") {
   scene.addFrame(frame);
   scene.addLabel("thing");
   return scene;
-}
-
-FanSpec fanBySamples(double min, double max, int samples) {
-  FanSpec fan;
-  fan.angle_min = min;
-  fan.angle_max = max;
-  fan.samples = samples;
-  return fan;
-}
-
-FanSpec fanByIncrement(double min, double max, double increment) {
-  FanSpec fan;
-  fan.angle_min = min;
-  fan.angle_max = max;
-  fan.angle_increment = increment;
-  return fan;
 }
 
 CastConfig config(bool fast_path, double tmax = 30.0) {

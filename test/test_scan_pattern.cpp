@@ -9,32 +9,19 @@
 #include <vector>
 
 #include "expect_invalid.h"
+#include "fan_specs.h"
 #include "laser_raycast/core/scan_pattern.h"
 
 using namespace laser_raycast::core;
 using laser_raycast::test::expectMentions;
+using laser_raycast::test::fanByIncrement;
+using laser_raycast::test::fanBySamples;
 using laser_raycast::test::invalidMessage;
 
 namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-FanSpec byIncrement(double min, double max, double increment) {
-  FanSpec fan;
-  fan.angle_min = min;
-  fan.angle_max = max;
-  fan.angle_increment = increment;
-  return fan;
-}
-
-FanSpec bySamples(double min, double max, int samples) {
-  FanSpec fan;
-  fan.angle_min = min;
-  fan.angle_max = max;
-  fan.samples = samples;
-  return fan;
-}
 
 void expectFanInvalid(const FanSpec& fan, const std::vector<std::string>& needles) {
   expectMentions(invalidMessage([&] { fan.validate(); }), needles);
@@ -65,7 +52,7 @@ TEST(FanSpec, IncrementModeCount) {
       {-M_PI, M_PI, M_PI / 180, 361},
   };
   for (const Case& c : cases) {
-    const FanSpec fan = byIncrement(c.min, c.max, c.increment);
+    const FanSpec fan = fanByIncrement(c.min, c.max, c.increment);
     ASSERT_NO_THROW(fan.validate());
     EXPECT_EQ(fan.beamCount(), c.n) << c.min << " " << c.max << " " << c.increment;
     EXPECT_EQ(fan.increment(), c.increment);
@@ -95,7 +82,7 @@ TEST(FanSpec, SamplesModeSpacing) {
   };
   const Case cases[] = {{-1.0, 1.0, 5}, {-M_PI, M_PI, 720}, {0.25, 0.5, 2}, {-2.0, 3.0, 1081}};
   for (const Case& c : cases) {
-    const FanSpec fan = bySamples(c.min, c.max, c.samples);
+    const FanSpec fan = fanBySamples(c.min, c.max, c.samples);
     ASSERT_NO_THROW(fan.validate());
     EXPECT_EQ(fan.beamCount(), c.samples);
     const double spacing = (c.max - c.min) / (c.samples - 1);
@@ -113,7 +100,7 @@ TEST(FanSpec, SamplesModeSpacing) {
     EXPECT_NEAR(last.y(), std::sin(c.max), 1e-15);
   }
   // The literal case: 5 samples over [-1, 1] are -1, -0.5, 0, 0.5, 1.
-  const ScanPattern five(bySamples(-1, 1, 5));
+  const ScanPattern five(fanBySamples(-1, 1, 5));
   const double expected[] = {-1, -0.5, 0, 0.5, 1};
   for (int i = 0; i < 5; ++i) EXPECT_EQ(five.azimuth(i), expected[i]);
 }
@@ -121,8 +108,8 @@ TEST(FanSpec, SamplesModeSpacing) {
 // Directions are unit vectors, each one increment counter-clockwise from the previous.
 TEST(ScanPattern, DirectionsAreUnitAndInOrder) {
   for (const FanSpec& fan :
-       {byIncrement(-M_PI, M_PI, 0.0174533), bySamples(-2.0, 2.5, 999),
-        byIncrement(-0.3, 0.3, 0.001), byIncrement(-3 * M_PI, 3 * M_PI, 0.1)}) {
+       {fanByIncrement(-M_PI, M_PI, 0.0174533), fanBySamples(-2.0, 2.5, 999),
+        fanByIncrement(-0.3, 0.3, 0.001), fanByIncrement(-3 * M_PI, 3 * M_PI, 0.1)}) {
     const ScanPattern pattern(fan);
     const auto& d = pattern.directions();
     ASSERT_EQ(static_cast<int>(d.size()), fan.beamCount());
@@ -137,7 +124,7 @@ TEST(ScanPattern, DirectionsAreUnitAndInOrder) {
 
 // planar(): a single ring at elevation exactly 0 (the default, or given explicitly; -0.0 is 0).
 TEST(ScanPattern, Planar) {
-  const FanSpec fan = bySamples(-1, 1, 11);
+  const FanSpec fan = fanBySamples(-1, 1, 11);
   EXPECT_TRUE(ScanPattern(fan).planar());
   EXPECT_TRUE(ScanPattern(fan, {0.0}).planar());
   EXPECT_TRUE(ScanPattern(fan, {-0.0}).planar());
@@ -152,7 +139,7 @@ TEST(ScanPattern, Planar) {
 // Rings are ring-major: beam r * azimuthCount() + i is azimuth i at elevation r, positive up.
 TEST(ScanPattern, RingsAreRingMajor) {
   const std::vector<double> elevations = {-0.2, 0.0, 0.3, M_PI / 2, -M_PI / 2};
-  const FanSpec fan = bySamples(-1.5, 1.5, 7);
+  const FanSpec fan = fanBySamples(-1.5, 1.5, 7);
   const ScanPattern pattern(fan, elevations);
   ASSERT_EQ(pattern.ringCount(), 5);
   ASSERT_EQ(pattern.azimuthCount(), 7);
@@ -173,36 +160,36 @@ TEST(ScanPattern, RingsAreRingMajor) {
 
 // Each invalid fan throws std::invalid_argument naming the field and the value given.
 TEST(FanSpec, ValidateNamesFieldAndValue) {
-  expectFanInvalid(byIncrement(kNan, 1, 0.1), {"angle_min", "nan"});
-  expectFanInvalid(byIncrement(-kInf, 1, 0.1), {"angle_min", "inf"});
-  expectFanInvalid(byIncrement(0, kNan, 0.1), {"angle_max", "nan"});
-  expectFanInvalid(byIncrement(0, kInf, 0.1), {"angle_max", "inf"});
-  expectFanInvalid(byIncrement(1, 1, 0.1), {"angle_max", "angle_min", "1"});
-  expectFanInvalid(byIncrement(1, -2, 0.1), {"angle_max", "angle_min", "-2"});
+  expectFanInvalid(fanByIncrement(kNan, 1, 0.1), {"angle_min", "nan"});
+  expectFanInvalid(fanByIncrement(-kInf, 1, 0.1), {"angle_min", "inf"});
+  expectFanInvalid(fanByIncrement(0, kNan, 0.1), {"angle_max", "nan"});
+  expectFanInvalid(fanByIncrement(0, kInf, 0.1), {"angle_max", "inf"});
+  expectFanInvalid(fanByIncrement(1, 1, 0.1), {"angle_max", "angle_min", "1"});
+  expectFanInvalid(fanByIncrement(1, -2, 0.1), {"angle_max", "angle_min", "-2"});
 
   // Both or neither of angle_increment and samples.
-  FanSpec both = byIncrement(-1, 1, 0.25);
+  FanSpec both = fanByIncrement(-1, 1, 0.25);
   both.samples = 9;
   expectFanInvalid(both, {"angle_increment", "samples", "0.25", "9"});
-  expectFanInvalid(byIncrement(-1, 1, 0), {"angle_increment", "samples"});
+  expectFanInvalid(fanByIncrement(-1, 1, 0), {"angle_increment", "samples"});
 
-  expectFanInvalid(byIncrement(-1, 1, -0.125), {"angle_increment", "-0.125"});
-  expectFanInvalid(byIncrement(-1, 1, kNan), {"angle_increment", "nan"});
-  expectFanInvalid(byIncrement(-1, 1, kInf), {"angle_increment", "inf"});
-  expectFanInvalid(bySamples(-1, 1, 1), {"samples", "1"});
-  expectFanInvalid(bySamples(-1, 1, -4), {"samples", "-4"});
+  expectFanInvalid(fanByIncrement(-1, 1, -0.125), {"angle_increment", "-0.125"});
+  expectFanInvalid(fanByIncrement(-1, 1, kNan), {"angle_increment", "nan"});
+  expectFanInvalid(fanByIncrement(-1, 1, kInf), {"angle_increment", "inf"});
+  expectFanInvalid(fanBySamples(-1, 1, 1), {"samples", "1"});
+  expectFanInvalid(fanBySamples(-1, 1, -4), {"samples", "-4"});
 
   // Too many beams: by increment (the count is in the message) and by samples.
-  expectFanInvalid(byIncrement(0, 1, 1e-8), {"angle_increment", "1e-08", "10000000"});
-  expectFanInvalid(bySamples(0, 1, FanSpec::kMaxBeams + 1), {"samples", "10000001"});
+  expectFanInvalid(fanByIncrement(0, 1, 1e-8), {"angle_increment", "1e-08", "10000000"});
+  expectFanInvalid(fanBySamples(0, 1, FanSpec::kMaxBeams + 1), {"samples", "10000001"});
   // The limit itself is accepted (validate only: no directions are allocated).
-  EXPECT_NO_THROW(bySamples(0, 1, FanSpec::kMaxBeams).validate());
-  EXPECT_NO_THROW(byIncrement(0, 1, 1.0 / (FanSpec::kMaxBeams - 1)).validate());
+  EXPECT_NO_THROW(fanBySamples(0, 1, FanSpec::kMaxBeams).validate());
+  EXPECT_NO_THROW(fanByIncrement(0, 1, 1.0 / (FanSpec::kMaxBeams - 1)).validate());
 }
 
 // Elevations: empty, outside [-pi/2, pi/2] or NaN throw and name the elevation; the bounds pass.
 TEST(ScanPattern, ElevationErrors) {
-  const FanSpec fan = bySamples(-1, 1, 3);
+  const FanSpec fan = fanBySamples(-1, 1, 3);
   auto pattern = [&](std::vector<double> elevations) {
     return invalidMessage([&] { ScanPattern p(fan, elevations); });
   };
@@ -217,7 +204,7 @@ TEST(ScanPattern, ElevationErrors) {
 
 // Azimuths x rings above kMaxBeams is refused before anything is allocated.
 TEST(ScanPattern, TooManyBeamsAcrossRings) {
-  const FanSpec fan = bySamples(-1, 1, 4000000);
+  const FanSpec fan = fanBySamples(-1, 1, 4000000);
   ASSERT_NO_THROW(fan.validate());
   expectMentions(invalidMessage([&] {
                    ScanPattern p(fan, {-0.1, 0.0, 0.1});
