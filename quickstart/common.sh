@@ -18,7 +18,7 @@ APT_PACKAGES=(
   librostest-dev libgtest-dev python3-rostest python3-roslaunch python3-rosmaster python3-rostopic
   python3-rospy python3-tf2-ros python3-sensor-msgs python3-geometry-msgs python3-std-msgs
   rosbash ros-robot-state-publisher
-  libembree-dev libbullet-dev python3-matplotlib
+  libembree-dev libbullet-dev python3-matplotlib catkin-lint
 )
 
 log() { echo "[laser_raycast] $*" >&2; }

@@ -8,6 +8,10 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 install_missing "${APT_PACKAGES[@]}"
+# A downstream package that links every exported library, built beside this one (test/downstream).
+mkdir -p "$WS_DIR/src"
+[ -e "$WS_DIR/src/laser_raycast_downstream_check" ] ||
+  ln -s "$REPO_DIR/test/downstream" "$WS_DIR/src/laser_raycast_downstream_check"
 build_workspace
 source_workspace
 
@@ -25,6 +29,12 @@ status=0
 (cd "$WS_DIR" && catkin_make -j"$JOBS" run_tests >&2) || status=$?
 if [ $status -ne 0 ]; then
   log "building or running the tests failed (catkin_make run_tests exit $status)"
+fi
+
+# The package's CMake and manifest, linted as a catkin package (-W2: notices too).
+if ! (cd "$WS_DIR/src" && catkin_lint -W2 --strict laser_raycast laser_raycast_downstream_check >&2); then
+  log "catkin_lint -W2 found problems (above)"
+  status=1
 fi
 
 summary=$(catkin_test_results --verbose "$WS_DIR/build/test_results") || status=1

@@ -9,8 +9,8 @@
 #include <random>
 #include <stdexcept>
 
-#include "laser_raycast/kinematics.h"
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/kinematics.h"
+#include "laser_raycast/loader/scene_loader.h"
 
 namespace laser_raycast {
 namespace bench {

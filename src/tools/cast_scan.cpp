@@ -15,8 +15,8 @@
 
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/scan_encoder.h"
-#include "laser_raycast/kinematics.h"
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/kinematics.h"
+#include "laser_raycast/loader/scene_loader.h"
 
 namespace {
 

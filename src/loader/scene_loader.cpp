@@ -1,4 +1,4 @@
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/scene_loader.h"
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>

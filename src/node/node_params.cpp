@@ -1,4 +1,4 @@
-#include "laser_raycast/node_params.h"
+#include "laser_raycast/node/node_params.h"
 
 #include <ros/console.h>
 #include <ros/param.h>

@@ -18,7 +18,7 @@
 #include "laser_raycast/core/scan_encoder.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scene.h"
-#include "laser_raycast/node_params.h"
+#include "laser_raycast/node/node_params.h"
 
 namespace laser_raycast {
 

@@ -1,4 +1,4 @@
-#include "laser_raycast/raycast_node.h"
+#include "laser_raycast/node/raycast_node.h"
 
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -12,7 +12,7 @@
 
 #include "laser_raycast/ScanLabels.h"
 #include "laser_raycast/core/pose.h"
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/scene_loader.h"
 
 namespace laser_raycast {
 namespace {

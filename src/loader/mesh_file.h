@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/scene_loader.h"
 
 namespace laser_raycast {
 namespace mesh_file {

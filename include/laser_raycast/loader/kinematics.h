@@ -7,7 +7,7 @@
 #include <string>
 
 #include "laser_raycast/core/scene.h"
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/scene_loader.h"
 
 namespace laser_raycast {
 

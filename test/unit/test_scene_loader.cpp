@@ -19,7 +19,7 @@
 #include <set>
 #include <sstream>
 
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/scene_loader.h"
 #include "shared_data.h"
 
 namespace laser_raycast {

@@ -10,7 +10,7 @@
 #include "laser_raycast/core/scan_encoder.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/triangle.h"
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/scene_loader.h"
 
 namespace laser_raycast {
 

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/scene_loader.h"
 #include "shared_data.h"
 
 namespace {

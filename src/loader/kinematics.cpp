@@ -1,4 +1,4 @@
-#include "laser_raycast/kinematics.h"
+#include "laser_raycast/loader/kinematics.h"
 
 #include <vector>
 

@@ -28,7 +28,7 @@
 #include "laser_raycast/core/bvh.h"
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/core/triangle.h"
-#include "laser_raycast/scene_loader.h"
+#include "laser_raycast/loader/scene_loader.h"
 #include "shared_data.h"
 #include "test_geometry.h"
 

@@ -1,7 +1,7 @@
 // laser_raycast_node: constructs the node, fails fast on a bad configuration, spins.
 #include <ros/ros.h>
 
-#include "laser_raycast/raycast_node.h"
+#include "laser_raycast/node/raycast_node.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "laser_raycast");

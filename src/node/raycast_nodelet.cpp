@@ -5,7 +5,7 @@
 #include <pluginlib/class_list_macros.hpp>
 #include <stdexcept>
 
-#include "laser_raycast/raycast_node.h"
+#include "laser_raycast/node/raycast_node.h"
 
 namespace laser_raycast {
 

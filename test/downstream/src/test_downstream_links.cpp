@@ -1,0 +1,42 @@
+// A downstream package's view of laser_raycast: each exported library is linked through catkin and
+// used once. A library that is installed but not exported fails here at link time ("undefined
+// reference"), as it would in a user's package.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "laser_raycast/core/scan_pattern.h"
+#include "laser_raycast/core/scene.h"
+#include "laser_raycast/loader/kinematics.h"
+#include "laser_raycast/loader/scene_loader.h"
+#include "laser_raycast/node/node_params.h"
+
+TEST(Downstream, UsesTheCore) {
+  laser_raycast::core::FanSpec fan;
+  fan.samples = 5;
+  const laser_raycast::core::ScanPattern pattern(fan);
+  EXPECT_EQ(pattern.size(), 5);
+}
+
+TEST(Downstream, UsesTheLoader) {
+  laser_raycast::GeometrySource source;
+  EXPECT_TRUE(laser_raycast::parseGeometrySource("collision", &source));
+  EXPECT_EQ(source, laser_raycast::GeometrySource::kCollision);
+}
+
+TEST(Downstream, UsesTheKinematics) {
+  const Eigen::Isometry3d pose = laser_raycast::poseFromXyzRpy(1, 2, 3, 0, 0, M_PI / 2);
+  EXPECT_NEAR(pose.translation().y(), 2.0, 1e-12);
+  EXPECT_NEAR(pose.linear()(1, 0), 1.0, 1e-12);
+}
+
+TEST(Downstream, LinksTheNode) {
+  // Reading parameters needs a ROS master; the address is enough to make the linker resolve it.
+  void* volatile address = reinterpret_cast<void*>(&laser_raycast::readNodeParams);
+  EXPECT_NE(address, nullptr);
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
