@@ -9,29 +9,6 @@
 namespace laser_raycast {
 namespace core {
 
-const char* toString(MinRangePolicy policy) {
-  switch (policy) {
-    case MinRangePolicy::kNegInf:
-      return "-inf";
-    case MinRangePolicy::kPassThrough:
-      return "pass_through";
-    case MinRangePolicy::kNan:
-      return "nan";
-  }
-  return "unknown";
-}
-
-bool parseMinRangePolicy(const std::string& name, MinRangePolicy* policy) {
-  for (const MinRangePolicy p :
-       {MinRangePolicy::kNegInf, MinRangePolicy::kPassThrough, MinRangePolicy::kNan}) {
-    if (name == toString(p)) {
-      *policy = p;
-      return true;
-    }
-  }
-  return false;
-}
-
 void EncoderConfig::validate() const {
   std::ostringstream msg;
   if (!(std::isfinite(range_min) && range_min >= 0)) {

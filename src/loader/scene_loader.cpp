@@ -181,27 +181,6 @@ void requirePositive(const char* what, const Eigen::Vector3d& v) {
 
 }  // namespace
 
-const char* toString(GeometrySource source) {
-  switch (source) {
-    case GeometrySource::kVisual:
-      return "visual";
-    case GeometrySource::kCollision:
-      return "collision";
-  }
-  return "unknown";
-}
-
-bool parseGeometrySource(const std::string& name, GeometrySource* source) {
-  if (name == "visual") {
-    *source = GeometrySource::kVisual;
-  } else if (name == "collision") {
-    *source = GeometrySource::kCollision;
-  } else {
-    return false;
-  }
-  return true;
-}
-
 SceneLoader::SceneLoader(PackageResolver resolver) : resolver_(std::move(resolver)) {}
 
 std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,

@@ -262,28 +262,28 @@ bool readNodeParams(const ros::NodeHandle& pnh, NodeParams* p, std::string* erro
       r.fail(name, "'" + frame + "': tf2 frame ids must not start with '/'");
   }
 
-  p->fan.angle_min = r.number("angle_min", -M_PI, "rad");
-  p->fan.angle_max = r.number("angle_max", M_PI, "rad");
+  p->scan.fan.angle_min = r.number("angle_min", -M_PI, "rad");
+  p->scan.fan.angle_max = r.number("angle_max", M_PI, "rad");
   const bool has_increment = r.has("angle_increment"), has_samples = r.has("samples");
-  p->fan.angle_increment = has_increment ? r.number("angle_increment", 0.0, "rad") : 0.0;
-  p->fan.samples = has_samples || !has_increment ? r.integer("samples", 360, "beams") : 0;
+  p->scan.fan.angle_increment = has_increment ? r.number("angle_increment", 0.0, "rad") : 0.0;
+  p->scan.fan.samples = has_samples || !has_increment ? r.integer("samples", 360, "beams") : 0;
   if (has_increment && has_samples) r.fail("samples", "set ~angle_increment or ~samples, not both");
 
-  p->encoder.range_min = r.number("range_min", 0.0, "m");
-  p->encoder.range_max = r.number("range_max", 30.0, "m");
+  p->scan.output.range_min = r.number("range_min", 0.0, "m");
+  p->scan.output.range_max = r.number("range_max", 30.0, "m");
   const std::string policy = r.text("min_range_policy", "-inf");
-  if (!core::parseMinRangePolicy(policy, &p->encoder.min_range_policy)) {
-    r.fail("min_range_policy", "'" + policy + "' is not one of -inf, pass_through, nan");
+  if (!core::parseMinRangePolicy(policy, &p->scan.output.min_range_policy)) {
+    r.fail("min_range_policy", core::kMinRangePolicyNames.notOneOf(policy));
   }
-  p->encoder.noise_stddev = r.number("noise_stddev", 0.0, "m");
+  p->scan.output.noise_stddev = r.number("noise_stddev", 0.0, "m");
   const int seed = r.integer("noise_seed", 0, "");
   if (seed < 0) r.fail("noise_seed", "must be >= 0, got " + std::to_string(seed));
-  p->encoder.noise_seed = static_cast<std::uint64_t>(std::max(seed, 0));
+  p->scan.output.noise_seed = static_cast<std::uint64_t>(std::max(seed, 0));
   const std::string intensity = r.text("intensity", "off");
   if (intensity != "off" && intensity != "reflectivity") {
     r.fail("intensity", "'" + intensity + "' is not one of off, reflectivity");
   }
-  p->encoder.intensity = intensity == "reflectivity";
+  p->scan.output.intensity = intensity == "reflectivity";
   readReflectivity(&r, &p->reflectivity);
   p->default_reflectivity = r.number("default_reflectivity", 1.0, "");
   if (!(std::isfinite(p->default_reflectivity) && p->default_reflectivity >= 0)) {
@@ -301,19 +301,17 @@ bool readNodeParams(const ros::NodeHandle& pnh, NodeParams* p, std::string* erro
 
   const std::string geometry = r.text("geometry", "visual");
   if (!parseGeometrySource(geometry, &p->geometry)) {
-    r.fail("geometry", "'" + geometry + "' is not one of visual, collision");
+    r.fail("geometry", kGeometrySourceNames.notOneOf(geometry));
   }
   p->skip_bad_geometry = r.boolean("skip_bad_geometry", false);
   readModels(&r, &p->models);
   p->ignore_links = r.textList("ignore_links");
 
   const std::string method = r.text("method", "watertight");
-  if (!core::parseTriangleMethod(method, &p->method)) {
-    r.fail(
-        "method",
-        "'" + method + "' is not one of seed_plane, seed_uv, cramer, moller_trumbore, watertight");
+  if (!core::parseTriangleMethod(method, &p->scan.method)) {
+    r.fail("method", core::kTriangleMethodNames.notOneOf(method));
   }
-  p->cull_backfaces = r.boolean("cull_backfaces", false);
+  p->scan.cull_backfaces = r.boolean("cull_backfaces", false);
 
   p->pose_topic = r.text("pose_topic", "");
   p->pose_frame = r.text("pose_frame", "");
@@ -327,8 +325,7 @@ bool readNodeParams(const ros::NodeHandle& pnh, NodeParams* p, std::string* erro
   // Ranges, angles and noise through the core's own validation, which names the field.
   if (r.error().empty()) {
     try {
-      p->fan.validate();
-      p->encoder.validate();
+      p->scan.validate();
     } catch (const std::invalid_argument& e) {
       r.failWith(std::string("bad parameter: ") + e.what());
     }

@@ -66,13 +66,9 @@ bool RaycastNode::init() {
     ROS_FATAL_STREAM(error);
     return false;
   }
-  pattern_ = std::make_unique<core::ScanPattern>(params_.fan);
-  encoder_ = std::make_unique<core::ScanEncoder>(params_.encoder);
-  cast_config_.method = params_.method;
-  cast_config_.cull_backfaces = params_.cull_backfaces;
-  cast_config_.tmin = params_.encoder.castTmin();
-  cast_config_.tmax = params_.encoder.castTmax();
-  cast_config_.compute_incidence = params_.encoder.intensity;
+  pattern_ = std::make_unique<core::ScanPattern>(params_.scan.pattern());
+  encoder_ = std::make_unique<core::ScanEncoder>(params_.scan.output);
+  cast_config_ = params_.scan.castConfig();
   if (!loadScene()) return false;
 
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh_);
@@ -307,8 +303,8 @@ void RaycastNode::onTimer(const ros::TimerEvent&) {
   scan.angle_increment = static_cast<float>(pattern_->angleIncrement());
   scan.time_increment = 0.0f;  // instantaneous: all beams share the stamp
   scan.scan_time = static_cast<float>(1.0 / params_.rate);
-  scan.range_min = static_cast<float>(params_.encoder.range_min);
-  scan.range_max = static_cast<float>(params_.encoder.range_max);
+  scan.range_min = static_cast<float>(params_.scan.output.range_min);
+  scan.range_max = static_cast<float>(params_.scan.output.range_max);
   scan.ranges = encoded_.ranges;
   scan.intensities = encoded_.intensities;
   scan_pub_.publish(scan);

@@ -15,6 +15,7 @@
 
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/kinematics.h"
 #include "laser_raycast/loader/scene_loader.h"
 
@@ -52,10 +53,8 @@ struct Args {
   std::vector<Model> models;
   bool has_sensor = false;
   Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
-  core::FanSpec fan;
-  double range_min = 0.0, range_max = 30.0;
+  core::ScanSpec scan;  // the fan, ranges and method; REP 117 with the default -inf policy
   GeometrySource geometry = GeometrySource::kVisual;
-  core::TriangleMethod method = core::TriangleMethod::kWatertight;
   std::map<std::string, double> joints;
   int repeat = 0;
 };
@@ -130,29 +129,28 @@ Args parseArgs(int argc, char** argv) {
       }
       args.has_sensor = true;
     } else if (flag == "--angle-min") {
-      args.fan.angle_min = parseNumber(flag, next());
+      args.scan.fan.angle_min = parseNumber(flag, next());
     } else if (flag == "--angle-max") {
-      args.fan.angle_max = parseNumber(flag, next());
+      args.scan.fan.angle_max = parseNumber(flag, next());
     } else if (flag == "--samples") {
-      args.fan.samples = parseCount(flag, next());
+      args.scan.fan.samples = parseCount(flag, next());
       has_samples = true;
     } else if (flag == "--angle-increment") {
-      args.fan.angle_increment = parseNumber(flag, next());
+      args.scan.fan.angle_increment = parseNumber(flag, next());
       has_increment = true;
     } else if (flag == "--range-min") {
-      args.range_min = parseNumber(flag, next());
+      args.scan.output.range_min = parseNumber(flag, next());
     } else if (flag == "--range-max") {
-      args.range_max = parseNumber(flag, next());
+      args.scan.output.range_max = parseNumber(flag, next());
     } else if (flag == "--geometry") {
       const std::string name = next();
       if (!laser_raycast::parseGeometrySource(name, &args.geometry)) {
-        throw ArgError("--geometry: '" + name + "' is not visual or collision");
+        throw ArgError("--geometry: " + laser_raycast::kGeometrySourceNames.notOneOf(name));
       }
     } else if (flag == "--method") {
       const std::string name = next();
-      if (!core::parseTriangleMethod(name, &args.method)) {
-        throw ArgError("--method: '" + name +
-                       "' is not one of seed_plane, seed_uv, cramer, moller_trumbore, watertight");
+      if (!core::parseTriangleMethod(name, &args.scan.method)) {
+        throw ArgError("--method: " + core::kTriangleMethodNames.notOneOf(name));
       }
     } else if (flag == "--joint") {
       // One NAME=VALUE per --joint, or several after one --joint.
@@ -178,15 +176,15 @@ Args parseArgs(int argc, char** argv) {
   if (args.models.empty()) throw ArgError("give at least one --urdf");
   if (!args.has_sensor) throw ArgError("--sensor is required");
   if (has_samples && has_increment) throw ArgError("give --samples or --angle-increment, not both");
-  if (!has_samples && !has_increment) args.fan.samples = 360;
+  if (!has_samples && !has_increment) args.scan.fan.samples = 360;
+  if (!(args.scan.output.range_min >= 0)) throw ArgError("--range-min must be >= 0");
+  if (!(args.scan.output.range_max > args.scan.output.range_min))
+    throw ArgError("--range-max must be greater than --range-min");
   try {
-    args.fan.validate();
+    args.scan.validate();
   } catch (const std::invalid_argument& e) {
     throw ArgError(e.what());
   }
-  if (!(args.range_min >= 0)) throw ArgError("--range-min must be >= 0");
-  if (!(args.range_max > args.range_min))
-    throw ArgError("--range-max must be greater than --range-min");
   return args;
 }
 
@@ -269,14 +267,8 @@ int main(int argc, char** argv) {
   }
   const core::FramePoses frame_poses = laser_raycast::framePosesFromLinks(scene, link_poses);
 
-  const core::ScanPattern pattern(args.fan);
-  core::EncoderConfig encoder;
-  encoder.range_min = args.range_min;
-  encoder.range_max = args.range_max;
-  core::CastConfig config;
-  config.method = args.method;
-  config.tmin = encoder.castTmin();
-  config.tmax = encoder.castTmax();
+  const core::ScanPattern pattern = args.scan.pattern();
+  const core::CastConfig config = args.scan.castConfig();
   core::Caster caster;
   const core::ScanResult& result = caster.cast(scene, frame_poses, args.sensor, pattern, config);
 
@@ -297,7 +289,7 @@ int main(int argc, char** argv) {
   std::string out = "index,angle,range,link\n";
   for (int i = 0; i < pattern.size(); ++i) {
     out += std::to_string(i) + "," + formatNumber(pattern.azimuth(i)) + "," +
-           formatNumber(core::classifyRange(result.range[i], encoder)) + ",";
+           formatNumber(core::classifyRange(result.range[i], args.scan.output)) + ",";
     if (result.body[i] >= 0) {
       const std::string& label = scene.labels()[scene.bodies()[result.body[i]].label];
       out += prefixed ? label.substr(label.find('/') + 1) : label;

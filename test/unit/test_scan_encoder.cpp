@@ -12,6 +12,7 @@
 
 #include "expect_invalid.h"
 #include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/scan_spec.h"
 
 using namespace laser_raycast::core;
 using laser_raycast::test::expectMentions;
@@ -81,8 +82,8 @@ TEST(ClassifyRange, ValidOutOfRangeAndNan) {
 }
 
 // A hit closer than range_min: -Inf by default (REP 117: too close), NaN with "nan". With
-// "pass_through" the cast should have started at range_min (castTmin), so such a hit means the
-// caller cast from 0; it is reported as +Inf, never as a valid range.
+// "pass_through" the cast should have started at range_min (ScanSpec::castConfig), so such a hit
+// means the caller cast from 0; it is reported as +Inf, never as a valid range.
 TEST(ClassifyRange, TooClosePolicies) {
   EXPECT_EQ(classifyRange(0.3, encoderConfig(0.5, 10.0)), -kInf);
   EXPECT_EQ(classifyRange(std::nextafter(0.5, 0.0), encoderConfig(0.5, 10.0)), -kInf);
@@ -90,15 +91,6 @@ TEST(ClassifyRange, TooClosePolicies) {
   EXPECT_TRUE(std::isnan(classifyRange(0.3, encoderConfig(0.5, 10.0, MinRangePolicy::kNan))));
   EXPECT_EQ(classifyRange(0.3, encoderConfig(0.5, 10.0, MinRangePolicy::kPassThrough)), kInf);
   EXPECT_EQ(EncoderConfig{}.min_range_policy, MinRangePolicy::kNegInf);  // the default
-}
-
-// The cast interval each policy needs: pass_through casts from range_min, the others from 0 (so
-// that too-close surfaces are seen and reported); all stop at range_max.
-TEST(EncoderConfig, CastInterval) {
-  EXPECT_EQ(encoderConfig(0.5, 12.0, MinRangePolicy::kPassThrough).castTmin(), 0.5);
-  EXPECT_EQ(encoderConfig(0.5, 12.0, MinRangePolicy::kNegInf).castTmin(), 0.0);
-  EXPECT_EQ(encoderConfig(0.5, 12.0, MinRangePolicy::kNan).castTmin(), 0.0);
-  EXPECT_EQ(encoderConfig(0.5, 12.0).castTmax(), 12.0);
 }
 
 TEST(MinRangePolicy, StringRoundTrip) {
@@ -191,7 +183,7 @@ TEST(ScanEncoder, Rep117AndLabels) {
 
 // The policy end to end with the caster: a panel at 0.3 m in front of a wall at 3 m, range_min 0.5.
 // -inf and nan cast from 0 and report the panel as too close; pass_through casts from range_min
-// (castTmin) and reports the wall behind it.
+// (ScanSpec::castConfig) and reports the wall behind it.
 TEST(ScanEncoder, PassThroughShowsTheSurfaceBeyond) {
   Scene scene;
   scene.addFrame("world");
@@ -220,10 +212,10 @@ TEST(ScanEncoder, PassThroughShowsTheSurfaceBeyond) {
   for (const bool fast : {true, false}) {
     for (const MinRangePolicy policy :
          {MinRangePolicy::kNegInf, MinRangePolicy::kNan, MinRangePolicy::kPassThrough}) {
-      const EncoderConfig ec = encoderConfig(0.5, 10.0, policy);
-      CastConfig cc;
-      cc.tmin = ec.castTmin();
-      cc.tmax = ec.castTmax();
+      ScanSpec spec;
+      spec.output = encoderConfig(0.5, 10.0, policy);
+      const EncoderConfig& ec = spec.output;
+      CastConfig cc = spec.castConfig();
       cc.planar_fast_path = fast;
       Caster caster;
       const ScanResult& r = caster.cast(scene, FramePoses::identity(scene),

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/enum_names.h"
 
 namespace laser_raycast {
 namespace core {
@@ -19,8 +20,15 @@ enum class MinRangePolicy {
                  // them
   kNan,          // "nan": the beam reports NaN (erroneous), as some drivers do
 };
-const char* toString(MinRangePolicy policy);
-bool parseMinRangePolicy(const std::string& name, MinRangePolicy* policy);
+inline const EnumNames<MinRangePolicy, 3> kMinRangePolicyNames{{{
+    {MinRangePolicy::kNegInf, "-inf"},
+    {MinRangePolicy::kPassThrough, "pass_through"},
+    {MinRangePolicy::kNan, "nan"},
+}}};
+inline const char* toString(MinRangePolicy policy) { return kMinRangePolicyNames.name(policy); }
+inline bool parseMinRangePolicy(const std::string& name, MinRangePolicy* policy) {
+  return kMinRangePolicyNames.parse(name, policy);
+}
 
 struct EncoderConfig {
   double range_min = 0.0;   // m, >= 0
@@ -33,17 +41,12 @@ struct EncoderConfig {
 
   // Throws std::invalid_argument naming the field and its value.
   void validate() const;
-  // The cast interval the policy needs: [range_min, range_max] for pass_through, else [0,
-  // range_max].
-  double castTmin() const {
-    return min_range_policy == MinRangePolicy::kPassThrough ? range_min : 0.0;
-  }
-  double castTmax() const { return range_max; }
 };
 
 // REP 117 for one noise-free range from the caster: a hit in [range_min, range_max] is itself, a
-// hit closer than range_min follows the policy, no hit is +Inf, NaN stays NaN. Under pass_through the
-// cast starts at range_min (castTmin()), so no closer range comes from it; one passed anyway is +Inf.
+// hit closer than range_min follows the policy, no hit is +Inf, NaN stays NaN. Under pass_through
+// the cast starts at range_min (ScanSpec::castConfig), so no closer range comes from it; one passed
+// anyway is +Inf.
 double classifyRange(double range, const EncoderConfig& config);
 
 struct EncodedScan {
@@ -55,7 +58,6 @@ struct EncodedScan {
 class ScanEncoder {
  public:
   explicit ScanEncoder(const EncoderConfig& config);  // validates
-  const EncoderConfig& config() const { return config_; }
 
   // Valid ranges get N(0, noise_stddev) noise, clamped to [range_min, range_max] so that a valid
   // return stays valid, then are rounded once to float. Noise is drawn afresh on every call.

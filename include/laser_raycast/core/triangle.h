@@ -26,6 +26,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "laser_raycast/core/enum_names.h"
 #include "laser_raycast/core/ray.h"
 
 namespace laser_raycast {
@@ -37,7 +38,6 @@ struct TriangleHitT {
   T u;  // weight of b
   T v;  // weight of c
 };
-using TriangleHit = TriangleHitT<double>;
 
 enum class TriangleMethod { kSeedPlane, kSeedUv, kCramer, kMollerTrumbore, kWatertight };
 
@@ -45,11 +45,19 @@ inline constexpr std::array<TriangleMethod, 5> kAllTriangleMethods = {
     TriangleMethod::kSeedPlane, TriangleMethod::kSeedUv, TriangleMethod::kCramer,
     TriangleMethod::kMollerTrumbore, TriangleMethod::kWatertight};
 
-// The method's name as used by parameters, the CLI and the benchmark: seed_plane, seed_uv, cramer,
-// moller_trumbore, watertight.
-const char* toString(TriangleMethod method);
+// The names parameters, the CLI and the benchmark use.
+inline const EnumNames<TriangleMethod, 5> kTriangleMethodNames{{{
+    {TriangleMethod::kSeedPlane, "seed_plane"},
+    {TriangleMethod::kSeedUv, "seed_uv"},
+    {TriangleMethod::kCramer, "cramer"},
+    {TriangleMethod::kMollerTrumbore, "moller_trumbore"},
+    {TriangleMethod::kWatertight, "watertight"},
+}}};
+inline const char* toString(TriangleMethod method) { return kTriangleMethodNames.name(method); }
 // Parses a name produced by toString(); false for anything else.
-bool parseTriangleMethod(const std::string& name, TriangleMethod* method);
+inline bool parseTriangleMethod(const std::string& name, TriangleMethod* method) {
+  return kTriangleMethodNames.parse(name, method);
+}
 
 template <typename T>
 inline bool isDegenerateTriangle(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {

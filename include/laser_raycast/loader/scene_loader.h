@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "laser_raycast/core/enum_names.h"
 #include "laser_raycast/core/scene.h"
 
 namespace laser_raycast {
@@ -25,8 +26,14 @@ enum class GeometrySource {
   kVisual,  // "visual": each link's visual elements; a link without any uses its collision elements
   kCollision,  // "collision": collision elements only
 };
-const char* toString(GeometrySource source);
-bool parseGeometrySource(const std::string& name, GeometrySource* source);
+inline const core::EnumNames<GeometrySource, 2> kGeometrySourceNames{{{
+    {GeometrySource::kVisual, "visual"},
+    {GeometrySource::kCollision, "collision"},
+}}};
+inline const char* toString(GeometrySource source) { return kGeometrySourceNames.name(source); }
+inline bool parseGeometrySource(const std::string& name, GeometrySource* source) {
+  return kGeometrySourceNames.parse(name, source);
+}
 
 // A bad model: the message names the file, the link and the problem.
 class SceneLoadError : public std::runtime_error {

@@ -7,9 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "laser_raycast/core/scan_encoder.h"
-#include "laser_raycast/core/scan_pattern.h"
-#include "laser_raycast/core/triangle.h"
+#include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/scene_loader.h"
 
 namespace laser_raycast {
@@ -27,18 +25,15 @@ struct ModelSource {
 struct NodeParams {
   std::string frame_id = "laser";   // sensor frame; header.frame_id of the scans
   std::string fixed_frame = "map";  // frame the link and sensor poses are looked up in
-  core::FanSpec fan;                // angle_min, angle_max, angle_increment or samples
-  core::EncoderConfig encoder;      // range_min, range_max, min_range_policy, noise, intensity
-  double rate = 10.0;               // Hz
-  double tf_timeout = 0.1;          // s, longest wait for the transforms of one scan
+  core::ScanSpec scan;  // beams, range limits, min-range policy, noise, intensity, triangle test
+  double rate = 10.0;   // Hz
+  double tf_timeout = 0.1;  // s, longest wait for the transforms of one scan
   GeometrySource geometry = GeometrySource::kVisual;
   bool skip_bad_geometry = false;
   std::vector<ModelSource> models;
   std::vector<std::string> ignore_links;
   std::map<std::string, double> reflectivity;  // link name (with TF prefix) -> reflectivity
   double default_reflectivity = 1.0;
-  core::TriangleMethod method = core::TriangleMethod::kWatertight;
-  bool cull_backfaces = false;
   std::string pose_topic;  // empty: the sensor pose comes from TF
   std::string pose_frame;  // frame whose pose pose_topic gives; empty: frame_id
 };
