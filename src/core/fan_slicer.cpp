@@ -88,15 +88,18 @@ void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, cons
     if (cull_backfaces) front = rot * (v[1] - v[0]).cross(v[2] - v[0]);
 
     // The beams that can see the segment: the shorter arc between its endpoints' bearings, widened
-    // for their approximation (twice the error each side also covers a tiny sweep whose sign the
-    // approximation flipped). A segment passing beside the sensor, within the error of half a
-    // turn, could be either arc: then every beam is tried.
+    // by one bearing error each side. Each true bearing lies within kBearingError of its
+    // approximation, so the arc from the lower approximation minus the error to the higher plus the
+    // error holds the true arc, also when the approximation flipped the sign of a tiny sweep (the
+    // window spans both approximations either way). The shorter arc is the true one unless the
+    // sweep is within two errors of half a turn (a segment passing beside the sensor): then every
+    // beam is tried.
     const double bearing_p = approxAtan2(p.y(), p.x());
     const double bearing_q = approxAtan2(q.y(), q.x());
     double sweep = bearing_q - bearing_p;
     if (sweep > M_PI) sweep -= 2 * M_PI;
     if (sweep < -M_PI) sweep += 2 * M_PI;
-    const double pad = 4 * kBearingError;
+    const double pad = kBearingError;
     const bool ambiguous = std::abs(sweep) > M_PI - 2 * pad;
     const double start =
         ambiguous ? 0.0 : wrapToTurn((sweep >= 0 ? bearing_p : bearing_q) - pad - fan.angleMin());
@@ -125,6 +128,7 @@ void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, cons
         range[i] = t;
         (*buffer.body)[i] = body_index;
         (*buffer.triangle)[i] = static_cast<int>(ids[slot]);
+        if (buffer.normal) (*buffer.normal)[i] = rot * mesh.normal(ids[slot]);
       }
     });
   };

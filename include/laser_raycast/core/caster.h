@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "laser_raycast/core/scan_pattern.h"
@@ -39,8 +40,10 @@ struct ScanResult {
   std::vector<double> range;  // m; +inf: no hit in [tmin, tmax]; NaN: the beam could not be cast
   std::vector<int> body;      // index of the body hit, -1 for none
   std::vector<int> triangle;  // the triangle hit on a mesh body, -1 for a primitive or no hit
-  std::vector<double> cos_incidence;  // |cos| of the beam's angle to the surface normal (0 if no
-                                      // hit); filled only with CastConfig::compute_incidence
+  // Filled only with CastConfig::compute_incidence (else empty):
+  std::vector<Eigen::Vector3d> normal;  // unit normal at the hit, sensor frame (zero if no hit):
+                                        // a mesh triangle's front normal, a primitive's outward one
+  std::vector<double> cos_incidence;    // |cos| of the beam's angle to that normal (0 if no hit)
   CastStats stats;
 };
 
@@ -55,7 +58,7 @@ class Caster {
                          const CastConfig& config);
 
   // Drops the remembered inputs, so that the next cast() computes even if nothing moved (timing).
-  void forget() { has_previous_ = false; }
+  void forget() { previous_.reset(); }
 
   // A body prepared for this scan: its pose relative to the sensor and its culling data.
   struct ActiveBody {
@@ -74,21 +77,31 @@ class Caster {
   };
 
  private:
-  bool unchanged(const Scene& scene, const std::vector<Eigen::Isometry3d>& sensor_from_frame,
-                 const std::vector<char>& valid, const ScanPattern& pattern,
-                 const CastConfig& config) const;
+  // What a result was computed from: if all of it is equal, the result is too.
+  struct ReuseKey {
+    std::uint64_t scene_version = 0;
+    CastConfig config;
+    double angle_min = 0, angle_increment = 0;
+    int azimuths = 0;
+    std::vector<double> elevations;
+    std::vector<Eigen::Isometry3d> sensor_from_frame;  // meaningful where valid
+    std::vector<char> valid;
+    bool operator==(const ReuseKey& o) const;
+  };
+
+  // The stages of cast(), in order.
+  ReuseKey relativeInputs(const Scene& scene, const FramePoses& poses,
+                          const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
+                          const CastConfig& config) const;
+  void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals);
+  void prepareBodies(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,
+                     const CastConfig& config);
+  void castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config);
+  void computeIncidence(const ScanPattern& pattern);
 
   ScanResult result_;
   std::vector<ActiveBody> active_;
-  // What the previous result was computed from.
-  bool has_previous_ = false;
-  std::uint64_t previous_scene_ = 0;
-  double previous_angle_min_ = 0, previous_increment_ = 0;
-  int previous_azimuths_ = 0;
-  std::vector<double> previous_elevations_;
-  CastConfig previous_config_;
-  std::vector<Eigen::Isometry3d> previous_relative_;
-  std::vector<char> previous_valid_;
+  std::optional<ReuseKey> previous_;  // the inputs of result_, if it is complete
 };
 
 }  // namespace core

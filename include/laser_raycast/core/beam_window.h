@@ -1,0 +1,107 @@
+// Which beams of a scan pattern can reach a thing: the azimuth and elevation windows of a bounding
+// sphere or a segment as seen from the sensor, and the beam index ranges inside an azimuth window.
+// Every window here is conservative (it may hold beams that miss; the exact tests decide), so these
+// functions only decide how much work is done, never a range.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "laser_raycast/core/scan_pattern.h"
+
+namespace laser_raycast {
+namespace core {
+
+// Relative slack for window tests, which round a few times: a thing is left out only if it is out
+// by more than this fraction of the magnitudes compared. Not an absolute epsilon.
+inline constexpr double kWindowSlack = 8 * std::numeric_limits<double>::epsilon();
+
+// Beam index ranges of a fan that may see the angular interval [start, start + width] (rad, start
+// measured from angle_min, width in [0, 2 pi]). Padded by one beam each side, which absorbs the
+// rounding of the index arithmetic. Calls f(first, last) for each index range (more than one when
+// the fan spans more than a turn); the ranges are increasing and disjoint, so no beam is visited
+// twice even when the padding of a coarse fan makes consecutive turns' windows overlap.
+template <class F>
+void forEachBeamRange(const ScanPattern& fan, double start, double width, F&& f) {
+  const double inc = fan.angleIncrement();
+  const int n = fan.azimuthCount();
+  const double span = (n - 1) * inc;
+  int next = 0;  // the first beam not yet visited
+  for (int turn = -1;; ++turn) {
+    const double lo = start + turn * 2 * M_PI;
+    const double hi = lo + width;
+    if (lo > span + inc) break;
+    if (hi < -inc) continue;
+    const int first = std::max(next, static_cast<int>(std::ceil(lo / inc)) - 1);
+    const int last = std::min(n - 1, static_cast<int>(std::floor(hi / inc)) + 1);
+    if (first <= last) {
+      f(first, last);
+      next = last + 1;
+    }
+  }
+}
+
+// atan2(y, x) to within kBearingError rad, much cheaper than std::atan2, for windows only. The
+// polynomial is Abramowitz and Stegun's 4.4.49 (Handbook of Mathematical Functions, 1964): atan(a)
+// for a in [0, 1] with an error of at most 1e-5 rad; the other octants follow by symmetry.
+// kBearingError is twice that, which leaves room for the rounding of the division and the octant
+// reflections (a few ulps of pi).
+inline constexpr double kBearingError = 2e-5;
+inline double approxAtan2(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double big = std::max(ax, ay);
+  if (!(big > 0)) return 0;
+  const double a = std::min(ax, ay) / big;
+  const double z = a * a;
+  double r =
+      a * (0.9998660 + z * (-0.3302995 + z * (0.1801410 + z * (-0.0851330 + z * 0.0208351))));
+  if (ay > ax) r = M_PI / 2 - r;
+  if (x < 0) r = M_PI - r;
+  return y < 0 ? -r : r;
+}
+
+// angle wrapped into [0, 2 pi).
+inline double wrapToTurn(double angle) {
+  double a = angle - 2 * M_PI * std::floor(angle / (2 * M_PI));
+  return a < 2 * M_PI ? a : 0.0;
+}
+
+// The azimuth interval that a sphere at `center` (sensor frame) can occupy, as forEachBeamRange
+// takes it: start measured from angle_min in [0, 2 pi), width less than pi. False if it spans half
+// a turn or more, or surrounds the sensor's z axis: every azimuth. Conservative: the half-width is
+// tan(asin(r / rho)) = r / sqrt(rho^2 - r^2) (cheaper than asin, and never smaller), widened by the
+// bearing's error (twice: once for the centre's bearing, once more as margin for the rounding of
+// the half-width).
+inline bool azimuthWindow(const Eigen::Vector3d& center, double radius, double angle_min,
+                          double* start, double* width) {
+  const double rho2 = center.x() * center.x() + center.y() * center.y();
+  const double r = radius * (1 + kWindowSlack);
+  if (!(rho2 > r * r)) return false;
+  const double half = r / std::sqrt(rho2 - r * r) * (1 + kWindowSlack) + 2 * kBearingError;
+  if (!(half < M_PI / 2)) return false;
+  *start = wrapToTurn(approxAtan2(center.y(), center.x()) - half - angle_min);
+  *width = 2 * half;
+  return true;
+}
+
+// The elevation interval (rad) that a sphere at `center` (sensor frame) can occupy; all of
+// [-pi/2, pi/2] if it contains the sensor. Widened for the rounding of asin and its arguments:
+// relatively, and by kWindowSlack rad, which is relative too since elevations are of order 1.
+inline void elevationWindow(const Eigen::Vector3d& center, double radius, double* lo, double* hi) {
+  const double dist = center.norm();
+  if (!(dist > radius * (1 + kWindowSlack))) {
+    *lo = -M_PI / 2;
+    *hi = M_PI / 2;
+    return;
+  }
+  const double half =
+      std::asin(std::min(1.0, radius * (1 + kWindowSlack) / dist)) * (1 + kWindowSlack);
+  const double middle = std::asin(std::max(-1.0, std::min(1.0, center.z() / dist)));
+  *lo = middle - half - kWindowSlack;
+  *hi = middle + half + kWindowSlack;
+}
+
+}  // namespace core
+}  // namespace laser_raycast
