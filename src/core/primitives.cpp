@@ -157,28 +157,6 @@ std::optional<PrimitiveHit> intersect(const Ray& ray, const Cylinder& cylinder) 
   return nearest.hit;
 }
 
-Aabb bounds(const Box& box) {
-  Aabb b;
-  b.lo = -box.size * 0.5;
-  b.hi = box.size * 0.5;
-  return b;
-}
-
-Aabb bounds(const Cylinder& cylinder) {
-  const Eigen::Vector3d half(cylinder.radius, cylinder.radius, cylinder.length * 0.5);
-  Aabb b;
-  b.lo = -half;
-  b.hi = half;
-  return b;
-}
-
-Aabb bounds(const Sphere& sphere) {
-  Aabb b;
-  b.lo = Eigen::Vector3d::Constant(-sphere.radius);
-  b.hi = Eigen::Vector3d::Constant(sphere.radius);
-  return b;
-}
-
 void validate(const Box& box) {
   requirePositive("box size x", box.size.x());
   requirePositive("box size y", box.size.y());

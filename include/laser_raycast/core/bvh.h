@@ -34,7 +34,6 @@ struct MeshHitT {
   T u, v;                  // barycentric weights of the triangle's second and third vertex
   std::uint32_t triangle;  // index into the mesh's triangle list
 };
-using MeshHit = MeshHitT<double>;
 
 template <typename T>
 class BvhT {

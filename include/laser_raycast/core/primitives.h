@@ -5,7 +5,6 @@
 #include <Eigen/Geometry>
 #include <optional>
 
-#include "laser_raycast/core/aabb.h"
 #include "laser_raycast/core/ray.h"
 
 namespace laser_raycast {
@@ -34,10 +33,6 @@ struct PrimitiveHit {
 std::optional<PrimitiveHit> intersect(const Ray& ray, const Box& box);
 std::optional<PrimitiveHit> intersect(const Ray& ray, const Cylinder& cylinder);
 std::optional<PrimitiveHit> intersect(const Ray& ray, const Sphere& sphere);
-
-Aabb bounds(const Box& box);
-Aabb bounds(const Cylinder& cylinder);
-Aabb bounds(const Sphere& sphere);
 
 // Throw std::invalid_argument naming the dimension and its value unless every size is finite and >
 // 0.

@@ -27,6 +27,10 @@ struct FanSpec {
   void validate() const;
   int beamCount() const;     // N (after validate())
   double increment() const;  // the spacing actually used
+  // At most this many beams in one scan (over all rings). It bounds what one scan allocates (about
+  // 60 bytes a beam across the pattern, the cast result and the message: 0.6 GB here), so that a
+  // slip such as angle_increment 1e-9 is refused with a message instead of exhausting memory. Real
+  // sensors stay far below it (a 128-ring lidar at 2048 azimuths has 262,144 beams).
   static constexpr int kMaxBeams = 10000000;
 };
 
