@@ -12,6 +12,7 @@
 #include <limits>
 #include <mutex>
 
+namespace laser_raycast_test {
 namespace {
 
 constexpr double kTolerance = 1e-5;  // m
@@ -117,6 +118,7 @@ TEST_F(PoseTopicTest, PoseStampedGivesTheLaserPoseAndBadPosesAreIgnored) {
 }
 
 }  // namespace
+}  // namespace laser_raycast_test
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);

@@ -11,6 +11,7 @@
 #include <limits>
 #include <mutex>
 
+namespace laser_raycast_test {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -240,11 +241,12 @@ TEST_F(NodeScanTest, IntensityReflectivityAndIgnoredLinks) {
 }
 
 }  // namespace
+}  // namespace laser_raycast_test
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_node_scan");
-  World shared;
-  world = &shared;
+  laser_raycast_test::World shared;
+  laser_raycast_test::world = &shared;
   return RUN_ALL_TESTS();
 }

@@ -12,15 +12,15 @@
 
 #include "run_command.h"
 
+namespace laser_raycast_test {
 namespace {
 
-using NodeRun = laser_raycast_test::CommandResult;
+using NodeRun = CommandResult;
 
 // Runs the node with the given arguments for at most `seconds` (status 124: it was still running).
 NodeRun runNode(const std::string& args, int seconds = 20) {
-  return laser_raycast_test::runCommand("timeout " + std::to_string(seconds) +
-                                        " rosrun laser_raycast laser_raycast_node " + args +
-                                        " 2>&1");
+  return runCommand("timeout " + std::to_string(seconds) +
+                    " rosrun laser_raycast laser_raycast_node " + args + " 2>&1");
 }
 
 std::string data(const std::string& file) {
@@ -120,6 +120,7 @@ TEST(NodeStartup, SkipBadGeometryStartsWithAWarning) {
 }
 
 }  // namespace
+}  // namespace laser_raycast_test
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);

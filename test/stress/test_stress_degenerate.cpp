@@ -16,11 +16,9 @@
 #include "laser_raycast/core/mesh.h"
 #include "stress_report.h"
 
-namespace laser_raycast {
-namespace stress {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
 using core::Vec3;
 using Eigen::Vector3d;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -39,17 +37,15 @@ constexpr double kTinyScale = 1e-155;
 // line by rounding, so that triangle is a needle of area ~1e-17 rather than zero. The tiny one is
 // well shaped but ~1e-155 m across, so its edge functions are subnormal and 1 / det overflows.
 std::array<Vector3d, 3> degenerate(Kind kind, std::mt19937& rng) {
-  const auto dyadic = [&] {
-    return Vector3d((lt::uniformInCube(rng, 1.0) * 64).array().round() / 64);
-  };
+  const auto dyadic = [&] { return Vector3d((uniformInCube(rng, 1.0) * 64).array().round() / 64); };
   std::array<Vector3d, 3> v;
   switch (kind) {
     case kRepeated:
-      v = {lt::uniformInCube(rng, 1.0), Vector3d::Zero(), lt::uniformInCube(rng, 1.0)};
+      v = {uniformInCube(rng, 1.0), Vector3d::Zero(), uniformInCube(rng, 1.0)};
       v[1] = v[0];
       break;
     case kAllEqual:
-      v[0] = v[1] = v[2] = lt::uniformInCube(rng, 1.0);
+      v[0] = v[1] = v[2] = uniformInCube(rng, 1.0);
       break;
     case kCollinearExact:
       v[0] = dyadic();
@@ -57,14 +53,14 @@ std::array<Vector3d, 3> degenerate(Kind kind, std::mt19937& rng) {
       v[1] = v[0] + 0.5 * (v[2] - v[0]);
       break;
     case kCollinearRounded:
-      v[0] = lt::uniformInCube(rng, 1.0);
-      v[2] = lt::uniformInCube(rng, 1.0);
+      v[0] = uniformInCube(rng, 1.0);
+      v[2] = uniformInCube(rng, 1.0);
       v[1] = v[0] + (v[2] - v[0]) / 3.0;
       break;
     default: {
-      const Eigen::Isometry3d pose = lt::randomPose(rng, 0.0);
+      const Eigen::Isometry3d pose = randomPose(rng, 0.0);
       for (int k = 0; k < 3; ++k) {
-        const double a = 2 * M_PI * k / 3 + lt::uniform(rng, -0.3, 0.3);
+        const double a = 2 * M_PI * k / 3 + uniform(rng, -0.3, 0.3);
         v[k] = kTinyScale * (pose * Vector3d(std::cos(a), std::sin(a), 0));
       }
     }
@@ -86,7 +82,7 @@ void castDegenerate(Kind kind, const std::array<Vector3d, 3>& tri, std::mt19937&
   std::vector<Vec3<T>> targets;
   if (kind == kTiny) {
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2d uv = 0.1 * Eigen::Vector2d::Ones() + 0.7 * lt::randomBarycentrics(rng);
+      const Eigen::Vector2d uv = 0.1 * Eigen::Vector2d::Ones() + 0.7 * randomBarycentrics(rng);
       targets.push_back(a + T(uv.x()) * (b - a) + T(uv.y()) * (c - a));
     }
   } else {
@@ -95,8 +91,7 @@ void castDegenerate(Kind kind, const std::array<Vector3d, 3>& tri, std::mt19937&
   const double scale = kind == kTiny ? kTinyScale : 1.0;
   for (const Vec3<T>& target : targets) {
     core::RayT<T> ray;
-    ray.origin =
-        target + (scale * lt::uniform(rng, 0.5, 2.0) * lt::randomUnitVector(rng)).cast<T>();
+    ray.origin = target + (scale * uniform(rng, 0.5, 2.0) * randomUnitVector(rng)).cast<T>();
     ray.dir = target - ray.origin;
     const auto hit = core::intersectTriangle<M>(ray, a, b, c);
     ++tally->rays;
@@ -176,7 +171,7 @@ TEST(StressDegenerate, WatertightTinyTriangleHitIsFinite) {
 // and no NaN or Inf range (the room around them is closed, so every beam hits something).
 TEST(StressDegenerate, ZeroAreaTrianglesThroughBvhAndCaster) {
   std::mt19937 rng(4401);
-  lt::TriMesh cloud;
+  TriMesh cloud;
   std::vector<char> zero_area;
   for (int n = 0; n < 400; ++n) {
     const Kind kind = static_cast<Kind>(n % 4);
@@ -200,7 +195,7 @@ TEST(StressDegenerate, ZeroAreaTrianglesThroughBvhAndCaster) {
           Vector3d((cloud.vertices[tri[0]] + cloud.vertices[tri[1]] + cloud.vertices[tri[2]]) /
                    3)}) {
       core::Ray ray;
-      ray.origin = target + lt::uniform(rng, 0.5, 2.0) * lt::randomUnitVector(rng);
+      ray.origin = target + uniform(rng, 0.5, 2.0) * randomUnitVector(rng);
       ray.dir = target - ray.origin;
       const auto hit = mesh->bvh().closestHit<TriangleMethod::kWatertight>(ray);
       ++bvh_rays;
@@ -214,7 +209,7 @@ TEST(StressDegenerate, ZeroAreaTrianglesThroughBvhAndCaster) {
   scene.addLabel("thing");
   core::Body room, thing;
   room.frame = thing.frame = scene.addFrame("world");
-  const lt::TriMesh room_mesh = lt::makeBoxRoom(Vector3d(8, 6, 3), 2);
+  const TriMesh room_mesh = makeBoxRoom(Vector3d(8, 6, 3), 2);
   room.shape = std::make_shared<const core::Mesh>(room_mesh.vertices, room_mesh.triangles);
   thing.shape = mesh;
   scene.addBody(room);
@@ -225,8 +220,7 @@ TEST(StressDegenerate, ZeroAreaTrianglesThroughBvhAndCaster) {
   long beams = 0, non_finite = 0, on_zero_area = 0;
   for (int s = 0; s < 4; ++s) {
     Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
-    sensor.translation() =
-        lt::uniformInBox(rng, Vector3d(-0.5, -0.5, -0.3), Vector3d(0.5, 0.5, 0.3));
+    sensor.translation() = uniformInBox(rng, Vector3d(-0.5, -0.5, -0.3), Vector3d(0.5, 0.5, 0.3));
     for (const core::ScanPattern* pattern : {&planar, &rings}) {
       for (const bool fast : {true, false}) {
         if (!pattern->planar() && !fast) continue;
@@ -258,5 +252,4 @@ TEST(StressDegenerate, ZeroAreaTrianglesThroughBvhAndCaster) {
 }
 
 }  // namespace
-}  // namespace stress
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

@@ -18,11 +18,9 @@
 #include "laser_raycast/core/pose.h"
 #include "stress_report.h"
 
-namespace laser_raycast {
-namespace stress {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
 using Eigen::Vector3d;
 
 // ---------------------------------------------------------------------------------------------------
@@ -30,8 +28,8 @@ using Eigen::Vector3d;
 
 // A closed prism over a polygon star-shaped about the z axis, with rows of vertices at zs and caps
 // fanned to the axis.
-lt::TriMesh prism(const std::vector<Eigen::Vector2d>& polygon, const std::vector<double>& zs) {
-  lt::TriMesh m;
+TriMesh prism(const std::vector<Eigen::Vector2d>& polygon, const std::vector<double>& zs) {
+  TriMesh m;
   const auto n = static_cast<std::uint32_t>(polygon.size());
   for (const double z : zs) {
     for (const auto& p : polygon) m.vertices.emplace_back(p.x(), p.y(), z);
@@ -50,7 +48,7 @@ lt::TriMesh prism(const std::vector<Eigen::Vector2d>& polygon, const std::vector
     const auto c = static_cast<std::uint32_t>(m.vertices.size() - 1);
     for (std::uint32_t i = 0; i < n; ++i) m.triangles.push_back({c, at(row, i + 1), at(row, i)});
   }
-  lt::orientOutwards(&m, Vector3d(0, 0, 0.5 * (zs.front() + zs.back())));
+  orientOutwards(&m, Vector3d(0, 0, 0.5 * (zs.front() + zs.back())));
   return m;
 }
 
@@ -64,7 +62,7 @@ core::ScanPattern fan(double angle_min, double span, int samples) {
 
 // A closed mesh and sensor poses inside it whose scan plane runs through a ring of its vertices.
 struct FanCase {
-  lt::TriMesh mesh;
+  TriMesh mesh;
   std::vector<Eigen::Isometry3d> sensors;
   std::vector<core::ScanPattern> patterns;  // one per sensor
 };
@@ -172,17 +170,15 @@ TEST(StressFans, PlanarFansThroughVertexRings) {
   std::mt19937 rng(1201);
   const std::vector<int> samples = {360, 720, 1000, 1441};
   std::vector<FanCase> cases;
-  FanCase sphere{lt::transformed(lt::makeIcosphere(3), 2.0, Eigen::Isometry3d::Identity()), {}, {}};
-  FanCase room{lt::makeBoxRoom(Vector3d(4, 3, 2.5), 4), {}, {}};
+  FanCase sphere{transformed(makeIcosphere(3), 2.0, Eigen::Isometry3d::Identity()), {}, {}};
+  FanCase room{makeBoxRoom(Vector3d(4, 3, 2.5), 4), {}, {}};
   for (int s = 0; s < 8; ++s) {
-    const double a0 = s % 2 ? -M_PI : lt::uniform(rng, -7, 7);
-    sphere.sensors.push_back(
-        yawPose(Vector3d(lt::uniform(rng, -0.7, 0.7), lt::uniform(rng, -0.7, 0.7), 0),
-                lt::uniform(rng, -4, 4)));
+    const double a0 = s % 2 ? -M_PI : uniform(rng, -7, 7);
+    sphere.sensors.push_back(yawPose(Vector3d(uniform(rng, -0.7, 0.7), uniform(rng, -0.7, 0.7), 0),
+                                     uniform(rng, -4, 4)));
     sphere.patterns.push_back(fan(a0, 2 * M_PI, samples[s % samples.size()]));
-    room.sensors.push_back(
-        yawPose(Vector3d(lt::uniform(rng, -1.8, 1.8), lt::uniform(rng, -1.3, 1.3), 0),
-                lt::uniform(rng, -4, 4)));
+    room.sensors.push_back(yawPose(Vector3d(uniform(rng, -1.8, 1.8), uniform(rng, -1.3, 1.3), 0),
+                                   uniform(rng, -4, 4)));
     room.patterns.push_back(fan(a0, 2 * M_PI, samples[(s + 1) % samples.size()]));
   }
   cases.push_back(std::move(sphere));
@@ -220,7 +216,7 @@ TEST(StressFans, PlanarFansThroughVertexRings) {
 TEST(StressFans, PlanarFansThroughRealMeshVertices) {
   REQUIRE_SHARED_DATA();
   std::mt19937 rng(1301);
-  const lt::TriMesh mesh = loadSharedMesh("hexagon.dae", 0.8);
+  const TriMesh mesh = loadSharedMesh("hexagon.dae", 0.8);
   std::vector<Vector3d> top, bottom;
   core::Aabb box;
   for (const Vector3d& v : mesh.vertices) box.grow(v);
@@ -246,11 +242,11 @@ TEST(StressFans, PlanarFansThroughRealMeshVertices) {
     r.col(2) = z;
     for (int s = 0; s < 3; ++s) {
       Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
-      sensor.linear() = r * Eigen::AngleAxisd(lt::uniform(rng, -4, 4), Vector3d::UnitZ());
-      sensor.translation() = centroid + r.col(0) * lt::uniform(rng, -0.2, 0.2) +
-                             r.col(1) * lt::uniform(rng, -0.2, 0.2);
+      sensor.linear() = r * Eigen::AngleAxisd(uniform(rng, -4, 4), Vector3d::UnitZ());
+      sensor.translation() =
+          centroid + r.col(0) * uniform(rng, -0.2, 0.2) + r.col(1) * uniform(rng, -0.2, 0.2);
       c.sensors.push_back(sensor);
-      c.patterns.push_back(fan(lt::uniform(rng, -4, 4), 2 * M_PI, 720 + 361 * s));
+      c.patterns.push_back(fan(uniform(rng, -4, 4), 2 * M_PI, 720 + 361 * s));
     }
   }
   const auto tallies = runFans({c});
@@ -261,5 +257,4 @@ TEST(StressFans, PlanarFansThroughRealMeshVertices) {
 }
 
 }  // namespace
-}  // namespace stress
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

@@ -36,11 +36,9 @@
 #include "laser_raycast/core/bvh.h"
 #include "stress_report.h"
 
-namespace laser_raycast {
-namespace stress {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
 using L = long double;
 using Vec3L = Eigen::Matrix<L, 3, 1>;
 using Eigen::Vector3d;
@@ -134,19 +132,19 @@ GrazingGeometry grazing(std::mt19937& rng, const Eigen::Isometry3d& frame, doubl
   const Eigen::Matrix<L, 3, 3> r = frame.linear().cast<L>();
   const Vec3L shift = frame.translation().cast<L>();
   Vec3L local[3];
-  L angle = lt::uniform(rng, 0, 2 * M_PI);
+  L angle = uniform(rng, 0, 2 * M_PI);
   for (auto& p : local) {
-    const L radius = lt::uniform(rng, 0.6, 1.0);
+    const L radius = uniform(rng, 0.6, 1.0);
     p = Vec3L(radius * std::cos(angle), radius * std::sin(angle), 0);
-    angle += lt::uniform(rng, 1.5, 2.5);
+    angle += uniform(rng, 1.5, 2.5);
   }
   const Vec3L target = (1 - target_uv.x() - target_uv.y()) * local[0] + target_uv.x() * local[1] +
                        target_uv.y() * local[2];
-  const L phi = lt::uniform(rng, 0, 2 * M_PI);
-  const L side = lt::uniform(rng, 0, 1) < 0.5 ? -1 : 1;
+  const L phi = uniform(rng, 0, 2 * M_PI);
+  const L side = uniform(rng, 0, 1) < 0.5 ? -1 : 1;
   const Vec3L d(std::cos(L(theta)) * std::cos(phi), std::cos(L(theta)) * std::sin(phi),
                 side * std::sin(L(theta)));
-  const Vec3L o = target - L(lt::uniform(rng, 0.5, 2.0)) * d;
+  const Vec3L o = target - L(uniform(rng, 0.5, 2.0)) * d;
   return {r * local[0] + shift, r * local[1] + shift, r * local[2] + shift, r * o + shift, r * d};
 }
 
@@ -155,11 +153,11 @@ GrazingGeometry grazing(std::mt19937& rng, const Eigen::Isometry3d& frame, doubl
 Eigen::Vector2d targetBarycentrics(std::mt19937& rng, bool inside) {
   if (inside) {
     for (;;) {
-      const Eigen::Vector2d uv = lt::randomBarycentrics(rng);
+      const Eigen::Vector2d uv = randomBarycentrics(rng);
       if (std::min({1 - uv.x() - uv.y(), uv.x(), uv.y()}) >= 0.1) return uv;
     }
   }
-  const double negative = lt::uniform(rng, -0.5, -0.1), other = lt::uniform(rng, 0.2, 0.8);
+  const double negative = uniform(rng, -0.5, -0.1), other = uniform(rng, 0.2, 0.8);
   switch (std::uniform_int_distribution<int>(0, 2)(rng)) {
     case 0:
       return Eigen::Vector2d(negative, other);
@@ -184,7 +182,7 @@ TEST(StressGrazing, SingleTrianglesDecideAndBoundT) {
   for (int k = 1; k <= kMaxK; ++k) {
     const double theta = std::pow(10.0, -k);
     for (int trial = 0; trial < 1000; ++trial) {
-      const Eigen::Isometry3d frame = lt::randomPose(rng, 2.0);
+      const Eigen::Isometry3d frame = randomPose(rng, 2.0);
       const GrazingGeometry g = grazing(rng, frame, theta, targetBarycentrics(rng, trial % 2 == 0));
       for (std::size_t vi = 0; vi < variants().size(); ++vi) {
         dispatchVariant(variants()[vi], [&](auto m, auto x) {
@@ -255,7 +253,7 @@ TEST(StressGrazing, SingleTrianglesDecideAndBoundT) {
 TEST(StressGrazing, BvhFloorHitsWithBoundedT) {
   std::mt19937 rng(3101);
   const int cells = 16;
-  lt::TriMesh floor;
+  TriMesh floor;
   for (int i = 0; i <= cells; ++i) {
     for (int j = 0; j <= cells; ++j) {
       floor.vertices.emplace_back(-1 + 2.0 * i / cells, -1 + 2.0 * j / cells, 0);
@@ -271,11 +269,11 @@ TEST(StressGrazing, BvhFloorHitsWithBoundedT) {
     }
   }
   const std::vector<Eigen::Isometry3d> poses = {Eigen::Isometry3d::Identity(),
-                                                lt::randomPose(rng, 3.0)};
+                                                randomPose(rng, 3.0)};
   std::vector<std::vector<GrazingTally>> tallies(variants().size(),
                                                  std::vector<GrazingTally>(kMaxK + 1));
   for (const Eigen::Isometry3d& pose : poses) {
-    const lt::TriMesh mesh = lt::transformed(floor, 1.0, pose);
+    const TriMesh mesh = transformed(floor, 1.0, pose);
     const core::Bvh bvh = core::Bvh::build(mesh.vertices, mesh.triangles);
     const core::BvhF bvh_f = core::BvhF::build(mesh.vertices, mesh.triangles);
     for (int k = 1; k <= kMaxK; ++k) {
@@ -287,15 +285,15 @@ TEST(StressGrazing, BvhFloorHitsWithBoundedT) {
         const auto& tri = floor.triangles[tri_index];
         Eigen::Vector2d uv;
         do {
-          uv = lt::randomBarycentrics(rng);
+          uv = randomBarycentrics(rng);
         } while (std::min({1 - uv.x() - uv.y(), uv.x(), uv.y()}) < kMargin);
         const Vec3L target = (1 - uv.x() - uv.y()) * floor.vertices[tri[0]].cast<L>() +
                              uv.x() * floor.vertices[tri[1]].cast<L>() +
                              uv.y() * floor.vertices[tri[2]].cast<L>();
-        const L phi = lt::uniform(rng, 0, 2 * M_PI);
+        const L phi = uniform(rng, 0, 2 * M_PI);
         const Vec3L d(std::cos(L(theta)) * std::cos(phi), std::cos(L(theta)) * std::sin(phi),
                       std::sin(L(theta)));  // from below: origin under the floor
-        const Vec3L o = target - L(lt::uniform(rng, 0.5, 2.0)) * d;
+        const Vec3L o = target - L(uniform(rng, 0.5, 2.0)) * d;
         const Eigen::Matrix<L, 3, 3> r = pose.linear().cast<L>();
         const Vec3L shift = pose.translation().cast<L>();
         for (std::size_t vi = 0; vi < variants().size(); ++vi) {
@@ -352,5 +350,4 @@ TEST(StressGrazing, BvhFloorHitsWithBoundedT) {
 }
 
 }  // namespace
-}  // namespace stress
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

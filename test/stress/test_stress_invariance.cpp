@@ -17,11 +17,9 @@
 #include "laser_raycast/core/bvh.h"
 #include "stress_report.h"
 
-namespace laser_raycast {
-namespace stress {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
 using core::Vec3;
 using Eigen::Vector3d;
 
@@ -74,16 +72,16 @@ template <TriangleMethod M, typename T>
 void randomSet(std::mt19937& rng, InvarianceTally* tally) {
   for (int n = 0; n < 2000; ++n) {
     Vec3<T> v[3];
-    for (auto& p : v) p = lt::uniformInCube(rng, 1.0).cast<T>();
+    for (auto& p : v) p = uniformInCube(rng, 1.0).cast<T>();
     const Vec3<T> targets[4] = {
         v[0] + T(0.3) * (v[1] - v[0]) + T(0.3) * (v[2] - v[0]),
-        v[0] + T(lt::uniform(rng, 0, 1)) * (v[1] - v[0]),
+        v[0] + T(uniform(rng, 0, 1)) * (v[1] - v[0]),
         v[2],
         v[0] + T(-0.2) * (v[1] - v[0]) + T(0.5) * (v[2] - v[0]),
     };
     for (const Vec3<T>& target : targets) {
       core::RayT<T> ray;
-      ray.origin = target + (lt::uniform(rng, 1, 3) * lt::randomUnitVector(rng)).cast<T>();
+      ray.origin = target + (uniform(rng, 1, 3) * randomUnitVector(rng)).cast<T>();
       ray.dir = target - ray.origin;
       compareOrders<M>(v, ray, tally);
     }
@@ -127,19 +125,19 @@ void exactSet(std::mt19937& rng, InvarianceTally* tally) {
 // A closed icosphere whose every triangle is rotated (b, c, a) or reversed (a, c, b): through the
 // BVH, the closest hit must be the same triangle (its index is kept) at the same t.
 template <TriangleMethod M, typename T>
-void bvhSet(const std::vector<lt::TriMesh>& versions, const std::vector<Vector3d>& origins,
+void bvhSet(const std::vector<TriMesh>& versions, const std::vector<Vector3d>& origins,
             std::mt19937& rng, InvarianceTally* tally) {
   std::vector<core::BvhT<T>> bvhs;
   for (const auto& m : versions) bvhs.push_back(core::BvhT<T>::build(m.vertices, m.triangles));
   const auto v = castVertices<T>(versions[0].vertices);
-  const auto edges = lt::uniqueEdges(versions[0]);
+  const auto edges = uniqueEdges(versions[0]);
   for (const Vector3d& o : origins) {
     double s = 0;  // the farthest vertex, for the spread bound
     for (const auto& p : v) s = std::max(s, double((p - o.cast<T>()).norm()));
     std::vector<Vec3<T>> targets(v.begin(), v.end());
     for (const auto& e : edges) {
       targets.push_back(v[e[0]] + T(0.5) * (v[e[1]] - v[e[0]]));
-      targets.push_back(v[e[0]] + T(lt::uniform(rng, 0, 1)) * (v[e[1]] - v[e[0]]));
+      targets.push_back(v[e[0]] + T(uniform(rng, 0, 1)) * (v[e[1]] - v[e[0]]));
     }
     for (const Vec3<T>& target : targets) {
       core::RayT<T> ray;
@@ -163,14 +161,14 @@ void bvhSet(const std::vector<lt::TriMesh>& versions, const std::vector<Vector3d
 
 TEST(StressInvariance, VertexOrderDoesNotChangeDecisions) {
   std::mt19937 rng(7001);
-  const lt::TriMesh sphere = lt::transformed(lt::makeIcosphere(2), 1.5, lt::randomPose(rng, 2.0));
-  std::vector<lt::TriMesh> versions(3, sphere);
+  const TriMesh sphere = transformed(makeIcosphere(2), 1.5, randomPose(rng, 2.0));
+  std::vector<TriMesh> versions(3, sphere);
   for (auto& tri : versions[1].triangles) tri = {tri[1], tri[2], tri[0]};
   for (auto& tri : versions[2].triangles) std::swap(tri[1], tri[2]);
   core::Aabb box;
   for (const Vector3d& p : sphere.vertices) box.grow(p);
   std::vector<Vector3d> origins = {box.center()};
-  for (int k = 0; k < 2; ++k) origins.push_back(box.center() + 0.5 * lt::randomUnitVector(rng));
+  for (int k = 0; k < 2; ++k) origins.push_back(box.center() + 0.5 * randomUnitVector(rng));
 
   std::vector<InvarianceTally> random(variants().size()), exact(variants().size()),
       bvh(variants().size());
@@ -221,5 +219,4 @@ TEST(StressInvariance, VertexOrderDoesNotChangeDecisions) {
 }
 
 }  // namespace
-}  // namespace stress
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

@@ -18,11 +18,9 @@
 #include "laser_raycast/core/mesh.h"
 #include "stress_report.h"
 
-namespace laser_raycast {
-namespace stress {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
 using core::Vec3;
 using Eigen::Vector3d;
 
@@ -49,19 +47,18 @@ core::RayT<T> aimedRay(const Aim& aim, const std::vector<Vec3<T>>& v) {
 
 // From each origin: every stride-th vertex, and of every stride-th edge its midpoint plus
 // (random_edge_points) random points.
-std::vector<Aim> aimsAtVerticesAndEdges(const lt::TriMesh& mesh,
-                                        const std::vector<Vector3d>& origins,
+std::vector<Aim> aimsAtVerticesAndEdges(const TriMesh& mesh, const std::vector<Vector3d>& origins,
                                         int random_edge_points, std::mt19937& rng,
                                         std::size_t stride = 1) {
   std::vector<Aim> aims;
-  const auto edges = lt::uniqueEdges(mesh);
+  const auto edges = uniqueEdges(mesh);
   for (const Vector3d& o : origins) {
     for (std::uint32_t v = 0; v < mesh.vertices.size(); v += stride) aims.push_back({o, v, v, 0.0});
     for (std::size_t k = 0; k < edges.size(); k += stride) {
       const auto& e = edges[k];
       aims.push_back({o, e[0], e[1], 0.5});
       for (int k = 0; k < random_edge_points; ++k) {
-        aims.push_back({o, e[0], e[1], lt::uniform(rng, 0.0, 1.0)});
+        aims.push_back({o, e[0], e[1], uniform(rng, 0.0, 1.0)});
       }
     }
   }
@@ -98,7 +95,7 @@ struct LeakTally {
 // Rays from inside a convex closed mesh: exactly one triangle must be hit, and the BVH's closest
 // hit must exist.
 template <TriangleMethod M, typename T>
-void castFromInside(const lt::TriMesh& mesh, const core::BvhT<T>& bvh, const std::vector<Aim>& aims,
+void castFromInside(const TriMesh& mesh, const core::BvhT<T>& bvh, const std::vector<Aim>& aims,
                     LeakTally* tally) {
   const auto v = castVertices<T>(mesh.vertices);
   for (const Aim& aim : aims) {
@@ -113,8 +110,8 @@ void castFromInside(const lt::TriMesh& mesh, const core::BvhT<T>& bvh, const std
 
 // Rays from outside a closed mesh: an odd crossing count is a leak or a double hit.
 template <TriangleMethod M, typename T>
-void castFromOutside(const lt::TriMesh& mesh, const core::BvhT<T>& bvh,
-                     const std::vector<Aim>& aims, LeakTally* tally) {
+void castFromOutside(const TriMesh& mesh, const core::BvhT<T>& bvh, const std::vector<Aim>& aims,
+                     LeakTally* tally) {
   const auto v = castVertices<T>(mesh.vertices);
   for (const Aim& aim : aims) {
     ++tally->outside_rays;
@@ -124,25 +121,25 @@ void castFromOutside(const lt::TriMesh& mesh, const core::BvhT<T>& bvh,
 
 // A convex closed mesh with interior origins.
 struct InsideCase {
-  lt::TriMesh mesh;
+  TriMesh mesh;
   std::vector<Vector3d> origins;
 };
 
 InsideCase icosphereCase(int level, double radius, const Eigen::Isometry3d& pose, int origins,
                          std::mt19937& rng) {
-  InsideCase c{lt::transformed(lt::makeIcosphere(level), radius, pose), {pose.translation()}};
+  InsideCase c{transformed(makeIcosphere(level), radius, pose), {pose.translation()}};
   for (int k = 0; k < origins; ++k) {
-    const double r = 0.7 * radius * std::cbrt(lt::uniform(rng, 0, 1));
-    c.origins.push_back(pose * (r * lt::randomUnitVector(rng)));
+    const double r = 0.7 * radius * std::cbrt(uniform(rng, 0, 1));
+    c.origins.push_back(pose * (r * randomUnitVector(rng)));
   }
   return c;
 }
 
 InsideCase boxRoomCase(const Vector3d& size, int cells, const Eigen::Isometry3d& pose, int origins,
                        std::mt19937& rng) {
-  InsideCase c{lt::transformed(lt::makeBoxRoom(size, cells), 1.0, pose), {pose.translation()}};
+  InsideCase c{transformed(makeBoxRoom(size, cells), 1.0, pose), {pose.translation()}};
   for (int k = 0; k < origins; ++k) {
-    c.origins.push_back(pose * lt::uniformInBox(rng, -0.45 * size, 0.45 * size));
+    c.origins.push_back(pose * uniformInBox(rng, -0.45 * size, 0.45 * size));
   }
   return c;
 }
@@ -163,9 +160,9 @@ std::vector<std::string> tallyRow(const Variant& v, const LeakTally& t, bool ins
 // order.
 std::vector<LeakTally> runLeakCases(
     const std::vector<InsideCase>& inside,
-    const std::vector<std::pair<lt::TriMesh, std::vector<Aim>>>& outside, std::mt19937& rng) {
+    const std::vector<std::pair<TriMesh, std::vector<Aim>>>& outside, std::mt19937& rng) {
   std::vector<LeakTally> tallies(variants().size());
-  auto run_mesh = [&](const lt::TriMesh& mesh, const std::vector<Aim>* inside_aims,
+  auto run_mesh = [&](const TriMesh& mesh, const std::vector<Aim>* inside_aims,
                       const std::vector<Aim>* outside_aims) {
     const core::Bvh bvh = core::Bvh::build(mesh.vertices, mesh.triangles);
     const core::BvhF bvh_f = core::BvhF::build(mesh.vertices, mesh.triangles);
@@ -182,7 +179,7 @@ std::vector<LeakTally> runLeakCases(
     }
   };
   for (const InsideCase& c : inside) {
-    EXPECT_TRUE(lt::isClosedAndConsistentlyWound(c.mesh));
+    EXPECT_TRUE(isClosedAndConsistentlyWound(c.mesh));
     const std::vector<Aim> aims = aimsAtVerticesAndEdges(c.mesh, c.origins, 1, rng);
     run_mesh(c.mesh, &aims, nullptr);
   }
@@ -207,9 +204,9 @@ TEST(StressLeaks, ConvexClosedMeshesFromInside) {
   const std::vector<InsideCase> cases = {
       icosphereCase(1, 1.0, identity, 8, rng),
       icosphereCase(3, 1.0, identity, 2, rng),
-      icosphereCase(2, 2.5, lt::randomPose(rng, 3.0), 4, rng),
+      icosphereCase(2, 2.5, randomPose(rng, 3.0), 4, rng),
       boxRoomCase(Vector3d(4, 3, 2.5), 4, identity, 6, rng),
-      boxRoomCase(Vector3d(1, 1, 1), 3, lt::randomPose(rng, 2.0), 6, rng),
+      boxRoomCase(Vector3d(1, 1, 1), 3, randomPose(rng, 2.0), 6, rng),
   };
   const auto tallies = runLeakCases(cases, {}, rng);
   Table t{"1a",
@@ -238,14 +235,13 @@ class StressRealMeshLeaks : public ::testing::Test {
 
 // Interior points of a convex mesh: random points of its bounds at least `margin` inside every
 // face plane.
-std::vector<Vector3d> convexInterior(const lt::TriMesh& mesh, double margin, int n,
-                                     std::mt19937& rng) {
+std::vector<Vector3d> convexInterior(const TriMesh& mesh, double margin, int n, std::mt19937& rng) {
   core::Aabb box;
   for (const Vector3d& v : mesh.vertices) box.grow(v);
-  const double orientation = lt::signedVolume(mesh) > 0 ? 1.0 : -1.0;
+  const double orientation = signedVolume(mesh) > 0 ? 1.0 : -1.0;
   std::vector<Vector3d> out = {box.center()};
   while (static_cast<int>(out.size()) < n) {
-    const Vector3d p = lt::uniformInBox(rng, box.lo, box.hi);
+    const Vector3d p = uniformInBox(rng, box.lo, box.hi);
     bool inside = true;
     for (const auto& tri : mesh.triangles) {
       const Vector3d& a = mesh.vertices[tri[0]];
@@ -265,20 +261,20 @@ TEST_F(StressRealMeshLeaks, ClosedMeshesFromInsideAndOutside) {
   std::mt19937 rng(1101);
   InsideCase hexagon;
   hexagon.mesh = loadSharedMesh("hexagon.dae", 0.8);
-  ASSERT_LT(lt::maxConvexityViolation(hexagon.mesh), 1e-12);
+  ASSERT_LT(maxConvexityViolation(hexagon.mesh), 1e-12);
   hexagon.origins = convexInterior(hexagon.mesh, 0.1, 12, rng);
 
-  std::vector<std::pair<lt::TriMesh, std::vector<Aim>>> outside;
+  std::vector<std::pair<TriMesh, std::vector<Aim>>> outside;
   const std::vector<std::pair<std::string, double>> files = {{"wall.dae", 0.25},
                                                              {"waffle/waffle_base.dae", 0.001},
                                                              {"waffle/lds.stl", 0.001},
                                                              {"waffle/left_tire.stl", 0.001}};
   for (const auto& file : files) {
-    lt::TriMesh mesh = loadSharedMesh(file.first, file.second);
+    TriMesh mesh = loadSharedMesh(file.first, file.second);
     core::Aabb box;
     for (const Vector3d& v : mesh.vertices) box.grow(v);
     // Outside the bounding sphere, so certainly outside the solid.
-    const Vector3d origin = box.center() + 1.5 * box.extent().norm() * lt::randomUnitVector(rng);
+    const Vector3d origin = box.center() + 1.5 * box.extent().norm() * randomUnitVector(rng);
     // Every third vertex and edge of the two large meshes keeps the run short.
     const std::size_t stride = mesh.triangles.size() > 1000 ? 3 : 1;
     std::vector<Aim> aims = aimsAtVerticesAndEdges(mesh, {origin}, 0, rng, stride);
@@ -306,5 +302,4 @@ TEST_F(StressRealMeshLeaks, ClosedMeshesFromInsideAndOutside) {
 }
 
 }  // namespace
-}  // namespace stress
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

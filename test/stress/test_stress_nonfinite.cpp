@@ -17,11 +17,9 @@
 #include "laser_raycast/core/scan_encoder.h"
 #include "stress_report.h"
 
-namespace laser_raycast {
-namespace stress {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
 using core::Vec3;
 using Eigen::Vector3d;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -82,8 +80,8 @@ TEST(StressNonFinite, TriangleAndBvhNeverHit) {
   // Triangle level: random triangles, each with a ray aimed at its centroid (which hits).
   for (int n = 0; n < 100; ++n) {
     Case base;
-    for (auto& p : base.v) p = lt::uniformInCube(rng, 1.0);
-    base.ray.origin = 3.0 * lt::randomUnitVector(rng);
+    for (auto& p : base.v) p = uniformInCube(rng, 1.0);
+    base.ray.origin = 3.0 * randomUnitVector(rng);
     base.ray.dir = (base.v[0] + base.v[1] + base.v[2]) / 3.0 - base.ray.origin;
     for (const Case& c : corruptions(base)) {
       for (std::size_t vi = 0; vi < variants().size(); ++vi) {
@@ -100,14 +98,14 @@ TEST(StressNonFinite, TriangleAndBvhNeverHit) {
   }
   // Through the BVH: rays from inside an icosphere (they all hit it), corrupted the same way
   // (origin, direction, zero direction, NaN interval).
-  const lt::TriMesh sphere = lt::transformed(lt::makeIcosphere(2), 2.0, lt::randomPose(rng, 1.0));
+  const TriMesh sphere = transformed(makeIcosphere(2), 2.0, randomPose(rng, 1.0));
   const core::Bvh bvh = core::Bvh::build(sphere.vertices, sphere.triangles);
   const core::BvhF bvh_f = core::BvhF::build(sphere.vertices, sphere.triangles);
   for (int n = 0; n < 100; ++n) {
     Case base;
     base.v = {Vector3d::Zero(), Vector3d::Zero(), Vector3d::Zero()};  // unused: the mesh's
-    base.ray.origin = bvh.bounds().center() + lt::uniformInCube(rng, 0.5);
-    base.ray.dir = lt::randomUnitVector(rng);
+    base.ray.origin = bvh.bounds().center() + uniformInCube(rng, 0.5);
+    base.ray.dir = randomUnitVector(rng);
     const std::vector<Case> all = corruptions(base);
     for (std::size_t k = 27; k < all.size(); ++k) {  // after the 27 vertex corruptions
       const Case& c = all[k];
@@ -149,12 +147,12 @@ TEST(StressNonFinite, TriangleAndBvhNeverHit) {
 // The production pipeline: Mesh, ScanPattern, Caster and ScanEncoder.
 TEST(StressNonFinite, PipelineReportsNanOrRejects) {
   // Mesh rejects a non-finite vertex (in the vertex list, used or not).
-  const lt::TriMesh cube = lt::makeBoxRoom(Vector3d(1, 1, 1), 1);
+  const TriMesh cube = makeBoxRoom(Vector3d(1, 1, 1), 1);
   long mesh_cases = 0, mesh_rejected = 0;
   for (const std::size_t index : {std::size_t(0), cube.vertices.size() - 1}) {
     for (int k = 0; k < 3; ++k) {
       for (const double bad : kBadValues) {
-        lt::TriMesh m = cube;
+        TriMesh m = cube;
         m.vertices[index][k] = bad;
         ++mesh_cases;
         try {
@@ -189,7 +187,7 @@ TEST(StressNonFinite, PipelineReportsNanOrRejects) {
   room.frame = scene.addFrame("room");
   ball.frame = scene.addFrame("ball");
   room.label = ball.label = label;
-  const lt::TriMesh room_mesh = lt::makeBoxRoom(Vector3d(8, 6, 3), 2);
+  const TriMesh room_mesh = makeBoxRoom(Vector3d(8, 6, 3), 2);
   room.shape = std::make_shared<const core::Mesh>(room_mesh.vertices, room_mesh.triangles);
   ball.shape = core::Sphere{0.5};
   ball.frame_from_body.translation() = Vector3d(2, 0, 0);
@@ -288,5 +286,4 @@ TEST(StressNonFinite, PipelineReportsNanOrRejects) {
 }
 
 }  // namespace
-}  // namespace stress
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

@@ -20,11 +20,9 @@
 #include "laser_raycast/core/pose.h"
 #include "stress_report.h"
 
-namespace laser_raycast {
-namespace stress {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
 using Eigen::Vector3d;
 using L = long double;
 using Vec3L = Eigen::Matrix<L, 3, 1>;
@@ -62,7 +60,7 @@ struct LocalPose {
 
 // A room with two objects on three frames, and the sensor.
 struct FarScene {
-  std::vector<lt::TriMesh> meshes;  // one body per frame, frame_from_body = identity
+  std::vector<TriMesh> meshes;  // one body per frame, frame_from_body = identity
   std::vector<LocalPose> frames;
   LocalPose sensor;
   core::Scene scene;
@@ -70,9 +68,9 @@ struct FarScene {
 
 FarScene farScene() {
   FarScene s;
-  s.meshes = {lt::makeBoxRoom(Vector3d(8, 6, 3), 4),
-              lt::transformed(lt::makeIcosphere(2), 0.5, Eigen::Isometry3d::Identity()),
-              lt::makeBoxRoom(Vector3d(0.8, 0.6, 1.0), 2)};
+  s.meshes = {makeBoxRoom(Vector3d(8, 6, 3), 4),
+              transformed(makeIcosphere(2), 0.5, Eigen::Isometry3d::Identity()),
+              makeBoxRoom(Vector3d(0.8, 0.6, 1.0), 2)};
   s.frames = {{Vector3d(0, 0, 0), Vector3d(0, 0, 0)},
               {Vector3d(1.5, -0.75, 0.25), Vector3d(0.3, 0.2, 0.1)},
               {Vector3d(-2, 1.25, -0.125), Vector3d(0, 0, 0.6)}};
@@ -189,7 +187,7 @@ TEST(StressPrecision, FarFromOriginErrorDoesNotGrow) {
     }
     const Eigen::Isometry3d sensor_w = s.sensor.at(offset);
     // World-space copies of every triangle, for the naive evaluation.
-    lt::TriMesh world;
+    TriMesh world;
     for (std::size_t f = 0; f < s.meshes.size(); ++f) {
       const auto base = static_cast<std::uint32_t>(world.vertices.size());
       for (const Vector3d& v : s.meshes[f].vertices) world.vertices.push_back(frame_w[f] * v);
@@ -316,10 +314,10 @@ struct ScaleTally {
 };
 
 template <TriangleMethod M, typename T>
-void castScaled(const lt::TriMesh& mesh, const std::vector<Vector3d>& origins,
-                const core::BvhT<T>& bvh, ScaleTally* tally) {
+void castScaled(const TriMesh& mesh, const std::vector<Vector3d>& origins, const core::BvhT<T>& bvh,
+                ScaleTally* tally) {
   const auto v = castVertices<T>(mesh.vertices);
-  const auto edges = lt::uniqueEdges(mesh);
+  const auto edges = uniqueEdges(mesh);
   for (const Vector3d& o : origins) {
     auto cast = [&](const core::Vec3<T>& target) {
       core::RayT<T> ray;
@@ -341,19 +339,18 @@ void castScaled(const lt::TriMesh& mesh, const std::vector<Vector3d>& origins,
 // vertices) is the scan plane.
 TEST(StressPrecision, ScaleNeedsNoAbsoluteEpsilon) {
   std::mt19937 rng(5001);
-  const Eigen::Isometry3d pose = lt::randomPose(rng, 1.0);
-  const lt::TriMesh sphere = lt::makeIcosphere(2);
-  const lt::TriMesh room = lt::makeBoxRoom(Vector3d(4, 3, 2.5), 3);
+  const Eigen::Isometry3d pose = randomPose(rng, 1.0);
+  const TriMesh sphere = makeIcosphere(2);
+  const TriMesh room = makeBoxRoom(Vector3d(4, 3, 2.5), 3);
   std::vector<Vector3d> sphere_origins = {Vector3d::Zero()}, room_origins = {Vector3d::Zero()};
   for (int k = 0; k < 2; ++k) {
-    sphere_origins.push_back(0.6 * std::cbrt(lt::uniform(rng, 0, 1)) * lt::randomUnitVector(rng));
-    room_origins.push_back(
-        lt::uniformInBox(rng, Vector3d(-1.8, -1.3, -1.1), Vector3d(1.8, 1.3, 1.1)));
+    sphere_origins.push_back(0.6 * std::cbrt(uniform(rng, 0, 1)) * randomUnitVector(rng));
+    room_origins.push_back(uniformInBox(rng, Vector3d(-1.8, -1.3, -1.1), Vector3d(1.8, 1.3, 1.1)));
   }
-  const lt::TriMesh caster_sphere = lt::makeIcosphere(3);
+  const TriMesh caster_sphere = makeIcosphere(3);
   std::vector<Vector3d> sensor_at;
   for (int k = 0; k < 4; ++k)
-    sensor_at.emplace_back(lt::uniform(rng, -0.5, 0.5), lt::uniform(rng, -0.5, 0.5), 0);
+    sensor_at.emplace_back(uniform(rng, -0.5, 0.5), uniform(rng, -0.5, 0.5), 0);
 
   const std::vector<int> exponents = {-4, -3, -2, -1, 0, 1, 2, 3, 4};
   std::vector<std::vector<ScaleTally>> tallies(variants().size(),
@@ -364,9 +361,9 @@ TEST(StressPrecision, ScaleNeedsNoAbsoluteEpsilon) {
     const double scale = std::pow(10.0, exponents[e]);
     Eigen::Isometry3d scaled_pose = pose;
     scaled_pose.translation() *= scale;
-    const std::vector<std::pair<lt::TriMesh, std::vector<Vector3d>>> cases = {
-        {lt::transformed(sphere, scale, scaled_pose), sphere_origins},
-        {lt::transformed(room, scale, scaled_pose), room_origins}};
+    const std::vector<std::pair<TriMesh, std::vector<Vector3d>>> cases = {
+        {transformed(sphere, scale, scaled_pose), sphere_origins},
+        {transformed(room, scale, scaled_pose), room_origins}};
     for (const auto& c : cases) {
       std::vector<Vector3d> origins;
       for (const Vector3d& o : c.second) origins.push_back(scaled_pose * (scale * o));
@@ -381,7 +378,7 @@ TEST(StressPrecision, ScaleNeedsNoAbsoluteEpsilon) {
       }
     }
     // The Caster: fast path and per-beam (watertight), 1000 beams per sensor.
-    const lt::TriMesh m = lt::transformed(caster_sphere, scale, Eigen::Isometry3d::Identity());
+    const TriMesh m = transformed(caster_sphere, scale, Eigen::Isometry3d::Identity());
     core::Scene scene;
     scene.addFrame("f");
     scene.addLabel("l");
@@ -454,5 +451,4 @@ TEST(StressPrecision, ScaleNeedsNoAbsoluteEpsilon) {
 }
 
 }  // namespace
-}  // namespace stress
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

@@ -20,11 +20,9 @@
 #include "laser_raycast/core/pose.h"
 #include "stress_report.h"
 
-namespace laser_raycast {
-namespace stress {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
 using core::Vec3;
 using Eigen::Vector3d;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -35,7 +33,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // A flat mesh with its interior (shared by two triangles) edges and interior vertices (all of whose
 // edges are interior): a ray through those crosses the surface exactly once.
 struct Sliver {
-  lt::TriMesh mesh;
+  TriMesh mesh;
   std::vector<std::array<std::uint32_t, 2>> interior_edges;
   std::vector<std::uint32_t> interior_vertices;
   Vector3d normal;
@@ -117,11 +115,11 @@ void castSliver(const Sliver& s, const core::BvhT<T>& bvh, std::mt19937& rng, Sl
   const auto v = castVertices<T>(s.mesh.vertices);
   auto cast = [&](const Vector3d& target_d, const Vec3<T>& target) {
     for (int k = 0; k < 2; ++k) {
-      Vector3d e = lt::randomUnitVector(rng);
+      Vector3d e = randomUnitVector(rng);
       if (std::abs(e.dot(s.normal)) < 0.3)
         e = (e + s.normal * (e.dot(s.normal) < 0 ? -1 : 1)).normalized();
       core::RayT<T> ray;
-      ray.origin = (target_d + lt::uniform(rng, 0.5, 2.0) * e).cast<T>();
+      ray.origin = (target_d + uniform(rng, 0.5, 2.0) * e).cast<T>();
       ray.dir = target - ray.origin;
       int hits = 0;
       for (const auto& tri : s.mesh.triangles) {
@@ -138,7 +136,7 @@ void castSliver(const Sliver& s, const core::BvhT<T>& bvh, std::mt19937& rng, Sl
   };
   for (const auto i : s.interior_vertices) cast(s.mesh.vertices[i], v[i]);
   for (const auto& e : s.interior_edges) {
-    for (const double f : {0.5, lt::uniform(rng, 0, 1), lt::uniform(rng, 0, 1)}) {
+    for (const double f : {0.5, uniform(rng, 0, 1), uniform(rng, 0, 1)}) {
       cast((1 - f) * s.mesh.vertices[e[0]] + f * s.mesh.vertices[e[1]],
            Vec3<T>(v[e[0]] + T(f) * (v[e[1]] - v[e[0]])));
     }
@@ -155,8 +153,7 @@ TEST(StressSlivers, StripsAndFansNeitherLeakNorDoubleHit) {
     std::vector<Sliver> slivers;
     for (int p = 0; p < 3; ++p) {
       // The first pose is the identity (exact coordinates), the others random.
-      const Eigen::Isometry3d pose =
-          p == 0 ? Eigen::Isometry3d::Identity() : lt::randomPose(rng, 2.0);
+      const Eigen::Isometry3d pose = p == 0 ? Eigen::Isometry3d::Identity() : randomPose(rng, 2.0);
       slivers.push_back(sliverStrip(aspect, pose));
       slivers.push_back(sliverFan(aspect, pose));
     }
@@ -215,8 +212,8 @@ TEST(StressSlivers, StripsAndFansNeitherLeakNorDoubleHit) {
 // 4b. A wall of vertical slivers across the scan plane.
 
 // Vertical slivers at x = 2: columns dy apart, rows at z = -1, 0 (the scan plane), 1.
-lt::TriMesh sliverWall(double dy, int columns) {
-  lt::TriMesh m;
+TriMesh sliverWall(double dy, int columns) {
+  TriMesh m;
   for (const double z : {-1.0, 0.0, 1.0}) {
     for (int i = 0; i <= columns; ++i) m.vertices.emplace_back(2.0, (i - columns / 2.0) * dy, z);
   }
@@ -249,7 +246,7 @@ TEST(StressSlivers, WallAcrossTheScanPlane) {
   long beams = 0;
   for (int a = 0; a < kExponents; ++a) {
     const double dy = std::pow(10.0, -a);  // aspect ratio (height 1) / dy
-    const lt::TriMesh wall = sliverWall(dy, columns);
+    const TriMesh wall = sliverWall(dy, columns);
     auto mesh = std::make_shared<const core::Mesh>(wall.vertices, wall.triangles);
     core::Scene scene;
     core::Body body;
@@ -259,7 +256,7 @@ TEST(StressSlivers, WallAcrossTheScanPlane) {
     scene.addBody(body);
     for (int s = 0; s < 4; ++s) {
       // Yaw only, so the middle row stays exactly in the plane z = 0.
-      const double yaw = s == 0 ? 0.0 : lt::uniform(rng, -M_PI, M_PI);
+      const double yaw = s == 0 ? 0.0 : uniform(rng, -M_PI, M_PI);
       core::FramePoses poses = core::FramePoses::identity(scene);
       poses.pose[0].linear() = Eigen::AngleAxisd(yaw, Vector3d::UnitZ()).toRotationMatrix();
       const double half = 0.98 * std::atan(columns * dy / 2 / 2.0);
@@ -321,5 +318,4 @@ TEST(StressSlivers, WallAcrossTheScanPlane) {
 }
 
 }  // namespace
-}  // namespace stress
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

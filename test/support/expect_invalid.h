@@ -8,8 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace laser_raycast {
-namespace test {
+namespace laser_raycast_test {
 
 // The message of the std::invalid_argument that f throws, or a marker if it throws nothing.
 template <class F>
@@ -30,5 +29,4 @@ inline void expectMentions(const std::string& message, const std::vector<std::st
   }
 }
 
-}  // namespace test
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

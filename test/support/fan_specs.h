@@ -3,24 +3,22 @@
 
 #include "laser_raycast/core/scan_pattern.h"
 
-namespace laser_raycast {
-namespace test {
+namespace laser_raycast_test {
 
-inline core::FanSpec fanBySamples(double min, double max, int samples) {
-  core::FanSpec fan;
+inline laser_raycast::core::FanSpec fanBySamples(double min, double max, int samples) {
+  laser_raycast::core::FanSpec fan;
   fan.angle_min = min;
   fan.angle_max = max;
   fan.samples = samples;
   return fan;
 }
 
-inline core::FanSpec fanByIncrement(double min, double max, double increment) {
-  core::FanSpec fan;
+inline laser_raycast::core::FanSpec fanByIncrement(double min, double max, double increment) {
+  laser_raycast::core::FanSpec fan;
   fan.angle_min = min;
   fan.angle_max = max;
   fan.angle_increment = increment;
   return fan;
 }
 
-}  // namespace test
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

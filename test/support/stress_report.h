@@ -32,8 +32,9 @@
 #include "shared_data.h"
 #include "test_geometry.h"
 
-namespace laser_raycast {
-namespace stress {
+namespace laser_raycast_test {
+
+namespace core = laser_raycast::core;
 
 using core::TriangleMethod;
 
@@ -120,15 +121,16 @@ int countHits(const core::RayT<T>& ray, const std::vector<core::Vec3<T>>& v,
 // A mesh of ../shared/data/tb3_world_data (path under meshes/) as the loader reads it, with the
 // URDF scale, and its vertices joined by exact position (assimp and STL repeat a vertex per face),
 // so that shared edges are found by index. Call from a test that began with REQUIRE_SHARED_DATA().
-inline test::TriMesh loadSharedMesh(const std::string& file, double scale) {
-  const std::string dir = laser_raycast_test::tb3WorldData();
-  SceneLoader loader([dir](const std::string& package) -> std::optional<std::string> {
-    if (package == "tb3_world_data") return dir;
-    return std::nullopt;
-  });
+inline TriMesh loadSharedMesh(const std::string& file, double scale) {
+  const std::string dir = tb3WorldData();
+  laser_raycast::SceneLoader loader(
+      [dir](const std::string& package) -> std::optional<std::string> {
+        if (package == "tb3_world_data") return dir;
+        return std::nullopt;
+      });
   const auto mesh = loader.loadMesh("package://tb3_world_data/meshes/" + file, "",
                                     Eigen::Vector3d::Constant(scale), core::BvhConfig{});
-  test::TriMesh out;
+  TriMesh out;
   std::map<std::array<double, 3>, std::uint32_t> index_of;
   std::vector<std::uint32_t> joined(mesh->vertices().size());
   for (std::size_t i = 0; i < mesh->vertices().size(); ++i) {
@@ -141,7 +143,7 @@ inline test::TriMesh loadSharedMesh(const std::string& file, double scale) {
   for (const auto& tri : mesh->triangles()) {
     out.triangles.push_back({joined[tri[0]], joined[tri[1]], joined[tri[2]]});
   }
-  EXPECT_TRUE(test::isClosedAndConsistentlyWound(out)) << file << " is not closed";
+  EXPECT_TRUE(isClosedAndConsistentlyWound(out)) << file << " is not closed";
   return out;
 }
 
@@ -249,5 +251,4 @@ inline std::string fixed(double x, int decimals) {
   return buffer;
 }
 
-}  // namespace stress
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

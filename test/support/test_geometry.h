@@ -14,8 +14,7 @@
 #include <utility>
 #include <vector>
 
-namespace laser_raycast {
-namespace test {
+namespace laser_raycast_test {
 
 // An indexed triangle mesh. The triangle type matches core::TriangleIndices, so the vectors can be
 // passed to core::Mesh and core::Bvh as they are. Meshes made here are closed and wound so that
@@ -252,5 +251,4 @@ inline double maxConvexityViolation(const TriMesh& mesh) {
   return worst;
 }
 
-}  // namespace test
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

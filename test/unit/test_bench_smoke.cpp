@@ -18,6 +18,7 @@
 
 #include "run_command.h"
 
+namespace laser_raycast_test {
 namespace {
 
 const std::string kBench = BENCH_PATH;
@@ -66,13 +67,13 @@ bool parseCount(const std::string& text, long* value) {
 }
 
 TEST(BenchSmoke, BadArgumentsExitWithTwo) {
-  EXPECT_EQ(laser_raycast_test::runCommand(kBench + " --no-such-flag 2>/dev/null").status, 2);
-  EXPECT_EQ(laser_raycast_test::runCommand(kBench + " --scene nowhere 2>/dev/null").status, 2);
-  EXPECT_EQ(laser_raycast_test::runCommand(kBench + " --scene 2>/dev/null").status, 2);
+  EXPECT_EQ(runCommand(kBench + " --no-such-flag 2>/dev/null").status, 2);
+  EXPECT_EQ(runCommand(kBench + " --scene nowhere 2>/dev/null").status, 2);
+  EXPECT_EQ(runCommand(kBench + " --scene 2>/dev/null").status, 2);
 }
 
 TEST(BenchSmoke, ListsTheCoreMethods) {
-  const auto result = laser_raycast_test::runCommand(kBench + " --list-methods");
+  const auto result = runCommand(kBench + " --list-methods");
   ASSERT_EQ(result.status, 0);
   const auto lines = splitLines(result.output);
   const std::set<std::string> methods(lines.begin(), lines.end());
@@ -85,15 +86,14 @@ TEST(BenchSmoke, ListsTheCoreMethods) {
 }
 
 TEST(BenchSmoke, QuickRunWritesEveryRow) {
-  const auto listed = laser_raycast_test::runCommand(kBench + " --list-methods");
+  const auto listed = runCommand(kBench + " --list-methods");
   ASSERT_EQ(listed.status, 0);
   const std::vector<std::string> methods = splitLines(listed.output);
 
   const std::string dir = ::testing::TempDir() + "bench_smoke_" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   const std::string log = dir + ".log";
-  const auto run = laser_raycast_test::runCommand("timeout 900 " + kBench + " --quick --out " +
-                                                  dir + " 2>" + log);
+  const auto run = runCommand("timeout 900 " + kBench + " --quick --out " + dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
 
   const auto lines = splitLines(readFile(dir + "/results.csv"));
@@ -146,3 +146,4 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
 }
 
 }  // namespace
+}  // namespace laser_raycast_test

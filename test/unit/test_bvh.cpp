@@ -16,10 +16,10 @@
 #include "laser_raycast/core/bvh.h"
 #include "laser_raycast/core/mesh.h"
 
-using namespace laser_raycast::core;
-using laser_raycast::test::expectMentions;
-
+namespace laser_raycast_test {
 namespace {
+
+using namespace laser_raycast::core;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -307,8 +307,6 @@ Ray randomRay(std::mt19937_64& rng, const Aabb& box, const Soup& s) {
   }
   return ray;
 }
-
-}  // namespace
 
 // The core property: random soups from 1 to 5000 triangles, spread and clustered, every method and
 // precision, against brute force.
@@ -743,17 +741,13 @@ TEST(Bvh, VisitReachesExactlyTheLeavesThatPass) {
   EXPECT_EQ(none, 0);
 }
 
-namespace {
-
 void expectInvalid(const BvhConfig& config, const std::string& field, const std::string& value) {
-  expectMentions(laser_raycast::test::invalidMessage([&] { config.validate(); }), {field, value});
+  expectMentions(invalidMessage([&] { config.validate(); }), {field, value});
   // build() validates too.
   const std::vector<Eigen::Vector3d> v = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
                                           Eigen::Vector3d(0, 1, 0)};
   EXPECT_THROW(Bvh::build(v, {{0, 1, 2}}, config), std::invalid_argument);
 }
-
-}  // namespace
 
 TEST(BvhConfig, ValidateNamesFieldAndValue) {
   BvhConfig ok;
@@ -826,36 +820,33 @@ TEST(Bvh, MaxDepthTreeTraversesCorrectly) {
 
 // --- Mesh ---------------------------------------------------------------------------------------
 
-namespace {
-
-std::string invalidMessage(std::vector<Eigen::Vector3d> v, std::vector<TriangleIndices> t) {
-  return laser_raycast::test::invalidMessage([&] { Mesh mesh(std::move(v), std::move(t)); });
+// The message with which the Mesh constructor rejects (v, t).
+std::string meshMessage(std::vector<Eigen::Vector3d> v, std::vector<TriangleIndices> t) {
+  return invalidMessage([&] { Mesh mesh(std::move(v), std::move(t)); });
 }
-
-}  // namespace
 
 TEST(Mesh, RejectsBadInput) {
   const std::vector<Eigen::Vector3d> v = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
                                           Eigen::Vector3d(0, 1, 0)};
-  EXPECT_NE(invalidMessage(v, {}).find("no triangles"), std::string::npos);
+  EXPECT_NE(meshMessage(v, {}).find("no triangles"), std::string::npos);
 
   auto with = [&](int index, double value) {
     auto bad = v;
     bad[index].y() = value;
     return bad;
   };
-  const std::string nan_msg = invalidMessage(with(1, std::nan("")), {{0, 1, 2}});
+  const std::string nan_msg = meshMessage(with(1, std::nan("")), {{0, 1, 2}});
   EXPECT_NE(nan_msg.find("vertex 1"), std::string::npos) << nan_msg;
   EXPECT_NE(nan_msg.find("nan"), std::string::npos) << nan_msg;
-  const std::string inf_msg = invalidMessage(with(2, -kInf), {{0, 1, 2}});
+  const std::string inf_msg = meshMessage(with(2, -kInf), {{0, 1, 2}});
   EXPECT_NE(inf_msg.find("vertex 2"), std::string::npos) << inf_msg;
   EXPECT_NE(inf_msg.find("inf"), std::string::npos) << inf_msg;
 
-  const std::string range_msg = invalidMessage(v, {{0, 1, 2}, {0, 3, 1}});
+  const std::string range_msg = meshMessage(v, {{0, 1, 2}, {0, 3, 1}});
   EXPECT_NE(range_msg.find("triangle 1"), std::string::npos) << range_msg;
   EXPECT_NE(range_msg.find("vertex 3"), std::string::npos) << range_msg;
 
-  const std::string degenerate_msg = invalidMessage(v, {{0, 0, 1}, {2, 2, 2}});
+  const std::string degenerate_msg = meshMessage(v, {{0, 0, 1}, {2, 2, 2}});
   EXPECT_NE(degenerate_msg.find("2 triangles"), std::string::npos) << degenerate_msg;
   EXPECT_NE(degenerate_msg.find("zero area"), std::string::npos) << degenerate_msg;
 
@@ -911,3 +902,6 @@ TEST(Mesh, Normal) {
     EXPECT_GT(n.dot(e1.cross(e2)), 0);
   }
 }
+
+}  // namespace
+}  // namespace laser_raycast_test

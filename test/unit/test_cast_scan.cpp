@@ -13,6 +13,7 @@
 
 #include "run_command.h"
 
+namespace laser_raycast_test {
 namespace {
 
 const std::string kData = std::string(LASER_RAYCAST_SOURCE_DIR) + "/test/data/";
@@ -27,8 +28,7 @@ struct CliRun {
 
 CliRun runCli(const std::string& args) {
   const std::string err_file = ::testing::TempDir() + "cast_scan_stderr.txt";
-  const auto result =
-      laser_raycast_test::runCommand(std::string(CAST_SCAN_PATH) + " " + args + " 2>" + err_file);
+  const auto result = runCommand(std::string(CAST_SCAN_PATH) + " " + args + " 2>" + err_file);
   CliRun run;
   run.status = result.status;
   run.out = result.output;
@@ -302,3 +302,4 @@ TEST(CastScan, BadSceneExitsThree) {
 }
 
 }  // namespace
+}  // namespace laser_raycast_test

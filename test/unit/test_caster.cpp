@@ -18,13 +18,10 @@
 #include "laser_raycast/core/fan_slicer.h"
 #include "laser_raycast/core/pose.h"
 
-using namespace laser_raycast::core;
-using laser_raycast::test::expectMentions;
-using laser_raycast::test::fanByIncrement;
-using laser_raycast::test::fanBySamples;
-using laser_raycast::test::invalidMessage;
-
+namespace laser_raycast_test {
 namespace {
+
+using namespace laser_raycast::core;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
@@ -362,8 +359,6 @@ bool onTriangle(const Mesh& mesh, int triangle, const Eigen::Vector3d& p, double
   return u >= -tol && v >= -tol && u + v <= 1 + tol;
 }
 
-}  // namespace
-
 // -------------------------------------------------------------------------------------------------
 // Hand formulas
 
@@ -434,8 +429,6 @@ TEST(Caster, BoxPrimitiveRoomMatchesHandFormula) {
   }
 }
 
-namespace {
-
 // Nearest root >= tmin of |o + t w - c|^2 = r^2 (hand formula), or +inf; *disc receives the
 // discriminant so that callers can skip near-silhouette beams.
 double sphereRange(const Eigen::Vector3d& o, const Eigen::Vector3d& w, const Eigen::Vector3d& c,
@@ -489,8 +482,6 @@ double cylinderRange(const Eigen::Vector3d& o, const Eigen::Vector3d& w,
   }
   return best;
 }
-
-}  // namespace
 
 // A sphere and an upright cylinder at known places (primitives), planar and 3D; beams within a
 // small margin of a silhouette are skipped, where the range is ill-conditioned.
@@ -617,8 +608,6 @@ TEST(Caster, TiltedCylinder) {
 // -------------------------------------------------------------------------------------------------
 // Planar fast path against the per-beam path
 
-namespace {
-
 // Bearings (sensor frame, rad) where the scan plane crosses a mesh edge: the silhouettes of the
 // slices, near which hit/miss is decided by rounding and the two paths may legitimately differ.
 std::vector<double> sliceBearings(const Scene& scene, const FramePoses& poses,
@@ -654,8 +643,6 @@ double angularDistance(double a, const std::vector<double>& sorted) {
   }
   return best;
 }
-
-}  // namespace
 
 // Random scenes (closed spheres, boxes, triangle soups, a room, primitives) at random poses, random
 // sensor poses (tilted, so the scan plane cuts the meshes obliquely) and random fans, with and
@@ -747,8 +734,6 @@ TEST(Caster, FastPathMatchesGeneralPath) {
 // -------------------------------------------------------------------------------------------------
 // Watertightness of the fast path
 
-namespace {
-
 int misses(const ScanResult& r) {
   int n = 0;
   for (const double t : r.range) n += !std::isfinite(t);
@@ -768,8 +753,6 @@ std::vector<int> crossingsPerBeam(const Mesh& mesh, const Eigen::Isometry3d& wor
             DepthBuffer{&range, &body, &triangle, &crossings});
   return crossings;
 }
-
-}  // namespace
 
 // Closed meshes with a vertex row exactly at the sensor's height: the scan plane runs through rows
 // of vertices and along horizontal edges. From inside, every beam must hit, for many fans and
@@ -1188,8 +1171,6 @@ TEST(Caster, FramePosesSizeMismatchThrows) {
 // -------------------------------------------------------------------------------------------------
 // Far from the origin
 
-namespace {
-
 struct FarScene {
   Scene scene;
   FramePoses poses;
@@ -1226,8 +1207,6 @@ void translateAll(FarScene* s, const Eigen::Vector3d& offset) {
   for (auto& p : s->poses.pose) p.pretranslate(offset);
   s->sensor.pretranslate(offset);
 }
-
-}  // namespace
 
 // The same scene and sensor moved 10^6 m away (frame poses and sensor pose alike) give the same
 // ranges. With dyadic coordinates the translated poses are exact, so any difference would be the
@@ -1271,8 +1250,6 @@ TEST(Caster, FarFromOriginGivesSameRanges) {
 // -------------------------------------------------------------------------------------------------
 // Reuse
 
-namespace {
-
 void expectSameResult(const ScanResult& a, const ScanResult& b) {
   ASSERT_EQ(a.range.size(), b.range.size());
   for (std::size_t i = 0; i < a.range.size(); ++i) {
@@ -1282,8 +1259,6 @@ void expectSameResult(const ScanResult& a, const ScanResult& b) {
   EXPECT_EQ(a.triangle, b.triangle);
   EXPECT_EQ(a.cos_incidence, b.cos_incidence);
 }
-
-}  // namespace
 
 // Casting again with nothing moved returns the previous result (stats.reused); any change that can
 // alter the result (a frame, the sensor, validity, config, pattern, the scene) recomputes.
@@ -1612,3 +1587,6 @@ TEST(CastConfig, ValidateNamesFieldAndValue) {
                            ScanPattern(fanBySamples(-1, 1, 3)), c),
                std::invalid_argument);
 }
+
+}  // namespace
+}  // namespace laser_raycast_test

@@ -18,11 +18,10 @@
 #include "laser_raycast/core/primitives.h"
 #include "test_geometry.h"
 
-namespace laser_raycast {
-namespace core {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
+using namespace laser_raycast::core;
 using Eigen::Vector3d;
 using L = long double;
 using Vec3L = Eigen::Matrix<L, 3, 1>;
@@ -191,14 +190,13 @@ TEST(BoxIntersect, RandomRaysMatchFaceEnumeration) {
   std::mt19937 rng(41);
   int hits = 0, checked = 0;
   for (int i = 0; i < 20000; ++i) {
-    const Vector3d size(lt::logUniform(rng, -2, 2), lt::logUniform(rng, -2, 2),
-                        lt::logUniform(rng, -2, 2));
+    const Vector3d size(logUniform(rng, -2, 2), logUniform(rng, -2, 2), logUniform(rng, -2, 2));
     const double extent = size.maxCoeff();
     // Half the origins inside the box, half outside; aimed near the box.
     const Vector3d origin =
-        i % 2 ? lt::uniformInBox(rng, -size / 2, size / 2) : lt::uniformInCube(rng, 3 * extent);
-    const Vector3d target = lt::uniformInBox(rng, -0.7 * size, 0.7 * size);
-    const Ray ray = makeRay(origin, (target - origin) * lt::logUniform(rng, -2, 2));
+        i % 2 ? uniformInBox(rng, -size / 2, size / 2) : uniformInCube(rng, 3 * extent);
+    const Vector3d target = uniformInBox(rng, -0.7 * size, 0.7 * size);
+    const Ray ray = makeRay(origin, (target - origin) * logUniform(rng, -2, 2));
     L t;
     Vector3d normal;
     if (!boxTruth(size, ray, &t, &normal)) continue;
@@ -360,22 +358,21 @@ TEST(CylinderIntersect, TiltedCylindersMatchAWorldFrameClosedForm) {
   std::mt19937 rng(43);
   int hits = 0, checked = 0, cap_hits = 0;
   for (int i = 0; i < 20000; ++i) {
-    const double radius = lt::logUniform(rng, -2, 1);
-    const double length = lt::logUniform(rng, -2, 1);
+    const double radius = logUniform(rng, -2, 1);
+    const double length = logUniform(rng, -2, 1);
     const Cylinder cylinder{radius, length};
-    const Eigen::Isometry3d world_from_cylinder = lt::randomPose(rng, 10.0);
+    const Eigen::Isometry3d world_from_cylinder = randomPose(rng, 10.0);
     const double extent = radius + length;
     // Origins outside (mostly) and inside; aimed near the cylinder.
-    const Vector3d local_origin = i % 4 == 0 ? Vector3d(lt::uniform(rng, -0.7, 0.7) * radius,
-                                                        lt::uniform(rng, -0.7, 0.7) * radius,
-                                                        lt::uniform(rng, -0.5, 0.5) * length)
-                                             : Vector3d(lt::uniformInCube(rng, 3 * extent));
-    const Vector3d local_target(lt::uniform(rng, -1.3, 1.3) * radius,
-                                lt::uniform(rng, -1.3, 1.3) * radius,
-                                lt::uniform(rng, -0.7, 0.7) * length);
+    const Vector3d local_origin =
+        i % 4 == 0 ? Vector3d(uniform(rng, -0.7, 0.7) * radius, uniform(rng, -0.7, 0.7) * radius,
+                              uniform(rng, -0.5, 0.5) * length)
+                   : Vector3d(uniformInCube(rng, 3 * extent));
+    const Vector3d local_target(uniform(rng, -1.3, 1.3) * radius, uniform(rng, -1.3, 1.3) * radius,
+                                uniform(rng, -0.7, 0.7) * length);
     const Vector3d origin = world_from_cylinder * local_origin;
     const Vector3d dir =
-        world_from_cylinder.linear() * (local_target - local_origin) * lt::logUniform(rng, -1, 1);
+        world_from_cylinder.linear() * (local_target - local_origin) * logUniform(rng, -1, 1);
     const Ray world_ray = makeRay(origin, dir);
 
     const Eigen::Matrix<L, 3, 3> rotation = world_from_cylinder.linear().cast<L>();
@@ -461,15 +458,15 @@ L sphereEntryTruth(const Ray& ray, L r) {
 TEST(SphereIntersect, FromAMillionMetresAway) {
   std::mt19937 rng(47);
   for (int i = 0; i < 5000; ++i) {
-    const double r = lt::logUniform(rng, -2, 1);
-    const Vector3d n = lt::randomUnitVector(rng);
+    const double r = logUniform(rng, -2, 1);
+    const Vector3d n = randomUnitVector(rng);
     Vector3d w;
     do {
-      w = lt::randomUnitVector(rng);
+      w = randomUnitVector(rng);
     } while (w.dot(n) > -0.2);
     const Vector3d entry = r * n;
-    const double distance = 1e6 * lt::uniform(rng, 1, 2);
-    const Ray ray = makeRay(entry - distance * w, w * lt::logUniform(rng, -1, 1));
+    const double distance = 1e6 * uniform(rng, 1, 2);
+    const Ray ray = makeRay(entry - distance * w, w * logUniform(rng, -1, 1));
     const L t = sphereEntryTruth(ray, r);
     // The construction itself: the entry point is where the ray enters, to ~1e-10 m.
     ASSERT_NEAR(double(t * ray.dir.cast<L>().norm()), distance, 1e-6);
@@ -490,13 +487,12 @@ TEST(SphereIntersect, RandomRaysMatchTheClosedForm) {
   std::mt19937 rng(53);
   int hits = 0, checked = 0;
   for (int i = 0; i < 20000; ++i) {
-    const double r = lt::logUniform(rng, -2, 2);
+    const double r = logUniform(rng, -2, 2);
     const Vector3d origin =
-        i % 3 == 0
-            ? Vector3d(0.9 * r * std::cbrt(lt::uniform(rng, 0, 1)) * lt::randomUnitVector(rng))
-            : Vector3d(lt::uniformInCube(rng, 10 * r));
-    const Vector3d target = lt::uniformInCube(rng, 1.3 * r);
-    const Ray ray = makeRay(origin, (target - origin) * lt::logUniform(rng, -2, 2));
+        i % 3 == 0 ? Vector3d(0.9 * r * std::cbrt(uniform(rng, 0, 1)) * randomUnitVector(rng))
+                   : Vector3d(uniformInCube(rng, 10 * r));
+    const Vector3d target = uniformInCube(rng, 1.3 * r);
+    const Ray ray = makeRay(origin, (target - origin) * logUniform(rng, -2, 2));
     // Truth: the roots of |o + t d|^2 = r^2 with the cancellation-free discriminant, long double.
     const Vec3L o = ray.origin.cast<L>(), d = ray.dir.cast<L>();
     const L a = d.squaredNorm();
@@ -545,8 +541,8 @@ TEST(PrimitiveNormals, UnitOutwardAndFacingTheRightWay) {
   int counted[3] = {0, 0, 0};
   for (int i = 0; i < 30000; ++i) {
     const int shape = i % 3;
-    const Vector3d origin = lt::uniformInCube(rng, 3);
-    const Ray ray = makeRay(origin, lt::uniformInCube(rng, 1) - origin);
+    const Vector3d origin = uniformInCube(rng, 3);
+    const Ray ray = makeRay(origin, uniformInCube(rng, 1) - origin);
     const auto hit = shape == 0   ? intersect(ray, box)
                      : shape == 1 ? intersect(ray, cylinder)
                                   : intersect(ray, sphere);
@@ -588,24 +584,24 @@ TEST(PrimitiveClosedSurfaces, RaysFromInsideAimedAtEdgesAlwaysHit) {
     const int shape = i % 3;
     Vector3d origin, target;
     if (shape == 0) {
-      origin = lt::uniformInBox(rng, -0.45 * box.size, 0.45 * box.size);
+      origin = uniformInBox(rng, -0.45 * box.size, 0.45 * box.size);
       // A corner, or a point of an edge: two coordinates on their faces, one anywhere.
       const Vector3d h = box.size / 2;
       target =
           Vector3d(i % 2 ? h.x() : -h.x(), i % 4 < 2 ? h.y() : -h.y(), i % 8 < 4 ? h.z() : -h.z());
       const int free_axis = (i / 8) % 4;  // 3: the corner itself
-      if (free_axis < 3) target[free_axis] = lt::uniform(rng, -h[free_axis], h[free_axis]);
+      if (free_axis < 3) target[free_axis] = uniform(rng, -h[free_axis], h[free_axis]);
     } else if (shape == 1) {
       const double r = cylinder.radius, h = cylinder.length / 2;
-      origin = Vector3d(0.6 * r * lt::uniform(rng, -1, 1), 0.6 * r * lt::uniform(rng, -1, 1),
-                        0.9 * h * lt::uniform(rng, -1, 1));
-      const double angle = lt::uniform(rng, -M_PI, M_PI);
+      origin = Vector3d(0.6 * r * uniform(rng, -1, 1), 0.6 * r * uniform(rng, -1, 1),
+                        0.9 * h * uniform(rng, -1, 1));
+      const double angle = uniform(rng, -M_PI, M_PI);
       target = Vector3d(r * std::cos(angle), r * std::sin(angle), i % 2 ? h : -h);
     } else {
-      origin = 0.9 * sphere.radius * std::cbrt(lt::uniform(rng, 0, 1)) * lt::randomUnitVector(rng);
-      target = sphere.radius * lt::randomUnitVector(rng);
+      origin = 0.9 * sphere.radius * std::cbrt(uniform(rng, 0, 1)) * randomUnitVector(rng);
+      target = sphere.radius * randomUnitVector(rng);
     }
-    const Ray ray = makeRay(origin, (target - origin) * lt::logUniform(rng, -1, 1));
+    const Ray ray = makeRay(origin, (target - origin) * logUniform(rng, -1, 1));
     const auto hit = shape == 0   ? intersect(ray, box)
                      : shape == 1 ? intersect(ray, cylinder)
                                   : intersect(ray, sphere);
@@ -686,5 +682,4 @@ TEST(PrimitiveValidate, RejectsZeroNegativeAndNonFiniteSizesNamingTheDimension) 
 }
 
 }  // namespace
-}  // namespace core
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

@@ -14,11 +14,10 @@
 #include "laser_raycast/core/scan_encoder.h"
 #include "laser_raycast/core/scan_spec.h"
 
-using namespace laser_raycast::core;
-using laser_raycast::test::expectMentions;
-using laser_raycast::test::invalidMessage;
-
+namespace laser_raycast_test {
 namespace {
+
+using namespace laser_raycast::core;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
@@ -58,8 +57,6 @@ ScanResult uniformResult(int n, double range, bool with_incidence = false) {
 }
 
 bool sameFloat(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
-
-}  // namespace
 
 // -------------------------------------------------------------------------------------------------
 // classifyRange
@@ -432,3 +429,6 @@ TEST(ScanEncoder, IntensityFromCaster) {
   EXPECT_NEAR(out.intensities[2], 0.4, 1e-7);
   EXPECT_NEAR(out.ranges[0], 6.0, 1e-6);
 }
+
+}  // namespace
+}  // namespace laser_raycast_test

@@ -12,13 +12,10 @@
 #include "fan_specs.h"
 #include "laser_raycast/core/scan_pattern.h"
 
-using namespace laser_raycast::core;
-using laser_raycast::test::expectMentions;
-using laser_raycast::test::fanByIncrement;
-using laser_raycast::test::fanBySamples;
-using laser_raycast::test::invalidMessage;
-
+namespace laser_raycast_test {
 namespace {
+
+using namespace laser_raycast::core;
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -33,8 +30,6 @@ void expectFanInvalid(const FanSpec& fan, const std::vector<std::string>& needle
 double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.x() * b.y() - a.y() * b.x(), a.x() * b.x() + a.y() * b.y());
 }
-
-}  // namespace
 
 // Increment mode: N = round((max - min) / increment) + 1, beams from angle_min spaced by the
 // increment, including when the span is not a multiple of it (the last beam may pass angle_max).
@@ -211,3 +206,6 @@ TEST(ScanPattern, TooManyBeamsAcrossRings) {
                  }),
                  {"4000000", "3", "10000000"});
 }
+
+}  // namespace
+}  // namespace laser_raycast_test

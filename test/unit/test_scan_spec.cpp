@@ -10,11 +10,10 @@
 #include "expect_invalid.h"
 #include "laser_raycast/core/scan_spec.h"
 
-using namespace laser_raycast::core;
-using laser_raycast::test::expectMentions;
-using laser_raycast::test::invalidMessage;
-
+namespace laser_raycast_test {
 namespace {
+
+using namespace laser_raycast::core;
 
 ScanSpec spec(double range_min, double range_max, MinRangePolicy policy) {
   ScanSpec s;
@@ -90,3 +89,4 @@ TEST(ScanSpec, ValidateNamesTheBadField) {
 }
 
 }  // namespace
+}  // namespace laser_raycast_test

@@ -22,8 +22,10 @@
 #include "laser_raycast/loader/scene_loader.h"
 #include "shared_data.h"
 
-namespace laser_raycast {
+namespace laser_raycast_test {
 namespace {
+
+using namespace laser_raycast;
 
 namespace fs = std::filesystem;
 using Eigen::Vector3d;
@@ -650,7 +652,7 @@ TEST_F(SceneLoaderTest, WithoutAResolverPackageUrisAreAnError) {
 // ---------------------------------------------------------------------------------------------------
 // The real TurtleBot3 data (../shared), counted independently of the loader.
 
-std::string sharedData() { return laser_raycast_test::tb3WorldData(); }
+std::string sharedData() { return tb3WorldData(); }
 
 std::string readText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -778,4 +780,4 @@ TEST_F(SharedDataTest, TurtleBot3Waffle) {
 }
 
 }  // namespace
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

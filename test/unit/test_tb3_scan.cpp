@@ -18,6 +18,7 @@
 #include "laser_raycast/loader/scene_loader.h"
 #include "shared_data.h"
 
+namespace laser_raycast_test {
 namespace {
 
 using laser_raycast::core::CastConfig;
@@ -112,7 +113,7 @@ class Tb3Scan : public ::testing::Test {
  protected:
   void SetUp() override {
     REQUIRE_SHARED_DATA();
-    const std::string dir = laser_raycast_test::tb3WorldData();
+    const std::string dir = tb3WorldData();
     laser_raycast::SceneLoader loader(
         [dir](const std::string& package) -> std::optional<std::string> {
           if (package == "tb3_world_data") return dir;
@@ -189,3 +190,4 @@ TEST_F(Tb3Scan, TiltedRingsMatchTheGeometry) {
 }
 
 }  // namespace
+}  // namespace laser_raycast_test

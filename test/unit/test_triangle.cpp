@@ -18,11 +18,10 @@
 #include "laser_raycast/core/triangle.h"
 #include "test_geometry.h"
 
-namespace laser_raycast {
-namespace core {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
+using namespace laser_raycast::core;
 using Eigen::Vector3d;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -92,9 +91,9 @@ std::string describe(const char* what, const Vector3d& a, const Vector3d& b, con
 void randomWellShapedTriangle(std::mt19937& rng, const Vector3d& center, double size, Vector3d* a,
                               Vector3d* b, Vector3d* c) {
   for (;;) {
-    *a = center + lt::uniformInCube(rng, size);
-    *b = center + lt::uniformInCube(rng, size);
-    *c = center + lt::uniformInCube(rng, size);
+    *a = center + uniformInCube(rng, size);
+    *b = center + uniformInCube(rng, size);
+    *c = center + uniformInCube(rng, size);
     const double longest =
         std::max({(*b - *a).squaredNorm(), (*c - *b).squaredNorm(), (*a - *c).squaredNorm()});
     if ((*b - *a).cross(*c - *a).norm() >= 0.1 * longest) return;
@@ -114,8 +113,8 @@ struct AimedCase {
 
 AimedCase makeAimedCase(std::mt19937& rng, const Eigen::Vector2d& uv) {
   AimedCase k;
-  const double scale = lt::logUniform(rng, -3, 3);
-  const Vector3d center = lt::uniformInCube(rng, 2 * scale);
+  const double scale = logUniform(rng, -3, 3);
+  const Vector3d center = uniformInCube(rng, 2 * scale);
   randomWellShapedTriangle(rng, center, scale, &k.a, &k.b, &k.c);
   k.u = uv[0];
   k.v = uv[1];
@@ -123,10 +122,10 @@ AimedCase makeAimedCase(std::mt19937& rng, const Eigen::Vector2d& uv) {
   const Vector3d n = (k.b - k.a).cross(k.c - k.a).normalized();
   Vector3d w;
   do {
-    w = lt::randomUnitVector(rng);
+    w = randomUnitVector(rng);
   } while (std::abs(w.dot(n)) < 0.3);
-  const double dist = scale * lt::uniform(rng, 0.2, 5.0);
-  const double dir_scale = lt::logUniform(rng, -2, 2);  // t is in units of |dir|
+  const double dist = scale * uniform(rng, 0.2, 5.0);
+  const double dir_scale = logUniform(rng, -2, 2);  // t is in units of |dir|
   k.origin = p - dist * w;
   k.dir = dir_scale * w;
   k.t = dist / dir_scale;
@@ -137,7 +136,7 @@ AimedCase makeAimedCase(std::mt19937& rng, const Eigen::Vector2d& uv) {
 // Barycentrics uniform over the part of the triangle at least `margin` inside every edge.
 Eigen::Vector2d randomInsideBarycentrics(std::mt19937& rng, double margin) {
   for (;;) {
-    const Eigen::Vector2d uv = lt::randomBarycentrics(rng);
+    const Eigen::Vector2d uv = randomBarycentrics(rng);
     if (std::min({uv[0], uv[1], 1 - uv[0] - uv[1]}) >= margin) return uv;
   }
 }
@@ -145,7 +144,7 @@ Eigen::Vector2d randomInsideBarycentrics(std::mt19937& rng, double margin) {
 // Barycentrics of a point in the triangle's plane, outside by at least `margin` across some edge.
 Eigen::Vector2d randomOutsideBarycentrics(std::mt19937& rng, double margin) {
   for (;;) {
-    const Eigen::Vector2d uv(lt::uniform(rng, -2, 3), lt::uniform(rng, -2, 3));
+    const Eigen::Vector2d uv(uniform(rng, -2, 3), uniform(rng, -2, 3));
     if (std::min({uv[0], uv[1], 1 - uv[0] - uv[1]}) <= -margin) return uv;
   }
 }
@@ -331,19 +330,19 @@ TYPED_TEST(TriangleRandom, RaysParallelToThePlaneMiss) {
   std::mt19937 rng(19);
   for (int i = 0; i < 3000; ++i) {
     const int axis = i % 3;
-    const double scale = lt::logUniform(rng, -3, 3);
-    const double plane = lt::uniform(rng, -2, 2) * scale;
+    const double scale = logUniform(rng, -3, 3);
+    const double plane = uniform(rng, -2, 2) * scale;
     Vector3d a, b, c;
     randomWellShapedTriangle(rng, Vector3d::Zero(), scale, &a, &b, &c);
     a[axis] = b[axis] = c[axis] = plane;
     if (isDegenerateTriangle(a, b, c)) continue;
     const Eigen::Vector2d uv = randomInsideBarycentrics(rng, 0.01);
     const Vector3d target = (1 - uv[0] - uv[1]) * a + uv[0] * b + uv[1] * c;
-    Vector3d dir = lt::randomUnitVector(rng) * lt::logUniform(rng, -2, 2);
+    Vector3d dir = randomUnitVector(rng) * logUniform(rng, -2, 2);
     dir[axis] = 0;
     // In the plane, through the triangle; or off the plane by a random offset.
-    const double offset = (i / 3) % 2 == 0 ? 0.0 : lt::uniform(rng, -1, 1) * scale;
-    Vector3d origin = target - lt::uniform(rng, 0.5, 5) * dir;
+    const double offset = (i / 3) % 2 == 0 ? 0.0 : uniform(rng, -1, 1) * scale;
+    Vector3d origin = target - uniform(rng, 0.5, 5) * dir;
     origin[axis] = plane + offset;
     const RayT<T> ray = makeRay<T>(origin, dir);
     ASSERT_EQ(ray.dir[axis], T(0));
@@ -369,18 +368,18 @@ TYPED_TEST(TriangleRandom, MethodsAgreeAwayFromEdges) {
   int checked = 0, expected_hits = 0;
   constexpr int kCases = 20000;
   for (int i = 0; i < kCases; ++i) {
-    const double scale = lt::logUniform(rng, -3, 3);
-    const Vector3d center = lt::uniformInCube(rng, 2 * scale);
+    const double scale = logUniform(rng, -3, 3);
+    const Vector3d center = uniformInCube(rng, 2 * scale);
     Vector3d a, b, c;
     randomWellShapedTriangle(rng, center, scale, &a, &b, &c);
     // Aim near the triangle (about a third of the aimed points are inside it), off the plane by up
     // to a fifth of its size; reverse one ray in five so that the triangle is behind the origin.
-    const Vector3d origin = center + lt::uniformInCube(rng, 4 * scale);
-    const double u_aim = lt::uniform(rng, -0.3, 1), v_aim = lt::uniform(rng, -0.3, 1);
+    const Vector3d origin = center + uniformInCube(rng, 4 * scale);
+    const double u_aim = uniform(rng, -0.3, 1), v_aim = uniform(rng, -0.3, 1);
     const Vector3d target =
-        (1 - u_aim - v_aim) * a + u_aim * b + v_aim * c + lt::uniformInCube(rng, 0.2 * scale);
+        (1 - u_aim - v_aim) * a + u_aim * b + v_aim * c + uniformInCube(rng, 0.2 * scale);
     const double sign = i % 5 == 0 ? -1 : 1;
-    const Vector3d dir = sign * (target - origin) * lt::logUniform(rng, -2, 2);
+    const Vector3d dir = sign * (target - origin) * logUniform(rng, -2, 2);
     const RayT<T> ray = makeRay<T>(origin, dir);
     const Vec3<T> at = a.cast<T>(), bt = b.cast<T>(), ct = c.cast<T>();
 
@@ -445,7 +444,7 @@ TYPED_TEST(TriangleRandom, TemplateAndRuntimeEntryPointsAgree) {
   using T = TypeParam;
   std::mt19937 rng(29);
   for (int i = 0; i < 500; ++i) {
-    const Eigen::Vector2d uv(lt::uniform(rng, -0.5, 1.5), lt::uniform(rng, -0.5, 1.5));
+    const Eigen::Vector2d uv(uniform(rng, -0.5, 1.5), uniform(rng, -0.5, 1.5));
     const AimedCase k = makeAimedCase(rng, uv);
     const RayT<T> ray = makeRay<T>(k.origin, k.dir);
     const Vec3<T> a = k.a.cast<T>(), b = k.b.cast<T>(), c = k.c.cast<T>();
@@ -544,14 +543,14 @@ TYPED_TEST(TriangleLiteral, DegenerateTrianglesNeverHit) {
     // Targets on the segment (the vertices, midpoints, and random points between the extremes).
     std::vector<Vector3d> targets = {a, b, c, (a + b) / 2, (b + c) / 2, (a + c) / 2};
     for (int i = 0; i < 20; ++i) {
-      const double s = lt::uniform(rng, 0, 1);
+      const double s = uniform(rng, 0, 1);
       targets.push_back((1 - s) * a + s * c);
       targets.push_back((1 - s) * a + s * b);
     }
     std::vector<std::pair<Vector3d, Vector3d>> rays;  // origin, dir
     for (const Vector3d& target : targets) {
       for (int i = 0; i < 10; ++i) {
-        const Vector3d dir = lt::randomUnitVector(rng);
+        const Vector3d dir = randomUnitVector(rng);
         rays.emplace_back(target - 3 * dir, dir);
       }
       rays.emplace_back(target - Vector3d(0, 0, 1), Vector3d(0, 0, 1));  // axis-aligned
@@ -563,7 +562,7 @@ TYPED_TEST(TriangleLiteral, DegenerateTrianglesNeverHit) {
     rays.emplace_back(a + 5 * line, -line);
     rays.emplace_back(a, Vector3d(0, 1, 0));
     for (int i = 0; i < 50; ++i) {
-      rays.emplace_back(lt::uniformInCube(rng, 5), lt::randomUnitVector(rng));
+      rays.emplace_back(uniformInCube(rng, 5), randomUnitVector(rng));
     }
 
     for (const auto& r : rays) {
@@ -735,5 +734,4 @@ TYPED_TEST(TriangleLiteral, SeedUvUsesTheCorrectedSignOfV) {
 }
 
 }  // namespace
-}  // namespace core
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test

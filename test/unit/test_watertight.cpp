@@ -25,11 +25,10 @@
 #include "laser_raycast/core/triangle.h"
 #include "test_geometry.h"
 
-namespace laser_raycast {
-namespace core {
+namespace laser_raycast_test {
 namespace {
 
-namespace lt = laser_raycast::test;
+using namespace laser_raycast::core;
 using Eigen::Vector3d;
 using Triangles = std::vector<std::array<std::uint32_t, 3>>;
 
@@ -83,7 +82,7 @@ class PrintTotalTable : public ::testing::Environment {
 // A closed convex mesh in world coordinates with a region well inside it for ray origins.
 struct ClosedMesh {
   std::string name;
-  lt::TriMesh mesh;
+  TriMesh mesh;
   Vector3d center;
   double radius;  // about the distance from center to the surface, for choosing origins
   std::function<bool(const Vector3d&)> is_interior;
@@ -97,14 +96,14 @@ ClosedMesh icosphere(int level, double scale, const Eigen::Isometry3d& pose) {
   std::ostringstream name;
   name << "icosphere L" << level << " scale " << scale << " at " << pose.translation().transpose();
   m.name = name.str();
-  m.mesh = lt::transformed(lt::makeIcosphere(level), scale, pose);
+  m.mesh = transformed(makeIcosphere(level), scale, pose);
   m.center = pose.translation();
   m.radius = scale;
   const Eigen::Isometry3d inverse = pose.inverse();
   m.is_interior = [=](const Vector3d& p) { return (inverse * p).norm() < 0.7 * scale; };
   m.sample_interior = [=](std::mt19937& rng) {
-    const double r = 0.7 * scale * std::cbrt(lt::uniform(rng, 0, 1));
-    return Vector3d(pose * (r * lt::randomUnitVector(rng)));
+    const double r = 0.7 * scale * std::cbrt(uniform(rng, 0, 1));
+    return Vector3d(pose * (r * randomUnitVector(rng)));
   };
   return m;
 }
@@ -117,7 +116,7 @@ ClosedMesh boxRoom(const Vector3d& size, int cells, double scale, const Eigen::I
   name << "box room " << size.transpose() << " cells " << cells << " scale " << scale << " at "
        << pose.translation().transpose();
   m.name = name.str();
-  m.mesh = lt::transformed(lt::makeBoxRoom(size, cells), scale, pose);
+  m.mesh = transformed(makeBoxRoom(size, cells), scale, pose);
   m.center = pose.translation();
   m.radius = 0.5 * scale * size.maxCoeff();
   const Vector3d inner_half = 0.45 * scale * size;
@@ -126,7 +125,7 @@ ClosedMesh boxRoom(const Vector3d& size, int cells, double scale, const Eigen::I
     return ((inverse * p).cwiseAbs().array() < inner_half.array()).all();
   };
   m.sample_interior = [=](std::mt19937& rng) {
-    return Vector3d(pose * lt::uniformInBox(rng, -inner_half, inner_half));
+    return Vector3d(pose * uniformInBox(rng, -inner_half, inner_half));
   };
   return m;
 }
@@ -170,15 +169,15 @@ std::vector<AimedRay> aimedRays(const ClosedMesh& m, int random_origins, std::mt
   std::vector<AimedRay> rays;
   std::vector<Vector3d> origins = {m.center};
   for (int k = 0; k < random_origins; ++k) origins.push_back(m.sample_interior(rng));
-  const auto edges = lt::uniqueEdges(m.mesh);
+  const auto edges = uniqueEdges(m.mesh);
   for (const Vector3d& origin : origins) {
     for (std::uint32_t v = 0; v < m.mesh.vertices.size(); ++v) {
-      rays.push_back({origin, v, v, 0.0, lt::logUniform(rng, -1, 1)});
+      rays.push_back({origin, v, v, 0.0, logUniform(rng, -1, 1)});
     }
     for (const auto& e : edges) {
-      rays.push_back({origin, e[0], e[1], 0.5, lt::logUniform(rng, -1, 1)});
+      rays.push_back({origin, e[0], e[1], 0.5, logUniform(rng, -1, 1)});
       for (int k = 0; k < 2; ++k) {
-        rays.push_back({origin, e[0], e[1], lt::uniform(rng, 0, 1), lt::logUniform(rng, -1, 1)});
+        rays.push_back({origin, e[0], e[1], uniform(rng, 0, 1), logUniform(rng, -1, 1)});
       }
     }
   }
@@ -188,7 +187,7 @@ std::vector<AimedRay> aimedRays(const ClosedMesh& m, int random_origins, std::mt
       const Vector3d u(code % 3 - 1, code / 3 % 3 - 1, code / 9 - 1);
       if (u.dot(vertex - m.center) <= 0) continue;  // origin = vertex - k u must be inside
       for (int attempt = 0; attempt < 8; ++attempt) {
-        const Vector3d origin = vertex - lt::uniform(rng, 0, 2 * m.radius) * u;
+        const Vector3d origin = vertex - uniform(rng, 0, 2 * m.radius) * u;
         if (m.is_interior(origin)) {
           rays.push_back({origin, v, v, 0.0, 1.0});
           break;
@@ -290,7 +289,7 @@ void runClosedMeshes(const std::string& title, const std::vector<ClosedMesh>& me
   long axis_aligned = 0, with_zero_component = 0;
   for (std::size_t k = 0; k < meshes.size(); ++k) {
     const ClosedMesh& m = meshes[k];
-    ASSERT_TRUE(lt::isClosedAndConsistentlyWound(m.mesh)) << m.name;
+    ASSERT_TRUE(isClosedAndConsistentlyWound(m.mesh)) << m.name;
     std::vector<Eigen::Vector3f> vertices_f;
     for (const Vector3d& v : m.mesh.vertices) vertices_f.push_back(v.cast<float>());
     for (const AimedRay& aim : aimedRays(m, random_origins[k], rng)) {
@@ -339,31 +338,31 @@ void runClosedMeshes(const std::string& title, const std::vector<ClosedMesh>& me
 
 TEST(ClosedMeshGeometry, IcosphereIsClosedConvexAndOutward) {
   for (int level = 0; level <= 4; ++level) {
-    const lt::TriMesh m = lt::makeIcosphere(level);
+    const TriMesh m = makeIcosphere(level);
     const std::size_t four_l = std::size_t(1) << (2 * level);
     EXPECT_EQ(m.vertices.size(), 10 * four_l + 2) << level;
     EXPECT_EQ(m.triangles.size(), 20 * four_l) << level;
-    EXPECT_EQ(lt::uniqueEdges(m).size(), 30 * four_l) << level;
-    EXPECT_TRUE(lt::isClosedAndConsistentlyWound(m)) << level;
+    EXPECT_EQ(uniqueEdges(m).size(), 30 * four_l) << level;
+    EXPECT_TRUE(isClosedAndConsistentlyWound(m)) << level;
     for (const Vector3d& v : m.vertices) EXPECT_NEAR(v.norm(), 1.0, 1e-15) << level;
-    const double volume = lt::signedVolume(m);
+    const double volume = signedVolume(m);
     EXPECT_GT(volume, 0.6 * 4 / 3 * M_PI) << level;  // the icosahedron holds 61% of the ball
     EXPECT_LT(volume, 4 / 3.0 * M_PI) << level;
-    EXPECT_LT(lt::maxConvexityViolation(m), 1e-12) << level;
+    EXPECT_LT(maxConvexityViolation(m), 1e-12) << level;
   }
 }
 
 TEST(ClosedMeshGeometry, BoxRoomIsClosedConvexAndOutward) {
   for (const int cells : {1, 2, 3, 4, 8}) {
     const Vector3d size(4, 3, 2.5);
-    const lt::TriMesh m = lt::makeBoxRoom(size, cells);
+    const TriMesh m = makeBoxRoom(size, cells);
     EXPECT_EQ(m.vertices.size(), std::size_t((cells + 1) * (cells + 1) * (cells + 1) -
                                              (cells - 1) * (cells - 1) * (cells - 1)))
         << cells;
     EXPECT_EQ(m.triangles.size(), std::size_t(12 * cells * cells)) << cells;
-    EXPECT_TRUE(lt::isClosedAndConsistentlyWound(m)) << cells;
-    EXPECT_NEAR(lt::signedVolume(m), 4 * 3 * 2.5, 1e-12) << cells;
-    EXPECT_LT(lt::maxConvexityViolation(m), 1e-12) << cells;
+    EXPECT_TRUE(isClosedAndConsistentlyWound(m)) << cells;
+    EXPECT_NEAR(signedVolume(m), 4 * 3 * 2.5, 1e-12) << cells;
+    EXPECT_LT(maxConvexityViolation(m), 1e-12) << cells;
     for (const Vector3d& v : m.vertices) {
       EXPECT_NEAR((v.cwiseAbs() - 0.5 * size).maxCoeff(), 0.0, 0.0)
           << "on a wall: " << v.transpose();
@@ -386,9 +385,9 @@ TEST(Watertight, RaysFromInsideAnIcosphereNeverEscape) {
       icosphere(1, 1.0, identity),
       icosphere(2, 1.0, identity),
       icosphere(3, 1.0, identity),
-      icosphere(2, 1.0, lt::randomPose(rng, 3.0)),
-      icosphere(2, 1e-3, lt::randomPose(rng, 3e-3)),
-      icosphere(2, 1e3, lt::randomPose(rng, 3e3)),
+      icosphere(2, 1.0, randomPose(rng, 3.0)),
+      icosphere(2, 1e-3, randomPose(rng, 3e-3)),
+      icosphere(2, 1e3, randomPose(rng, 3e3)),
       icosphere(1, 1e3, Eigen::Isometry3d(Eigen::Translation3d(1e3 * off_axis))),
       icosphere(1, 1e-3, Eigen::Isometry3d(Eigen::Translation3d(1e-3 * off_axis))),
   };
@@ -405,12 +404,11 @@ TEST(Watertight, RaysFromInsideABoxRoomNeverEscape) {
       boxRoom(room, 4, 1.0, identity),
       boxRoom(room, 4, 1e-3, identity),
       boxRoom(room, 4, 1e3, identity),
-      boxRoom(room, 3, 1.0, lt::randomPose(rng, 2.0)),
+      boxRoom(room, 3, 1.0, randomPose(rng, 2.0)),
       boxRoom(Vector3d(1, 1, 1), 6, 1.0, identity),
   };
   runClosedMeshes("Watertightness, box rooms:", meshes, {12, 6, 6, 8, 3}, 202, 40000);
 }
 
 }  // namespace
-}  // namespace core
-}  // namespace laser_raycast
+}  // namespace laser_raycast_test
