@@ -14,6 +14,7 @@
 
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/mesh.h"
+#include "random.h"
 #include "stress_report.h"
 
 namespace laser_raycast_test {
@@ -36,7 +37,7 @@ constexpr double kTinyScale = 1e-155;
 // dyadic points: b - a = (c - a) / 2 exactly); the rounded third point of the fourth is off the
 // line by rounding, so that triangle is a needle of area ~1e-17 rather than zero. The tiny one is
 // well shaped but ~1e-155 m across, so its edge functions are subnormal and 1 / det overflows.
-std::array<Vector3d, 3> degenerate(Kind kind, std::mt19937& rng) {
+std::array<Vector3d, 3> degenerate(Kind kind, Rng& rng) {
   const auto dyadic = [&] { return Vector3d((uniformInCube(rng, 1.0) * 64).array().round() / 64); };
   std::array<Vector3d, 3> v;
   switch (kind) {
@@ -76,8 +77,7 @@ struct KindTally {
 // Rays at the vertices, edge midpoints and centroid (the tiny kind: three points well inside, so
 // that each must hit at t = 1, as the direction is target - origin).
 template <TriangleMethod M, typename T>
-void castDegenerate(Kind kind, const std::array<Vector3d, 3>& tri, std::mt19937& rng,
-                    KindTally* tally) {
+void castDegenerate(Kind kind, const std::array<Vector3d, 3>& tri, Rng& rng, KindTally* tally) {
   const Vec3<T> a = tri[0].cast<T>(), b = tri[1].cast<T>(), c = tri[2].cast<T>();
   std::vector<Vec3<T>> targets;
   if (kind == kTiny) {
@@ -106,12 +106,12 @@ void castDegenerate(Kind kind, const std::array<Vector3d, 3>& tri, std::mt19937&
 TEST(StressDegenerate, ZeroAreaAndTinyTriangles) {
   std::vector<std::vector<KindTally>> tallies(variants().size(), std::vector<KindTally>(kKinds));
   for (int kind = 0; kind < kKinds; ++kind) {
-    std::mt19937 rng(4300 + kind);
+    Rng rng(4300 + kind);
     for (int n = 0; n < 300; ++n) {
       const auto tri = degenerate(static_cast<Kind>(kind), rng);
       const std::uint32_t seed = rng();
       for (std::size_t vi = 0; vi < variants().size(); ++vi) {
-        std::mt19937 ray_rng(seed);  // the same rays for every variant
+        Rng ray_rng(seed);  // the same rays for every variant
         dispatchVariant(variants()[vi], [&](auto m, auto x) {
           castDegenerate<decltype(m)::value, decltype(x)>(static_cast<Kind>(kind), tri, ray_rng,
                                                           &tallies[vi][kind]);
@@ -170,7 +170,7 @@ TEST(StressDegenerate, WatertightTinyTriangleHitIsFinite) {
 // 4d. Zero-area triangles in a Mesh: kept out of the BVH, never reported by it or by the Caster,
 // and no NaN or Inf range (the room around them is closed, so every beam hits something).
 TEST(StressDegenerate, ZeroAreaTrianglesThroughBvhAndCaster) {
-  std::mt19937 rng(4401);
+  Rng rng(4401);
   TriMesh cloud;
   std::vector<char> zero_area;
   for (int n = 0; n < 400; ++n) {

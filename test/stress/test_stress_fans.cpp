@@ -16,6 +16,7 @@
 #include "laser_raycast/core/fan_slicer.h"
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/core/pose.h"
+#include "random.h"
 #include "stress_report.h"
 
 namespace laser_raycast_test {
@@ -167,7 +168,7 @@ Eigen::Isometry3d yawPose(const Vector3d& at, double yaw) {
 // the beams (corner = 2^k times the beam's own direction, so the beam passes through it without
 // rounding), with a vertex row at z = 0.
 TEST(StressFans, PlanarFansThroughVertexRings) {
-  std::mt19937 rng(1201);
+  Rng rng(1201);
   const std::vector<int> samples = {360, 720, 1000, 1441};
   std::vector<FanCase> cases;
   FanCase sphere{transformed(makeIcosphere(3), 2.0, Eigen::Isometry3d::Identity()), {}, {}};
@@ -215,7 +216,7 @@ TEST(StressFans, PlanarFansThroughVertexRings) {
 // rounding of the sensor pose).
 TEST(StressFans, PlanarFansThroughRealMeshVertices) {
   REQUIRE_SHARED_DATA();
-  std::mt19937 rng(1301);
+  Rng rng(1301);
   const TriMesh mesh = loadSharedMesh("hexagon.dae", 0.8);
   std::vector<Vector3d> top, bottom;
   core::Aabb box;

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
+#include "random.h"
 #include "stress_report.h"
 
 namespace laser_raycast_test {
@@ -127,7 +128,7 @@ struct GrazingGeometry {
 
 // A well-shaped triangle (vertices on a circle of radius 0.6..1, 1.5..2.5 rad apart) in the plane
 // z = 0 of a random frame, and a ray at theta to it aimed at barycentrics (u, v).
-GrazingGeometry grazing(std::mt19937& rng, const Eigen::Isometry3d& frame, double theta,
+GrazingGeometry grazing(Rng& rng, const Eigen::Isometry3d& frame, double theta,
                         const Eigen::Vector2d& target_uv) {
   const Eigen::Matrix<L, 3, 3> r = frame.linear().cast<L>();
   const Vec3L shift = frame.translation().cast<L>();
@@ -150,7 +151,7 @@ GrazingGeometry grazing(std::mt19937& rng, const Eigen::Isometry3d& frame, doubl
 
 // Barycentrics clearly inside (every weight >= 0.1) or clearly outside (one weight in
 // [-0.5, -0.1]).
-Eigen::Vector2d targetBarycentrics(std::mt19937& rng, bool inside) {
+Eigen::Vector2d targetBarycentrics(Rng& rng, bool inside) {
   if (inside) {
     for (;;) {
       const Eigen::Vector2d uv = randomBarycentrics(rng);
@@ -176,7 +177,7 @@ core::Vec3<T> round(const Vec3L& p) {
 std::string kHeader(int k) { return "10^-" + std::to_string(k) + " rad"; }
 
 TEST(StressGrazing, SingleTrianglesDecideAndBoundT) {
-  std::mt19937 rng(3001);
+  Rng rng(3001);
   std::vector<std::vector<GrazingTally>> tallies(variants().size(),
                                                  std::vector<GrazingTally>(kMaxK + 1));
   for (int k = 1; k <= kMaxK; ++k) {
@@ -251,7 +252,7 @@ TEST(StressGrazing, SingleTrianglesDecideAndBoundT) {
 // BVH's boxes are flat, and the ray nearly lies in their faces) and in a random pose. The grazing
 // ray is aimed at least 0.05 inside a triangle of the floor, so it must hit that triangle.
 TEST(StressGrazing, BvhFloorHitsWithBoundedT) {
-  std::mt19937 rng(3101);
+  Rng rng(3101);
   const int cells = 16;
   TriMesh floor;
   for (int i = 0; i <= cells; ++i) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
+#include "random.h"
 #include "stress_report.h"
 
 namespace laser_raycast_test {
@@ -69,7 +70,7 @@ void compareOrders(const Vec3<T>* v, const core::RayT<T>& ray, InvarianceTally* 
 
 // Random triangles: rays at an interior point, a point of an edge, a vertex, and a point outside.
 template <TriangleMethod M, typename T>
-void randomSet(std::mt19937& rng, InvarianceTally* tally) {
+void randomSet(Rng& rng, InvarianceTally* tally) {
   for (int n = 0; n < 2000; ++n) {
     Vec3<T> v[3];
     for (auto& p : v) p = uniformInCube(rng, 1.0).cast<T>();
@@ -92,7 +93,7 @@ void randomSet(std::mt19937& rng, InvarianceTally* tally) {
 // are 0, +-1/2 or +-1, so every step is exact and rays aimed at a vertex or a dyadic point of an
 // edge lie exactly on it (edge functions exactly 0: the tie-break decides).
 template <TriangleMethod M, typename T>
-void exactSet(std::mt19937& rng, InvarianceTally* tally) {
+void exactSet(Rng& rng, InvarianceTally* tally) {
   std::uniform_int_distribution<int> coord(-4, 4), dir(-2, 2), eighth(0, 8), quarter(0, 4),
       along(1, 3), corner(0, 2);
   for (int n = 0; n < 1500; ++n) {
@@ -125,8 +126,8 @@ void exactSet(std::mt19937& rng, InvarianceTally* tally) {
 // A closed icosphere whose every triangle is rotated (b, c, a) or reversed (a, c, b): through the
 // BVH, the closest hit must be the same triangle (its index is kept) at the same t.
 template <TriangleMethod M, typename T>
-void bvhSet(const std::vector<TriMesh>& versions, const std::vector<Vector3d>& origins,
-            std::mt19937& rng, InvarianceTally* tally) {
+void bvhSet(const std::vector<TriMesh>& versions, const std::vector<Vector3d>& origins, Rng& rng,
+            InvarianceTally* tally) {
   std::vector<core::BvhT<T>> bvhs;
   for (const auto& m : versions) bvhs.push_back(core::BvhT<T>::build(m.vertices, m.triangles));
   const auto v = castVertices<T>(versions[0].vertices);
@@ -160,7 +161,7 @@ void bvhSet(const std::vector<TriMesh>& versions, const std::vector<Vector3d>& o
 }
 
 TEST(StressInvariance, VertexOrderDoesNotChangeDecisions) {
-  std::mt19937 rng(7001);
+  Rng rng(7001);
   const TriMesh sphere = transformed(makeIcosphere(2), 1.5, randomPose(rng, 2.0));
   std::vector<TriMesh> versions(3, sphere);
   for (auto& tri : versions[1].triangles) tri = {tri[1], tri[2], tri[0]};
@@ -174,7 +175,7 @@ TEST(StressInvariance, VertexOrderDoesNotChangeDecisions) {
       bvh(variants().size());
   for (std::size_t vi = 0; vi < variants().size(); ++vi) {
     // The same geometry and rays for every variant.
-    std::mt19937 r1(7101), r2(7201), r3(7301);
+    Rng r1(7101), r2(7201), r3(7301);
     dispatchVariant(variants()[vi], [&](auto m, auto x) {
       constexpr TriangleMethod M = decltype(m)::value;
       using T = decltype(x);

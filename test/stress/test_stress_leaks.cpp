@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "laser_raycast/core/mesh.h"
+#include "random.h"
 #include "stress_report.h"
 
 namespace laser_raycast_test {
@@ -48,8 +49,7 @@ core::RayT<T> aimedRay(const Aim& aim, const std::vector<Vec3<T>>& v) {
 // From each origin: every stride-th vertex, and of every stride-th edge its midpoint plus
 // (random_edge_points) random points.
 std::vector<Aim> aimsAtVerticesAndEdges(const TriMesh& mesh, const std::vector<Vector3d>& origins,
-                                        int random_edge_points, std::mt19937& rng,
-                                        std::size_t stride = 1) {
+                                        int random_edge_points, Rng& rng, std::size_t stride = 1) {
   std::vector<Aim> aims;
   const auto edges = uniqueEdges(mesh);
   for (const Vector3d& o : origins) {
@@ -126,7 +126,7 @@ struct InsideCase {
 };
 
 InsideCase icosphereCase(int level, double radius, const Eigen::Isometry3d& pose, int origins,
-                         std::mt19937& rng) {
+                         Rng& rng) {
   InsideCase c{transformed(makeIcosphere(level), radius, pose), {pose.translation()}};
   for (int k = 0; k < origins; ++k) {
     const double r = 0.7 * radius * std::cbrt(uniform(rng, 0, 1));
@@ -136,7 +136,7 @@ InsideCase icosphereCase(int level, double radius, const Eigen::Isometry3d& pose
 }
 
 InsideCase boxRoomCase(const Vector3d& size, int cells, const Eigen::Isometry3d& pose, int origins,
-                       std::mt19937& rng) {
+                       Rng& rng) {
   InsideCase c{transformed(makeBoxRoom(size, cells), 1.0, pose), {pose.translation()}};
   for (int k = 0; k < origins; ++k) {
     c.origins.push_back(pose * uniformInBox(rng, -0.45 * size, 0.45 * size));
@@ -160,7 +160,7 @@ std::vector<std::string> tallyRow(const Variant& v, const LeakTally& t, bool ins
 // order.
 std::vector<LeakTally> runLeakCases(
     const std::vector<InsideCase>& inside,
-    const std::vector<std::pair<TriMesh, std::vector<Aim>>>& outside, std::mt19937& rng) {
+    const std::vector<std::pair<TriMesh, std::vector<Aim>>>& outside, Rng& rng) {
   std::vector<LeakTally> tallies(variants().size());
   auto run_mesh = [&](const TriMesh& mesh, const std::vector<Aim>* inside_aims,
                       const std::vector<Aim>* outside_aims) {
@@ -199,7 +199,7 @@ void expectProductionTight(const std::vector<LeakTally>& tallies) {
 // 1a. Icospheres (their vertex and edge-midpoint coordinates include exact zeros) and box rooms
 // (vertices on grid coordinates, walls in coordinate planes), at the origin and moved.
 TEST(StressLeaks, ConvexClosedMeshesFromInside) {
-  std::mt19937 rng(1001);
+  Rng rng(1001);
   const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
   const std::vector<InsideCase> cases = {
       icosphereCase(1, 1.0, identity, 8, rng),
@@ -235,7 +235,7 @@ class StressRealMeshLeaks : public ::testing::Test {
 
 // Interior points of a convex mesh: random points of its bounds at least `margin` inside every
 // face plane.
-std::vector<Vector3d> convexInterior(const TriMesh& mesh, double margin, int n, std::mt19937& rng) {
+std::vector<Vector3d> convexInterior(const TriMesh& mesh, double margin, int n, Rng& rng) {
   core::Aabb box;
   for (const Vector3d& v : mesh.vertices) box.grow(v);
   const double orientation = signedVolume(mesh) > 0 ? 1.0 : -1.0;
@@ -258,7 +258,7 @@ std::vector<Vector3d> convexInterior(const TriMesh& mesh, double margin, int n, 
 // is a convex prism (rays from inside); the arena wall (a hexagonal ring), the base plate, the LDS
 // and a tyre (non-convex, 14,566 and 21,672 triangles) are checked by parity from outside.
 TEST_F(StressRealMeshLeaks, ClosedMeshesFromInsideAndOutside) {
-  std::mt19937 rng(1101);
+  Rng rng(1101);
   InsideCase hexagon;
   hexagon.mesh = loadSharedMesh("hexagon.dae", 0.8);
   ASSERT_LT(maxConvexityViolation(hexagon.mesh), 1e-12);

@@ -15,6 +15,7 @@
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/core/scan_encoder.h"
+#include "random.h"
 #include "stress_report.h"
 
 namespace laser_raycast_test {
@@ -74,7 +75,7 @@ struct Tally {
 };
 
 TEST(StressNonFinite, TriangleAndBvhNeverHit) {
-  std::mt19937 rng(6001);
+  Rng rng(6001);
   std::vector<Tally> triangle(variants().size()), closest(variants().size()),
       any(variants().size());
   // Triangle level: random triangles, each with a ray aimed at its centroid (which hits).

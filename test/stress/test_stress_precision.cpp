@@ -18,6 +18,7 @@
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/core/pose.h"
+#include "random.h"
 #include "stress_report.h"
 
 namespace laser_raycast_test {
@@ -338,7 +339,7 @@ void castScaled(const TriMesh& mesh, const std::vector<Vector3d>& origins, const
 // translation scaled too; and the Caster in an icosphere at the origin whose equator (a ring of
 // vertices) is the scan plane.
 TEST(StressPrecision, ScaleNeedsNoAbsoluteEpsilon) {
-  std::mt19937 rng(5001);
+  Rng rng(5001);
   const Eigen::Isometry3d pose = randomPose(rng, 1.0);
   const TriMesh sphere = makeIcosphere(2);
   const TriMesh room = makeBoxRoom(Vector3d(4, 3, 2.5), 3);

@@ -18,6 +18,7 @@
 #include "laser_raycast/core/fan_slicer.h"
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/core/pose.h"
+#include "random.h"
 #include "stress_report.h"
 
 namespace laser_raycast_test {
@@ -111,7 +112,7 @@ struct SliverTally {
 // From two origins per target, 0.5..2 away and at least ~17 degrees off the surface: every
 // interior vertex, and the midpoint and two random points of every interior edge.
 template <TriangleMethod M, typename T>
-void castSliver(const Sliver& s, const core::BvhT<T>& bvh, std::mt19937& rng, SliverTally* t) {
+void castSliver(const Sliver& s, const core::BvhT<T>& bvh, Rng& rng, SliverTally* t) {
   const auto v = castVertices<T>(s.mesh.vertices);
   auto cast = [&](const Vector3d& target_d, const Vec3<T>& target) {
     for (int k = 0; k < 2; ++k) {
@@ -144,7 +145,7 @@ void castSliver(const Sliver& s, const core::BvhT<T>& bvh, std::mt19937& rng, Sl
 }
 
 TEST(StressSlivers, StripsAndFansNeitherLeakNorDoubleHit) {
-  std::mt19937 rng(4001);
+  Rng rng(4001);
   const int kExponents = 9;
   std::vector<std::vector<SliverTally>> tallies(variants().size(),
                                                 std::vector<SliverTally>(kExponents));
@@ -161,7 +162,7 @@ TEST(StressSlivers, StripsAndFansNeitherLeakNorDoubleHit) {
       const core::Bvh bvh = core::Bvh::build(s.mesh.vertices, s.mesh.triangles);
       const core::BvhF bvh_f = core::BvhF::build(s.mesh.vertices, s.mesh.triangles);
       for (std::size_t vi = 0; vi < variants().size(); ++vi) {
-        std::mt19937 ray_rng(4100 + a);  // the same rays for every variant
+        Rng ray_rng(4100 + a);  // the same rays for every variant
         dispatchVariant(variants()[vi], [&](auto m, auto x) {
           using T = decltype(x);
           castSliver<decltype(m)::value, T>(s, pick(bvh, bvh_f, T{}), ray_rng, &tallies[vi][a]);
@@ -238,7 +239,7 @@ TriMesh sliverWall(double dy, int columns) {
 // path's slice is a polyline of sliver cuts (with the middle row exactly in the plane), the
 // per-beam path tests the slivers themselves.
 TEST(StressSlivers, WallAcrossTheScanPlane) {
-  std::mt19937 rng(4201);
+  Rng rng(4201);
   const int kExponents = 9, columns = 32;
   std::vector<long> fast(kExponents), crossing_errors(kExponents);
   std::vector<std::vector<long>> per_beam(core::kAllTriangleMethods.size(),

@@ -1,6 +1,6 @@
 // Geometry for the unit tests: closed indexed triangle meshes (an icosphere, a box room) whose
-// neighbouring triangles share vertices by index, plus seeded random helpers. Eigen and the
-// standard library only, so that any test (triangle, BVH, caster) can include it.
+// neighbouring triangles share vertices by index. Eigen and the standard library only, so that any
+// test (triangle, BVH, caster) can include it.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -10,7 +10,6 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <random>
 #include <utility>
 #include <vector>
 
@@ -23,61 +22,6 @@ struct TriMesh {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<std::array<std::uint32_t, 3>> triangles;
 };
-
-// ---------------------------------------------------------------------------------------------------
-// Random helpers. Take the generator by reference and a fixed seed in the test, so failures repeat.
-
-inline double uniform(std::mt19937& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-
-// 10^uniform(lo_exp, hi_exp): a scale spread evenly over the decades.
-inline double logUniform(std::mt19937& rng, double lo_exp, double hi_exp) {
-  return std::pow(10.0, uniform(rng, lo_exp, hi_exp));
-}
-
-inline Eigen::Vector3d uniformInBox(std::mt19937& rng, const Eigen::Vector3d& lo,
-                                    const Eigen::Vector3d& hi) {
-  return Eigen::Vector3d(uniform(rng, lo.x(), hi.x()), uniform(rng, lo.y(), hi.y()),
-                         uniform(rng, lo.z(), hi.z()));
-}
-
-inline Eigen::Vector3d uniformInCube(std::mt19937& rng, double half) {
-  return uniformInBox(rng, Eigen::Vector3d::Constant(-half), Eigen::Vector3d::Constant(half));
-}
-
-// Uniform on the unit sphere (normalised Gaussian vector).
-inline Eigen::Vector3d randomUnitVector(std::mt19937& rng) {
-  std::normal_distribution<double> normal;
-  for (;;) {
-    const Eigen::Vector3d v(normal(rng), normal(rng), normal(rng));
-    const double n = v.norm();
-    if (n > 1e-6) return v / n;
-  }
-}
-
-// Uniform over rotations (normalised Gaussian quaternion).
-inline Eigen::Quaterniond randomRotation(std::mt19937& rng) {
-  std::normal_distribution<double> normal;
-  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-  q.normalize();
-  return q;
-}
-
-// A random rotation and a translation uniform in [-max_translation, max_translation]^3.
-inline Eigen::Isometry3d randomPose(std::mt19937& rng, double max_translation) {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = randomRotation(rng).toRotationMatrix();
-  pose.translation() = uniformInCube(rng, max_translation);
-  return pose;
-}
-
-// Barycentrics (u, v) uniform over the triangle: the point is (1 - u - v) a + u b + v c.
-inline Eigen::Vector2d randomBarycentrics(std::mt19937& rng) {
-  const double s = std::sqrt(uniform(rng, 0.0, 1.0));
-  const double r = uniform(rng, 0.0, 1.0);
-  return Eigen::Vector2d(s * (1.0 - r), s * r);
-}
 
 // ---------------------------------------------------------------------------------------------------
 // Meshes.

@@ -15,6 +15,7 @@
 #include "expect_invalid.h"
 #include "laser_raycast/core/bvh.h"
 #include "laser_raycast/core/mesh.h"
+#include "random.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -41,48 +42,34 @@ struct Soup {
   }
 };
 
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-
-Eigen::Vector3d uniformIn(std::mt19937_64& rng, const Eigen::Vector3d& lo,
-                          const Eigen::Vector3d& hi) {
-  return Eigen::Vector3d(uniform(rng, lo.x(), hi.x()), uniform(rng, lo.y(), hi.y()),
-                         uniform(rng, lo.z(), hi.z()));
-}
-
-Eigen::Vector3d unitVector(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  Eigen::Vector3d d(g(rng), g(rng), g(rng));
-  return d.normalized();
-}
-
 // Triangles of random size and orientation, spread over a 20 m cube.
-Soup spreadSoup(std::mt19937_64& rng, int n) {
+Soup spreadSoup(Rng& rng, int n) {
   Soup s;
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d c =
-        uniformIn(rng, Eigen::Vector3d::Constant(-10), Eigen::Vector3d::Constant(10));
+        uniformInBox(rng, Eigen::Vector3d::Constant(-10), Eigen::Vector3d::Constant(10));
     const double size = uniform(rng, 0.05, 2.0);
-    s.add(c + size * unitVector(rng), c + size * unitVector(rng), c + size * unitVector(rng));
+    s.add(c + size * randomUnitVector(rng), c + size * randomUnitVector(rng),
+          c + size * randomUnitVector(rng));
   }
   return s;
 }
 
 // Small triangles packed in a few tight clusters: deep trees, many overlapping boxes.
-Soup clusteredSoup(std::mt19937_64& rng, int n) {
+Soup clusteredSoup(Rng& rng, int n) {
   Soup s;
   std::vector<Eigen::Vector3d> centers;
   for (int k = 0; k < 5; ++k) {
     centers.push_back(
-        uniformIn(rng, Eigen::Vector3d::Constant(-10), Eigen::Vector3d::Constant(10)));
+        uniformInBox(rng, Eigen::Vector3d::Constant(-10), Eigen::Vector3d::Constant(10)));
   }
   std::normal_distribution<double> g(0.0, 0.3);
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d c = centers[static_cast<std::size_t>(i) % centers.size()] +
                               Eigen::Vector3d(g(rng), g(rng), g(rng));
     const double size = uniform(rng, 0.01, 0.3);
-    s.add(c + size * unitVector(rng), c + size * unitVector(rng), c + size * unitVector(rng));
+    s.add(c + size * randomUnitVector(rng), c + size * randomUnitVector(rng),
+          c + size * randomUnitVector(rng));
   }
   return s;
 }
@@ -266,20 +253,20 @@ void checkRayBothPrecisions(const Bvh& bvh, const BvhF& bvhf, const Soup& s, con
 }
 
 // A random ray of one of several kinds, aimed at or through the box.
-Ray randomRay(std::mt19937_64& rng, const Aabb& box, const Soup& s) {
+Ray randomRay(Rng& rng, const Aabb& box, const Soup& s) {
   const Eigen::Vector3d pad = 0.5 * box.extent() + Eigen::Vector3d::Constant(0.1);
   Ray ray;
-  ray.origin = uniformIn(rng, box.lo - pad, box.hi + pad);
+  ray.origin = uniformInBox(rng, box.lo - pad, box.hi + pad);
   const int kind = std::uniform_int_distribution<int>(0, 4)(rng);
   if (kind == 0) {
     // Towards a point of the box, not normalised (t is then not a distance).
-    ray.dir = uniformIn(rng, box.lo, box.hi) - ray.origin;
+    ray.dir = uniformInBox(rng, box.lo, box.hi) - ray.origin;
   } else if (kind == 1) {
-    ray.dir = unitVector(rng);
+    ray.dir = randomUnitVector(rng);
   } else if (kind == 2) {
     // One or two exact zero components, sometimes -0.0: the slab test divides by them.
-    ray.origin = uniformIn(rng, box.lo, box.hi);
-    ray.dir = unitVector(rng);
+    ray.origin = uniformInBox(rng, box.lo, box.hi);
+    ray.dir = randomUnitVector(rng);
     const int zeros = std::uniform_int_distribution<int>(1, 2)(rng);
     const int first = std::uniform_int_distribution<int>(0, 2)(rng);
     for (int k = 0; k < zeros; ++k) {
@@ -290,14 +277,14 @@ Ray randomRay(std::mt19937_64& rng, const Aabb& box, const Soup& s) {
     const auto& v = s.vertices;
     ray.origin = v[std::uniform_int_distribution<std::size_t>(0, v.size() - 1)(rng)];
     ray.dir = v[std::uniform_int_distribution<std::size_t>(0, v.size() - 1)(rng)] - ray.origin;
-    if (ray.dir.squaredNorm() == 0) ray.dir = unitVector(rng);
+    if (ray.dir.squaredNorm() == 0) ray.dir = randomUnitVector(rng);
   } else {
     // Starting in the plane of a vertex coordinate: on a box face, moving in any direction.
     const auto& v =
         s.vertices[std::uniform_int_distribution<std::size_t>(0, s.vertices.size() - 1)(rng)];
     const int axis = std::uniform_int_distribution<int>(0, 2)(rng);
     ray.origin[axis] = v[axis];
-    ray.dir = unitVector(rng);
+    ray.dir = randomUnitVector(rng);
   }
   // A quarter of the rays get a finite interval.
   if (std::uniform_int_distribution<int>(0, 3)(rng) == 0) {
@@ -312,7 +299,7 @@ Ray randomRay(std::mt19937_64& rng, const Aabb& box, const Soup& s) {
 // precision, against brute force.
 TEST(Bvh, MatchesBruteForceOnRandomSoups) {
   const ExemptionBudget budget;
-  std::mt19937_64 rng(20240601);
+  Rng rng(20240601);
   for (const int n : {1, 2, 3, 10, 100, 1000, 5000}) {
     for (const bool clustered : {false, true}) {
       const Soup s = clustered ? clusteredSoup(rng, n) : spreadSoup(rng, n);
@@ -332,7 +319,7 @@ TEST(Bvh, MatchesBruteForceOnRandomSoups) {
 // Tree shape must not change answers: one triangle per leaf, huge leaves, 2 bins, depth cap 2.
 TEST(Bvh, MatchesBruteForceForEveryConfig) {
   const ExemptionBudget budget;
-  std::mt19937_64 rng(77);
+  Rng rng(77);
   const Soup s = clusteredSoup(rng, 400);
   std::vector<BvhConfig> configs(5);
   configs[0].max_leaf_size = 1;
@@ -357,7 +344,7 @@ TEST(Bvh, MatchesBruteForceForEveryConfig) {
 TEST(Bvh, MatchesBruteForceOnLatticeWithRaysInBoxFaces) {
   const ExemptionBudget budget;
   const Soup s = gridSoup();
-  std::mt19937_64 rng(5);
+  Rng rng(5);
   for (const int leaf : {1, 2, 8}) {
     BvhConfig config;
     config.max_leaf_size = leaf;
@@ -402,7 +389,7 @@ TEST(Bvh, MatchesBruteForceOnLatticeWithRaysInBoxFaces) {
         ray.origin = Eigen::Vector3d(coordinate(0, 8), coordinate(0, 8), coordinate(0, 1));
         ray.origin[std::uniform_int_distribution<int>(0, 2)(rng)] =
             2.0 * std::uniform_int_distribution<int>(0, 4)(rng) * (i % 2);
-        ray.dir = unitVector(rng);
+        ray.dir = randomUnitVector(rng);
       }
       checkRayBothPrecisions(bvh, bvhf, s, ray);
       if (HasFatalFailure()) return;
@@ -447,12 +434,12 @@ TEST(Bvh, RayInFloorPlaneAgreesWithBruteForce) {
 // method), before the traversal widened its box culling; see TmaxAtHitRegression.
 TEST(Bvh, TminTmaxAtTheHitDistanceAreInclusive) {
   const ExemptionBudget budget;
-  std::mt19937_64 rng(31);
+  Rng rng(31);
   Soup s;
   for (int i = 0; i < 300; ++i) {
     const int axis = i % 3;
     const Eigen::Vector3d o =
-        uniformIn(rng, Eigen::Vector3d::Constant(-5), Eigen::Vector3d::Constant(5));
+        uniformInBox(rng, Eigen::Vector3d::Constant(-5), Eigen::Vector3d::Constant(5));
     // Mostly small walls; one in ten large, where t's rounding scales with the far vertices.
     const double size = i % 10 ? 2.0 : 40.0;
     Eigen::Vector3d e1 = Eigen::Vector3d::Zero(), e2 = Eigen::Vector3d::Zero();
@@ -465,8 +452,8 @@ TEST(Bvh, TminTmaxAtTheHitDistanceAreInclusive) {
   int checked = 0;
   for (int i = 0; i < 1500; ++i) {
     Ray ray;
-    ray.origin = uniformIn(rng, Eigen::Vector3d::Constant(-7), Eigen::Vector3d::Constant(7));
-    ray.dir = unitVector(rng);
+    ray.origin = uniformInBox(rng, Eigen::Vector3d::Constant(-7), Eigen::Vector3d::Constant(7));
+    ray.dir = randomUnitVector(rng);
     for (const TriangleMethod method : kAllTriangleMethods) {
       const auto first = bruteForceClosestHit(method, s.vertices, s.triangles, ray);
       const auto first_f = bruteForceClosestHit(method, s.vertices, s.triangles, toFloat(ray));
@@ -575,7 +562,7 @@ TEST(Bvh, AllCentroidsEqual) {
       const auto hit = bvh.closestHit<TriangleMethod::kWatertight>(ray);
       ASSERT_TRUE(hit);
       checkRayBothPrecisions(bvh, bvhf, *s, ray);
-      std::mt19937_64 rng(max_depth);
+      Rng rng(max_depth);
       for (int i = 0; i < 20; ++i)
         checkRayBothPrecisions(bvh, bvhf, *s, randomRay(rng, s->bounds(), *s));
     }
@@ -626,7 +613,7 @@ void checkStructure(const BvhT<T>& bvh, const Soup& s) {
 }
 
 TEST(Bvh, StructureInvariants) {
-  std::mt19937_64 rng(3);
+  Rng rng(3);
   for (const int n : {1, 5, 300, 3000}) {
     const Soup s = n % 2 ? spreadSoup(rng, n) : clusteredSoup(rng, n);
     checkStructure(Bvh::build(s.vertices, s.triangles), s);
@@ -639,7 +626,7 @@ TEST(Bvh, StructureInvariants) {
 // float) are left out of the BVH, counted by Mesh, and never hit.
 TEST(Bvh, DegenerateTrianglesAreExcluded) {
   const ExemptionBudget budget;
-  std::mt19937_64 rng(11);
+  Rng rng(11);
   Soup s = spreadSoup(rng, 200);
   const auto n0 = static_cast<std::uint32_t>(s.vertices.size());
   s.vertices.push_back(Eigen::Vector3d(0, 0, 0));
@@ -699,14 +686,14 @@ TEST(Bvh, EmptyBuildHitsNothing) {
 // straight from nodes(), plus the root's exact box, which a child's rounded box may exceed by an
 // ulp.
 TEST(Bvh, VisitReachesExactlyTheLeavesThatPass) {
-  std::mt19937_64 rng(8);
+  Rng rng(8);
   const Soup s = spreadSoup(rng, 2000);
   const Bvh bvh = Bvh::build(s.vertices, s.triangles);
   for (int q = 0; q < 50; ++q) {
     const Eigen::Vector3d c =
-        uniformIn(rng, Eigen::Vector3d::Constant(-12), Eigen::Vector3d::Constant(12));
+        uniformInBox(rng, Eigen::Vector3d::Constant(-12), Eigen::Vector3d::Constant(12));
     const Eigen::Vector3d h =
-        uniformIn(rng, Eigen::Vector3d::Constant(0), Eigen::Vector3d::Constant(6));
+        uniformInBox(rng, Eigen::Vector3d::Constant(0), Eigen::Vector3d::Constant(6));
     auto overlaps = [&](const Aabb& box) {
       return (box.lo.array() <= (c + h).array()).all() && (box.hi.array() >= (c - h).array()).all();
     };
@@ -807,7 +794,7 @@ TEST(Bvh, MaxDepthTreeTraversesCorrectly) {
   const Bvh bvh = Bvh::build(s.vertices, s.triangles, config);
   const BvhF bvhf = BvhF::build(s.vertices, s.triangles, config);
   EXPECT_LE(bvh.depth(), 62);
-  std::mt19937_64 rng(2);
+  Rng rng(2);
   for (int i = 0; i < 50; ++i) {
     Ray ray;
     ray.origin =
@@ -855,7 +842,7 @@ TEST(Mesh, RejectsBadInput) {
 
 // The bounding sphere holds every vertex, near the origin and far from it, small and large.
 TEST(Mesh, BoundingSphereContainsEveryVertex) {
-  std::mt19937_64 rng(17);
+  Rng rng(17);
   for (const double offset : {0.0, 1e6, -3.7e7}) {
     for (const double scale : {1e-4, 1.0, 1e3}) {
       Soup s = clusteredSoup(rng, 200);
@@ -888,7 +875,7 @@ TEST(Mesh, Normal) {
   EXPECT_EQ(mesh.normal(2), Eigen::Vector3d(0, -1, 0));
   EXPECT_EQ(mesh.normal(3), Eigen::Vector3d(-1, 0, 0));
 
-  std::mt19937_64 rng(4);
+  Rng rng(4);
   const Soup s = spreadSoup(rng, 100);
   const Mesh random(s.vertices, s.triangles);
   for (std::uint32_t i = 0; i < s.triangles.size(); ++i) {

@@ -17,6 +17,7 @@
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/fan_slicer.h"
 #include "laser_raycast/core/pose.h"
+#include "random.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -174,7 +175,7 @@ std::shared_ptr<const Mesh> uvSphere(double radius, int rings, int segments) {
   return m.build();
 }
 
-std::shared_ptr<const Mesh> randomSoup(std::mt19937_64& rng, int n, double spread, double size) {
+std::shared_ptr<const Mesh> randomSoup(Rng& rng, int n, double spread, double size) {
   MeshBuilder m;
   std::uniform_real_distribution<double> u(-1, 1);
   for (int i = 0; i < n; ++i) {
@@ -209,15 +210,6 @@ Eigen::Matrix3d rpy(double roll, double pitch, double yaw_angle) {
           Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
-}
-
-Eigen::Matrix3d randomRotation(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
-}
-
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
 
 // --- Scenes ---
@@ -649,7 +641,7 @@ double angularDistance(double a, const std::vector<double>& sorted) {
 // without back-face culling and tmin: the fast path must give what the per-beam path gives, except
 // within 1e-7 rad of a slice's silhouette, and both must match the brute force.
 TEST(Caster, FastPathMatchesGeneralPath) {
-  std::mt19937_64 rng(99);
+  Rng rng(99);
   int compared = 0, hits = 0;
   for (int trial = 0; trial < 40; ++trial) {
     Scene scene;
@@ -662,7 +654,7 @@ TEST(Caster, FastPathMatchesGeneralPath) {
       const int frame = k % frames;
       const auto body_pose =
           pose(Eigen::Vector3d(uniform(rng, -5, 5), uniform(rng, -5, 5), uniform(rng, -1, 1)),
-               randomRotation(rng));
+               randomRotation(rng).toRotationMatrix());
       switch (k % 6) {
         case 0:
           addBody(&scene, uvSphere(uniform(rng, 0.3, 1.5), 8 + k, 12 + k), frame, body_pose);
@@ -758,7 +750,7 @@ std::vector<int> crossingsPerBeam(const Mesh& mesh, const Eigen::Isometry3d& wor
 // of vertices and along horizontal edges. From inside, every beam must hit, for many fans and
 // sensor positions; and the fast path must agree with the general path.
 TEST(Caster, FastPathIsWatertightThroughVertexRows) {
-  std::mt19937_64 rng(7);
+  Rng rng(7);
   const double h = 0.375;  // the sensor's height, and a vertex row
   std::vector<std::shared_ptr<const Mesh>> meshes;
   for (const int n : {3, 4, 5, 8, 31, 97, 256}) {
@@ -836,7 +828,7 @@ TEST(Caster, FastPathIsWatertightThroughVertices) {
 
 // A tilted sensor in a closed room: generic crossings, every beam must still hit.
 TEST(Caster, FastPathIsWatertightWhenTilted) {
-  std::mt19937_64 rng(21);
+  Rng rng(21);
   const auto room = gridBox(steps(-3, 4, 9), steps(-2, 5, 11), steps(-1, 2, 5), true);
   const auto drum = prism(circle(40, 2.5), steps(-1, 1, 6), true);
   for (const auto& mesh : {room, drum}) {
@@ -858,7 +850,7 @@ TEST(Caster, FastPathIsWatertightWhenTilted) {
 // direction (both lie in (-pi, pi]; compared on the circle), and azimuthWindow contains the bearing
 // of every point of the sphere it is given (sampled on its surface, the extreme bearings included).
 TEST(BeamWindow, ApproxAtan2IsWithinItsBound) {
-  std::mt19937_64 rng(41);
+  Rng rng(41);
   double worst = 0;
   for (int i = 0; i < 200000; ++i) {
     const double a = uniform(rng, -M_PI, M_PI);
@@ -880,7 +872,7 @@ TEST(BeamWindow, ApproxAtan2IsWithinItsBound) {
 }
 
 TEST(BeamWindow, AzimuthWindowContainsTheSphere) {
-  std::mt19937_64 rng(43);
+  Rng rng(43);
   int limited = 0;
   for (int i = 0; i < 3000; ++i) {
     const Eigen::Vector3d c(uniform(rng, -20, 20), uniform(rng, -20, 20), uniform(rng, -5, 5));
@@ -967,13 +959,13 @@ TEST(Caster, CullingCountsAndChangesNothing) {
 // Random scenes with everything culled or not: the result never depends on culling, checked
 // against the brute force for both paths and both pattern kinds.
 TEST(Caster, RandomScenesMatchBruteForce) {
-  std::mt19937_64 rng(1234);
+  Rng rng(1234);
   for (int trial = 0; trial < 12; ++trial) {
     Scene scene = sceneWithFrame();
     for (int k = 0; k < 12; ++k) {
       const auto p =
           pose(Eigen::Vector3d(uniform(rng, -15, 15), uniform(rng, -15, 15), uniform(rng, -3, 3)),
-               randomRotation(rng));
+               randomRotation(rng).toRotationMatrix());
       if (k % 3 == 0) addBody(&scene, uvSphere(uniform(rng, 0.3, 2), 6, 10), 0, p);
       if (k % 3 == 1) addBody(&scene, Cylinder{uniform(rng, 0.2, 1), uniform(rng, 0.5, 3)}, 0, p);
       if (k % 3 == 2) addBody(&scene, Box{Eigen::Vector3d(1, 2, 0.5)}, 0, p);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "laser_raycast/core/primitives.h"
+#include "random.h"
 #include "test_geometry.h"
 
 namespace laser_raycast_test {
@@ -187,7 +188,7 @@ bool boxTruth(const Vector3d& size, const Ray& ray, L* t, Vector3d* normal) {
 }
 
 TEST(BoxIntersect, RandomRaysMatchFaceEnumeration) {
-  std::mt19937 rng(41);
+  Rng rng(41);
   int hits = 0, checked = 0;
   for (int i = 0; i < 20000; ++i) {
     const Vector3d size(logUniform(rng, -2, 2), logUniform(rng, -2, 2), logUniform(rng, -2, 2));
@@ -355,7 +356,7 @@ bool cylinderTruth(const Vec3L& c, const Vec3L& w, L r, L h, const Ray& ray, L* 
 // moved into the cylinder's frame with the inverse pose, the normal rotated back. t is the same in
 // both frames (rigid motion keeps |dir|).
 TEST(CylinderIntersect, TiltedCylindersMatchAWorldFrameClosedForm) {
-  std::mt19937 rng(43);
+  Rng rng(43);
   int hits = 0, checked = 0, cap_hits = 0;
   for (int i = 0; i < 20000; ++i) {
     const double radius = logUniform(rng, -2, 1);
@@ -456,7 +457,7 @@ L sphereEntryTruth(const Ray& ray, L r) {
 // against r^2); the implementation's r^2 - |f|^2 form does not. The rays enter at a chosen point of
 // the sphere, at least ~12 degrees off tangent.
 TEST(SphereIntersect, FromAMillionMetresAway) {
-  std::mt19937 rng(47);
+  Rng rng(47);
   for (int i = 0; i < 5000; ++i) {
     const double r = logUniform(rng, -2, 1);
     const Vector3d n = randomUnitVector(rng);
@@ -484,7 +485,7 @@ TEST(SphereIntersect, FromAMillionMetresAway) {
 
 // Random rays near a sphere, from outside and inside, against the long double closed form.
 TEST(SphereIntersect, RandomRaysMatchTheClosedForm) {
-  std::mt19937 rng(53);
+  Rng rng(53);
   int hits = 0, checked = 0;
   for (int i = 0; i < 20000; ++i) {
     const double r = logUniform(rng, -2, 2);
@@ -524,7 +525,7 @@ TEST(SphereIntersect, RandomRaysMatchTheClosedForm) {
 // Normals are unit and outward; they oppose the ray where it enters (origin outside) and follow it
 // where it leaves (origin inside). Hit points lie on the shape's bounds.
 TEST(PrimitiveNormals, UnitOutwardAndFacingTheRightWay) {
-  std::mt19937 rng(59);
+  Rng rng(59);
   const Box box{Vector3d(1.5, 0.4, 3)};
   const Cylinder cylinder{0.7, 2.5};
   const Sphere sphere{1.2};
@@ -574,7 +575,7 @@ TEST(PrimitiveNormals, UnitOutwardAndFacingTheRightWay) {
 // its edges: the box's edges and corners, the cylinder's rims (where side and cap meet), points of
 // the sphere. The hit is the aimed point (the shapes are convex).
 TEST(PrimitiveClosedSurfaces, RaysFromInsideAimedAtEdgesAlwaysHit) {
-  std::mt19937 rng(61);
+  Rng rng(61);
   const Box box{Vector3d(1.5, 0.4, 3)};
   const Cylinder cylinder{0.7, 2.5};
   const Sphere sphere{1.2};

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "laser_raycast/core/triangle.h"
+#include "random.h"
 #include "test_geometry.h"
 
 namespace laser_raycast_test {
@@ -88,7 +89,7 @@ std::string describe(const char* what, const Vector3d& a, const Vector3d& b, con
 
 // A random triangle with no tiny angle (|n| >= 0.1 * longest edge^2), vertices in a cube of
 // half-size `size` around `center`.
-void randomWellShapedTriangle(std::mt19937& rng, const Vector3d& center, double size, Vector3d* a,
+void randomWellShapedTriangle(Rng& rng, const Vector3d& center, double size, Vector3d* a,
                               Vector3d* b, Vector3d* c) {
   for (;;) {
     *a = center + uniformInCube(rng, size);
@@ -111,7 +112,7 @@ struct AimedCase {
   bool front;   // the ray sees the front face: dir . ((b - a) x (c - a)) < 0
 };
 
-AimedCase makeAimedCase(std::mt19937& rng, const Eigen::Vector2d& uv) {
+AimedCase makeAimedCase(Rng& rng, const Eigen::Vector2d& uv) {
   AimedCase k;
   const double scale = logUniform(rng, -3, 3);
   const Vector3d center = uniformInCube(rng, 2 * scale);
@@ -134,7 +135,7 @@ AimedCase makeAimedCase(std::mt19937& rng, const Eigen::Vector2d& uv) {
 }
 
 // Barycentrics uniform over the part of the triangle at least `margin` inside every edge.
-Eigen::Vector2d randomInsideBarycentrics(std::mt19937& rng, double margin) {
+Eigen::Vector2d randomInsideBarycentrics(Rng& rng, double margin) {
   for (;;) {
     const Eigen::Vector2d uv = randomBarycentrics(rng);
     if (std::min({uv[0], uv[1], 1 - uv[0] - uv[1]}) >= margin) return uv;
@@ -142,7 +143,7 @@ Eigen::Vector2d randomInsideBarycentrics(std::mt19937& rng, double margin) {
 }
 
 // Barycentrics of a point in the triangle's plane, outside by at least `margin` across some edge.
-Eigen::Vector2d randomOutsideBarycentrics(std::mt19937& rng, double margin) {
+Eigen::Vector2d randomOutsideBarycentrics(Rng& rng, double margin) {
   for (;;) {
     const Eigen::Vector2d uv(uniform(rng, -2, 3), uniform(rng, -2, 3));
     if (std::min({uv[0], uv[1], 1 - uv[0] - uv[1]}) <= -margin) return uv;
@@ -192,7 +193,7 @@ TYPED_TEST_SUITE(TriangleRandom, Precisions, PrecisionNames);
 // exactly the front-face hits remain and are unchanged.
 TYPED_TEST(TriangleRandom, HitsMatchConstructedTruth) {
   using T = TypeParam;
-  std::mt19937 rng(20240601);
+  Rng rng(20240601);
   constexpr int kCases = 4000;
   std::vector<double> worst_t(kAllTriangleMethods.size(), 0.0);
   std::vector<double> worst_uv(kAllTriangleMethods.size(), 0.0);
@@ -238,7 +239,7 @@ TYPED_TEST(TriangleRandom, HitsMatchConstructedTruth) {
 // The hit point from the barycentrics is the ray point at t: the two outputs are consistent.
 TYPED_TEST(TriangleRandom, BarycentricsReproduceTheRayPoint) {
   using T = TypeParam;
-  std::mt19937 rng(7);
+  Rng rng(7);
   for (int i = 0; i < 2000; ++i) {
     const AimedCase k = makeAimedCase(rng, randomInsideBarycentrics(rng, Tolerance<T>::kMargin));
     const RayT<T> ray = makeRay<T>(k.origin, k.dir);
@@ -260,7 +261,7 @@ TYPED_TEST(TriangleRandom, BarycentricsReproduceTheRayPoint) {
 // without culling.
 TYPED_TEST(TriangleRandom, RaysAimedOutsideMiss) {
   using T = TypeParam;
-  std::mt19937 rng(11);
+  Rng rng(11);
   for (int i = 0; i < 4000; ++i) {
     const AimedCase k = makeAimedCase(rng, randomOutsideBarycentrics(rng, Tolerance<T>::kMargin));
     const RayT<T> ray = makeRay<T>(k.origin, k.dir);
@@ -278,7 +279,7 @@ TYPED_TEST(TriangleRandom, RaysAimedOutsideMiss) {
 // A triangle behind the origin (t < tmin = 0) is not hit: the same rays as above, reversed.
 TYPED_TEST(TriangleRandom, TrianglesBehindTheOriginMiss) {
   using T = TypeParam;
-  std::mt19937 rng(13);
+  Rng rng(13);
   for (int i = 0; i < 3000; ++i) {
     const AimedCase k = makeAimedCase(rng, randomInsideBarycentrics(rng, Tolerance<T>::kMargin));
     const RayT<T> ray = makeRay<T>(k.origin, -k.dir);
@@ -297,7 +298,7 @@ TYPED_TEST(TriangleRandom, TminTmaxLimitTheHit) {
   using T = TypeParam;
   // Well above the t tolerance, so that the verdict is not decided by rounding.
   const double margin = 100 * Tolerance<T>::kT;
-  std::mt19937 rng(17);
+  Rng rng(17);
   for (int i = 0; i < 2000; ++i) {
     const AimedCase k = makeAimedCase(rng, randomInsideBarycentrics(rng, Tolerance<T>::kMargin));
     for (const TriangleMethod m : kAllTriangleMethods) {
@@ -327,7 +328,7 @@ TYPED_TEST(TriangleRandom, TminTmaxLimitTheHit) {
 // edge functions of mixed signs (or all zero, then det = 0).
 TYPED_TEST(TriangleRandom, RaysParallelToThePlaneMiss) {
   using T = TypeParam;
-  std::mt19937 rng(19);
+  Rng rng(19);
   for (int i = 0; i < 3000; ++i) {
     const int axis = i % 3;
     const double scale = logUniform(rng, -3, 3);
@@ -364,7 +365,7 @@ TYPED_TEST(TriangleRandom, MethodsAgreeAwayFromEdges) {
   using T = TypeParam;
   using L = long double;
   using Vec3L = Eigen::Matrix<L, 3, 1>;
-  std::mt19937 rng(23);
+  Rng rng(23);
   int checked = 0, expected_hits = 0;
   constexpr int kCases = 20000;
   for (int i = 0; i < kCases; ++i) {
@@ -416,7 +417,7 @@ TYPED_TEST(TriangleRandom, MethodsAgreeAwayFromEdges) {
 // by luck are mostly absent).
 TYPED_TEST(TriangleRandom, NonFiniteInputNeverHits) {
   using T = TypeParam;
-  std::mt19937 rng(37);
+  Rng rng(37);
   const double bad_values[] = {std::numeric_limits<double>::quiet_NaN(), kInf, -kInf};
   for (int i = 0; i < 300; ++i) {
     const AimedCase k = makeAimedCase(rng, randomInsideBarycentrics(rng, Tolerance<T>::kMargin));
@@ -442,7 +443,7 @@ TYPED_TEST(TriangleRandom, NonFiniteInputNeverHits) {
 // The compile-time entry point intersectTriangle<M> and the run-time one give identical results.
 TYPED_TEST(TriangleRandom, TemplateAndRuntimeEntryPointsAgree) {
   using T = TypeParam;
-  std::mt19937 rng(29);
+  Rng rng(29);
   for (int i = 0; i < 500; ++i) {
     const Eigen::Vector2d uv(uniform(rng, -0.5, 1.5), uniform(rng, -0.5, 1.5));
     const AimedCase k = makeAimedCase(rng, uv);
@@ -536,7 +537,7 @@ TYPED_TEST(TriangleLiteral, DegenerateTrianglesNeverHit) {
       // All three the same point.
       {Vector3d(0.5, 0.5, 0.5), Vector3d(0.5, 0.5, 0.5), Vector3d(0.5, 0.5, 0.5)},
   };
-  std::mt19937 rng(31);
+  Rng rng(31);
   for (const auto& tri : triangles) {
     const Vector3d &a = tri[0], &b = tri[1], &c = tri[2];
     ASSERT_TRUE(isDegenerateTriangle<T>(a.cast<T>(), b.cast<T>(), c.cast<T>()));

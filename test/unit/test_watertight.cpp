@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "laser_raycast/core/triangle.h"
+#include "random.h"
 #include "test_geometry.h"
 
 namespace laser_raycast_test {
@@ -86,7 +87,7 @@ struct ClosedMesh {
   Vector3d center;
   double radius;  // about the distance from center to the surface, for choosing origins
   std::function<bool(const Vector3d&)> is_interior;
-  std::function<Vector3d(std::mt19937&)> sample_interior;
+  std::function<Vector3d(Rng&)> sample_interior;
 };
 
 // The icosphere of the given level, scaled, then moved by pose. Its inscribed radius is at least
@@ -101,7 +102,7 @@ ClosedMesh icosphere(int level, double scale, const Eigen::Isometry3d& pose) {
   m.radius = scale;
   const Eigen::Isometry3d inverse = pose.inverse();
   m.is_interior = [=](const Vector3d& p) { return (inverse * p).norm() < 0.7 * scale; };
-  m.sample_interior = [=](std::mt19937& rng) {
+  m.sample_interior = [=](Rng& rng) {
     const double r = 0.7 * scale * std::cbrt(uniform(rng, 0, 1));
     return Vector3d(pose * (r * randomUnitVector(rng)));
   };
@@ -124,7 +125,7 @@ ClosedMesh boxRoom(const Vector3d& size, int cells, double scale, const Eigen::I
   m.is_interior = [=](const Vector3d& p) {
     return ((inverse * p).cwiseAbs().array() < inner_half.array()).all();
   };
-  m.sample_interior = [=](std::mt19937& rng) {
+  m.sample_interior = [=](Rng& rng) {
     return Vector3d(pose * uniformInBox(rng, -inner_half, inner_half));
   };
   return m;
@@ -165,7 +166,7 @@ std::string describe(const ClosedMesh& m, const AimedRay& aim) {
 // each vertex back along the 26 directions with components in {-1, 0, 1} that point into the mesh,
 // to an interior origin on that line (so the direction has exact zeros and, for the 6 axes, is
 // exactly axis-aligned).
-std::vector<AimedRay> aimedRays(const ClosedMesh& m, int random_origins, std::mt19937& rng) {
+std::vector<AimedRay> aimedRays(const ClosedMesh& m, int random_origins, Rng& rng) {
   std::vector<AimedRay> rays;
   std::vector<Vector3d> origins = {m.center};
   for (int k = 0; k < random_origins; ++k) origins.push_back(m.sample_interior(rng));
@@ -283,7 +284,7 @@ void castWithEveryMethod(const ClosedMesh& m, const std::vector<Vec3<T>>& vertic
 void runClosedMeshes(const std::string& title, const std::vector<ClosedMesh>& meshes,
                      const std::vector<int>& random_origins, std::uint32_t seed,
                      long minimum_rays) {
-  std::mt19937 rng(seed);
+  Rng rng(seed);
   TallyTable table{};
   std::vector<std::string> errors;
   long axis_aligned = 0, with_zero_component = 0;
@@ -375,7 +376,7 @@ TEST(ClosedMeshGeometry, BoxRoomIsClosedConvexAndOutward) {
 
 // The minimum ray counts of the two tests add up to over 100,000 rays per method and precision.
 TEST(Watertight, RaysFromInsideAnIcosphereNeverEscape) {
-  std::mt19937 rng(101);
+  Rng rng(101);
   const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
   const Vector3d off_axis(2.5, -1.5, 0.75);
   // Levels 0 to 3 at the origin (many exact zeros in the vertices); level 2 rotated and moved at
@@ -395,7 +396,7 @@ TEST(Watertight, RaysFromInsideAnIcosphereNeverEscape) {
 }
 
 TEST(Watertight, RaysFromInsideABoxRoomNeverEscape) {
-  std::mt19937 rng(201);
+  Rng rng(201);
   const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
   const Vector3d room(4, 3, 2.5);
   // Axis-aligned rooms (walls in coordinate planes, grid vertices at exact coordinates) at scales
