@@ -1,4 +1,4 @@
-// BVH and Mesh: the BVH must return exactly what testing every triangle returns, for both
+// BVH: it must return exactly what testing every triangle returns, for both
 // precisions and every triangle method, including the rays that stress a slab test (zero and -0.0
 // direction components, rays lying in box faces, rays starting on faces).
 #include <gtest/gtest.h>
@@ -16,6 +16,7 @@
 #include "laser_raycast/core/bvh.h"
 #include "laser_raycast/core/mesh.h"
 #include "random.h"
+#include "triangle_soup.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -23,56 +24,6 @@ namespace {
 using namespace laser_raycast::core;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-struct Soup {
-  std::vector<Eigen::Vector3d> vertices;
-  std::vector<TriangleIndices> triangles;
-
-  void add(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-    const auto n = static_cast<std::uint32_t>(vertices.size());
-    vertices.push_back(a);
-    vertices.push_back(b);
-    vertices.push_back(c);
-    triangles.push_back({n, n + 1, n + 2});
-  }
-  Aabb bounds() const {
-    Aabb box;
-    for (const auto& v : vertices) box.grow(v);
-    return box;
-  }
-};
-
-// Triangles of random size and orientation, spread over a 20 m cube.
-Soup spreadSoup(Rng& rng, int n) {
-  Soup s;
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d c =
-        uniformInBox(rng, Eigen::Vector3d::Constant(-10), Eigen::Vector3d::Constant(10));
-    const double size = uniform(rng, 0.05, 2.0);
-    s.add(c + size * randomUnitVector(rng), c + size * randomUnitVector(rng),
-          c + size * randomUnitVector(rng));
-  }
-  return s;
-}
-
-// Small triangles packed in a few tight clusters: deep trees, many overlapping boxes.
-Soup clusteredSoup(Rng& rng, int n) {
-  Soup s;
-  std::vector<Eigen::Vector3d> centers;
-  for (int k = 0; k < 5; ++k) {
-    centers.push_back(
-        uniformInBox(rng, Eigen::Vector3d::Constant(-10), Eigen::Vector3d::Constant(10)));
-  }
-  std::normal_distribution<double> g(0.0, 0.3);
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d c = centers[static_cast<std::size_t>(i) % centers.size()] +
-                              Eigen::Vector3d(g(rng), g(rng), g(rng));
-    const double size = uniform(rng, 0.01, 0.3);
-    s.add(c + size * randomUnitVector(rng), c + size * randomUnitVector(rng),
-          c + size * randomUnitVector(rng));
-  }
-  return s;
-}
 
 // Unit squares (two triangles each) on an integer lattice: a floor in z = 0 and walls x = k, y = k
 // with z in [0, 1]. Leaf boxes then have faces exactly in the planes z = 0, z = 1, x = k, y = k.
@@ -802,91 +753,6 @@ TEST(Bvh, MaxDepthTreeTraversesCorrectly) {
     ray.dir = Eigen::Vector3d(i % 2 ? 1 : -1, 0, 0);
     checkRayBothPrecisions(bvh, bvhf, s, ray);
     if (HasFatalFailure()) return;
-  }
-}
-
-// --- Mesh ---------------------------------------------------------------------------------------
-
-// The message with which the Mesh constructor rejects (v, t).
-std::string meshMessage(std::vector<Eigen::Vector3d> v, std::vector<TriangleIndices> t) {
-  return invalidMessage([&] { Mesh mesh(std::move(v), std::move(t)); });
-}
-
-TEST(Mesh, RejectsBadInput) {
-  const std::vector<Eigen::Vector3d> v = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
-                                          Eigen::Vector3d(0, 1, 0)};
-  EXPECT_NE(meshMessage(v, {}).find("no triangles"), std::string::npos);
-
-  auto with = [&](int index, double value) {
-    auto bad = v;
-    bad[index].y() = value;
-    return bad;
-  };
-  const std::string nan_msg = meshMessage(with(1, std::nan("")), {{0, 1, 2}});
-  EXPECT_NE(nan_msg.find("vertex 1"), std::string::npos) << nan_msg;
-  EXPECT_NE(nan_msg.find("nan"), std::string::npos) << nan_msg;
-  const std::string inf_msg = meshMessage(with(2, -kInf), {{0, 1, 2}});
-  EXPECT_NE(inf_msg.find("vertex 2"), std::string::npos) << inf_msg;
-  EXPECT_NE(inf_msg.find("inf"), std::string::npos) << inf_msg;
-
-  const std::string range_msg = meshMessage(v, {{0, 1, 2}, {0, 3, 1}});
-  EXPECT_NE(range_msg.find("triangle 1"), std::string::npos) << range_msg;
-  EXPECT_NE(range_msg.find("vertex 3"), std::string::npos) << range_msg;
-
-  const std::string degenerate_msg = meshMessage(v, {{0, 0, 1}, {2, 2, 2}});
-  EXPECT_NE(degenerate_msg.find("2 triangles"), std::string::npos) << degenerate_msg;
-  EXPECT_NE(degenerate_msg.find("zero area"), std::string::npos) << degenerate_msg;
-
-  EXPECT_NO_THROW(Mesh(v, {{0, 1, 2}}));
-}
-
-// The bounding sphere holds every vertex, near the origin and far from it, small and large.
-TEST(Mesh, BoundingSphereContainsEveryVertex) {
-  Rng rng(17);
-  for (const double offset : {0.0, 1e6, -3.7e7}) {
-    for (const double scale : {1e-4, 1.0, 1e3}) {
-      Soup s = clusteredSoup(rng, 200);
-      for (auto& p : s.vertices) p = p * scale + Eigen::Vector3d::Constant(offset);
-      const Mesh mesh(s.vertices, s.triangles);
-      ASSERT_GT(mesh.sphereRadius(), 0);
-      double farthest = 0;
-      for (const auto& p : s.vertices) {
-        const double d = (p - mesh.sphereCenter()).norm();
-        farthest = std::max(farthest, d);
-        EXPECT_LE(d, mesh.sphereRadius()) << "offset " << offset << " scale " << scale;
-      }
-      // Radius to the farthest vertex, not some loose bound: within 1e-12 relative.
-      EXPECT_LE(mesh.sphereRadius(), farthest * (1 + 1e-12));
-      for (int k = 0; k < 3; ++k) {
-        EXPECT_LE(mesh.bounds().lo[k], mesh.sphereCenter()[k]);
-        EXPECT_GE(mesh.bounds().hi[k], mesh.sphereCenter()[k]);
-      }
-    }
-  }
-}
-
-// normal(): (b - a) x (c - a) normalised; the winding decides the side.
-TEST(Mesh, Normal) {
-  const std::vector<Eigen::Vector3d> v = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 0, 0),
-                                          Eigen::Vector3d(0, 3, 0), Eigen::Vector3d(0, 0, 5)};
-  const Mesh mesh(v, {{0, 1, 2}, {0, 2, 1}, {0, 1, 3}, {0, 3, 2}});
-  EXPECT_EQ(mesh.normal(0), Eigen::Vector3d(0, 0, 1));
-  EXPECT_EQ(mesh.normal(1), Eigen::Vector3d(0, 0, -1));
-  EXPECT_EQ(mesh.normal(2), Eigen::Vector3d(0, -1, 0));
-  EXPECT_EQ(mesh.normal(3), Eigen::Vector3d(-1, 0, 0));
-
-  Rng rng(4);
-  const Soup s = spreadSoup(rng, 100);
-  const Mesh random(s.vertices, s.triangles);
-  for (std::uint32_t i = 0; i < s.triangles.size(); ++i) {
-    const auto& t = s.triangles[i];
-    const Eigen::Vector3d n = random.normal(i);
-    EXPECT_NEAR(n.norm(), 1.0, 1e-15);
-    const Eigen::Vector3d e1 = s.vertices[t[1]] - s.vertices[t[0]];
-    const Eigen::Vector3d e2 = s.vertices[t[2]] - s.vertices[t[0]];
-    EXPECT_NEAR(n.dot(e1), 0.0, 1e-12 * e1.norm());
-    EXPECT_NEAR(n.dot(e2), 0.0, 1e-12 * e2.norm());
-    EXPECT_GT(n.dot(e1.cross(e2)), 0);
   }
 }
 
