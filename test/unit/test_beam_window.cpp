@@ -1,0 +1,76 @@
+// Beam windows: approxAtan2 within its stated bound of std::atan2, and azimuthWindow containing
+// every bearing of the sphere it is given.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "laser_raycast/core/beam_window.h"
+#include "random.h"
+
+namespace laser_raycast_test {
+namespace {
+
+using namespace laser_raycast::core;
+
+// The beam windows' helpers: approxAtan2 stays within its stated bound of std::atan2 over every
+// direction (both lie in (-pi, pi]; compared on the circle), and azimuthWindow contains the bearing
+// of every point of the sphere it is given (sampled on its surface, the extreme bearings included).
+TEST(BeamWindow, ApproxAtan2IsWithinItsBound) {
+  Rng rng(41);
+  double worst = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const double a = uniform(rng, -M_PI, M_PI);
+    const double r = std::pow(10.0, uniform(rng, -6, 6));
+    const double x = r * std::cos(a), y = r * std::sin(a);
+    double diff = std::abs(approxAtan2(y, x) - std::atan2(y, x));
+    diff = std::min(diff, 2 * M_PI - diff);
+    worst = std::max(worst, diff);
+  }
+  for (const double x : {1.0, -1.0, 0.0}) {  // the axes and the diagonals exactly
+    for (const double y : {1.0, -1.0, 0.0}) {
+      if (x == 0 && y == 0) continue;
+      double diff = std::abs(approxAtan2(y, x) - std::atan2(y, x));
+      worst = std::max(worst, std::min(diff, 2 * M_PI - diff));
+    }
+  }
+  EXPECT_LE(worst, kBearingError);
+  EXPECT_GT(worst, 0.0);  // it is an approximation: the bound is what matters
+}
+
+TEST(BeamWindow, AzimuthWindowContainsTheSphere) {
+  Rng rng(43);
+  int limited = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3d c(uniform(rng, -20, 20), uniform(rng, -20, 20), uniform(rng, -5, 5));
+    const double radius = std::pow(10.0, uniform(rng, -3, 1.2));
+    const double angle_min = uniform(rng, -10, 10);
+    double start, width;
+    if (!azimuthWindow(c, radius, angle_min, &start, &width)) continue;
+    ++limited;
+    ASSERT_GE(start, 0.0);
+    ASSERT_LT(start, 2 * M_PI);
+    // The two tangent bearings of the sphere's horizontal disc, and random points of the sphere.
+    const double rho = std::hypot(c.x(), c.y());
+    const double centre = std::atan2(c.y(), c.x());
+    std::vector<double> bearings = {centre + std::asin(radius / rho),
+                                    centre - std::asin(radius / rho)};
+    for (int k = 0; k < 20; ++k) {
+      Eigen::Vector3d u(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+      if (u.norm() == 0) continue;
+      const Eigen::Vector3d p = c + radius * u.normalized();
+      bearings.push_back(std::atan2(p.y(), p.x()));
+    }
+    for (const double b : bearings) {
+      // Offset from the window's start, on the circle.
+      double offset = std::fmod(b - angle_min - start, 2 * M_PI);
+      if (offset < 0) offset += 2 * M_PI;
+      EXPECT_LE(offset, width) << "sphere " << i;
+    }
+  }
+  EXPECT_GT(limited, 2000);
+}
+
+}  // namespace
+}  // namespace laser_raycast_test
