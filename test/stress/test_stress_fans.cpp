@@ -27,32 +27,6 @@ using Eigen::Vector3d;
 // ---------------------------------------------------------------------------------------------------
 // Planar fans through rings of vertices.
 
-// A closed prism over a polygon star-shaped about the z axis, with rows of vertices at zs and caps
-// fanned to the axis.
-TriMesh prism(const std::vector<Eigen::Vector2d>& polygon, const std::vector<double>& zs) {
-  TriMesh m;
-  const auto n = static_cast<std::uint32_t>(polygon.size());
-  for (const double z : zs) {
-    for (const auto& p : polygon) m.vertices.emplace_back(p.x(), p.y(), z);
-  }
-  auto at = [n](std::size_t row, std::uint32_t i) {
-    return static_cast<std::uint32_t>(row * n + i % n);
-  };
-  for (std::size_t r = 0; r + 1 < zs.size(); ++r) {
-    for (std::uint32_t i = 0; i < n; ++i) {
-      m.triangles.push_back({at(r, i), at(r, i + 1), at(r + 1, i + 1)});
-      m.triangles.push_back({at(r, i), at(r + 1, i + 1), at(r + 1, i)});
-    }
-  }
-  for (const std::size_t row : {std::size_t(0), zs.size() - 1}) {
-    m.vertices.emplace_back(0, 0, zs[row]);
-    const auto c = static_cast<std::uint32_t>(m.vertices.size() - 1);
-    for (std::uint32_t i = 0; i < n; ++i) m.triangles.push_back({c, at(row, i + 1), at(row, i)});
-  }
-  orientOutwards(&m, Vector3d(0, 0, 0.5 * (zs.front() + zs.back())));
-  return m;
-}
-
 core::ScanPattern fan(double angle_min, double span, int samples) {
   core::FanSpec spec;
   spec.angle_min = angle_min;
@@ -196,7 +170,8 @@ TEST(StressFans, PlanarFansThroughVertexRings) {
         const double r = (i / every) % 2 ? 2.0 : 4.0;
         star.emplace_back(r * pattern.directions()[i].x(), r * pattern.directions()[i].y());
       }
-      cases.push_back({prism(star, {-1.0, 0.0, 1.0}), {Eigen::Isometry3d::Identity()}, {pattern}});
+      cases.push_back(
+          {makePrism(star, {-1.0, 0.0, 1.0}), {Eigen::Isometry3d::Identity()}, {pattern}});
     }
   }
   const auto tallies = runFans(cases);

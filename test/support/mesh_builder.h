@@ -8,10 +8,12 @@
 #include <cstdint>
 #include <memory>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "laser_raycast/core/mesh.h"
 #include "random.h"
+#include "test_geometry.h"
 
 namespace laser_raycast_test {
 
@@ -93,37 +95,14 @@ inline std::vector<double> steps(double lo, double hi, int n) {
   return out;
 }
 
-// A closed prism over a polygon star-shaped about the origin (xy), with vertex rows at zs (first
-// and last are the caps, fanned to the axis).
+// makePrism as a core::Mesh, its front faces outward or, for a room, inward.
 inline std::shared_ptr<const core::Mesh> prism(const std::vector<Eigen::Vector2d>& polygon,
                                                const std::vector<double>& zs, bool inward) {
-  MeshBuilder m;
-  const std::size_t n = polygon.size();
-  std::vector<std::vector<std::uint32_t>> rows;
-  for (const double z : zs) {
-    rows.emplace_back();
-    for (const auto& p : polygon) rows.back().push_back(m.vertex(Eigen::Vector3d(p.x(), p.y(), z)));
+  TriMesh mesh = makePrism(polygon, zs);
+  if (inward) {
+    for (auto& triangle : mesh.triangles) std::swap(triangle[1], triangle[2]);
   }
-  const double sign = inward ? -1 : 1;
-  for (std::size_t r = 0; r + 1 < zs.size(); ++r) {
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t j = (i + 1) % n;
-      const Eigen::Vector2d mid = 0.5 * (polygon[i] + polygon[j]);
-      const Eigen::Vector2d edge = polygon[j] - polygon[i];
-      Eigen::Vector3d out(edge.y(), -edge.x(), 0);
-      if (out.head<2>().dot(mid) < 0) out = -out;
-      m.quad(rows[r][i], rows[r][j], rows[r + 1][j], rows[r + 1][i], sign * out);
-    }
-  }
-  for (const bool top : {false, true}) {
-    const double z = top ? zs.back() : zs.front();
-    const std::uint32_t c = m.vertex(Eigen::Vector3d(0, 0, z));
-    const auto& row = top ? rows.back() : rows.front();
-    for (std::size_t i = 0; i < n; ++i) {
-      m.triangle(c, row[i], row[(i + 1) % n], sign * Eigen::Vector3d(0, 0, top ? 1 : -1));
-    }
-  }
-  return m.build();
+  return std::make_shared<const core::Mesh>(mesh.vertices, mesh.triangles);
 }
 
 inline std::vector<Eigen::Vector2d> circle(int n, double radius, double phase = 0) {

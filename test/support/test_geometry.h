@@ -136,6 +136,33 @@ inline TriMesh makeBoxRoom(const Eigen::Vector3d& size, int cells) {
   return mesh;
 }
 
+// A closed prism over a polygon star-shaped about the z axis: a row of vertices at each of zs, two
+// triangles per side quad, and caps fanned to a vertex on the axis. Wound outwards.
+inline TriMesh makePrism(const std::vector<Eigen::Vector2d>& polygon,
+                         const std::vector<double>& zs) {
+  TriMesh m;
+  const auto n = static_cast<std::uint32_t>(polygon.size());
+  for (const double z : zs) {
+    for (const auto& p : polygon) m.vertices.emplace_back(p.x(), p.y(), z);
+  }
+  auto at = [n](std::size_t row, std::uint32_t i) {
+    return static_cast<std::uint32_t>(row * n + i % n);
+  };
+  for (std::size_t r = 0; r + 1 < zs.size(); ++r) {
+    for (std::uint32_t i = 0; i < n; ++i) {
+      m.triangles.push_back({at(r, i), at(r, i + 1), at(r + 1, i + 1)});
+      m.triangles.push_back({at(r, i), at(r + 1, i + 1), at(r + 1, i)});
+    }
+  }
+  for (const std::size_t row : {std::size_t(0), zs.size() - 1}) {
+    m.vertices.emplace_back(0, 0, zs[row]);
+    const auto c = static_cast<std::uint32_t>(m.vertices.size() - 1);
+    for (std::uint32_t i = 0; i < n; ++i) m.triangles.push_back({c, at(row, i + 1), at(row, i)});
+  }
+  orientOutwards(&m, Eigen::Vector3d(0, 0, 0.5 * (zs.front() + zs.back())));
+  return m;
+}
+
 // Every vertex v becomes pose * (scale * v). Shared vertices stay shared (one transformed copy
 // each).
 inline TriMesh transformed(const TriMesh& mesh, double scale, const Eigen::Isometry3d& pose) {
