@@ -1,12 +1,14 @@
-// Beam windows: approxAtan2 within its stated bound of std::atan2, and azimuthWindow containing
-// every bearing of the sphere it is given.
+// Beam windows: approxAtan2 within its stated bound of std::atan2, azimuthWindow containing every
+// bearing of the sphere it is given, and forEachBeamRange against a check of every beam.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "fan_specs.h"
 #include "laser_raycast/core/beam_window.h"
+#include "laser_raycast/core/scan_pattern.h"
 #include "random.h"
 
 namespace laser_raycast_test {
@@ -70,6 +72,53 @@ TEST(BeamWindow, AzimuthWindowContainsTheSphere) {
     }
   }
   EXPECT_GT(limited, 2000);
+}
+
+// forEachBeamRange against every beam: for random fans (a fraction of a turn up to three turns,
+// coarse and fine) and random windows (empty and full ones too), the ranges are increasing and
+// disjoint, every beam whose bearing lies in the window (modulo a turn) is visited, and no visited
+// beam lies more than one increment outside it (the padding).
+TEST(BeamWindow, BeamRangesHoldTheWindowPaddedByOneBeam) {
+  Rng rng(47);
+  long inside = 0, padding = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const double angle_min = uniform(rng, -7, 7);
+    const double span = uniform(rng, 0.05, 6 * M_PI);
+    const int samples = 2 + static_cast<int>(logUniform(rng, 0, 3.5));
+    const ScanPattern fan(fanBySamples(angle_min, angle_min + span, samples));
+    const double start = uniform(rng, 0, 2 * M_PI);
+    const double width = trial % 7 == 0   ? 0.0
+                         : trial % 7 == 1 ? 2 * M_PI
+                                          : uniform(rng, 0, 2 * M_PI);
+    const double inc = fan.angleIncrement();
+    const int n = fan.azimuthCount();
+    std::vector<char> visited(n, 0);
+    int previous_last = -1;
+    forEachBeamRange(fan, start, width, [&](int first, int last) {
+      EXPECT_GE(first, 0) << "trial " << trial;
+      EXPECT_GT(first, previous_last) << "trial " << trial;
+      EXPECT_LE(first, last) << "trial " << trial;
+      EXPECT_LT(last, n) << "trial " << trial;
+      for (int i = std::max(first, 0); i <= std::min(last, n - 1); ++i) visited[i] = 1;
+      previous_last = last;
+    });
+    for (int i = 0; i < n; ++i) {
+      // The beam's offset from the window's start, on the circle, and how far it is outside.
+      double offset = std::fmod(i * inc - start, 2 * M_PI);
+      if (offset < 0) offset += 2 * M_PI;
+      const double outside = offset <= width ? 0.0 : std::min(offset - width, 2 * M_PI - offset);
+      if (outside == 0) {
+        ++inside;
+        EXPECT_TRUE(visited[i]) << "trial " << trial << " beam " << i << " of " << n;
+      } else if (visited[i]) {
+        ++padding;
+        EXPECT_LE(outside, inc * (1 + 1e-6)) << "trial " << trial << " beam " << i << " of " << n;
+      }
+    }
+    if (HasFailure()) return;
+  }
+  EXPECT_GT(inside, 100000);
+  EXPECT_GT(padding, 1000);
 }
 
 }  // namespace
