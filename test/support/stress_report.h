@@ -1,4 +1,4 @@
-// Shared by the numerical stress suite (test/test_stress_*.cpp, one executable): the figures
+// Shared by the numerical stress suite (test/stress/test_stress_*.cpp, one executable): the figures
 // table and the method variants it compares.
 //
 // Each stress case measures a figure for every variant (the five triangle methods, in double and
