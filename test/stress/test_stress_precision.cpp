@@ -1,7 +1,7 @@
 // Stress cases 2 and 5: a scene far from the origin, and one closed mesh at scales 10^-4..10^4.
 //
 // 2. The same scene and sensor translated together by 10^k m (k = 0..7). The Caster composes the
-//    sensor-relative poses in double every scan (DESIGN.md, decision 1), so its range error must
+//    sensor-relative poses in double every scan (docs/design.md §4.1), so its range error must
 //    not grow with k. For contrast the triangle methods are also run the naive way, on world-space
 //    vertices and a world-space ray, where the error grows with the coordinates' magnitude.
 // 5. No absolute epsilons: rays at the vertices and edges of a closed mesh find it at every scale.

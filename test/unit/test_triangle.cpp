@@ -1,7 +1,7 @@
 // The five ray/triangle intersectors of triangle.h, in double and float, against constructed truth:
 // hits at known (t, u, v), misses by construction, the conventions every method shares (inclusive
 // [tmin, tmax], front face and culling, degenerate triangles, non-finite input), agreement between
-// the methods, and the seed documents' worked examples.
+// the methods, and the worked examples of docs/design.md §6.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -644,13 +644,13 @@ TYPED_TEST(TriangleLiteral, WatertightInfiniteDirectionRegression) {
   }
 }
 
-// Seed 004 (ray-plane-hypergraph.txt): plane [1 0 0 -7], R0 = [2 3 4], Rd = [0.577 0.577 0.577].
-// The seed computes Vd = 0.577, V0 = 5, t = 8.66 and Pi = [7 8 9]; "Vd > 0: the plane points away
-// from the ray", so the ray-facing normal is [-1 0 0]. (The text says "x = -7"; [1 0 0 -7] is the
-// plane x = 7, as its numbers show.)
-TYPED_TEST(TriangleLiteral, Seed004WorkedExample) {
+// The ray-plane worked example of docs/design.md §6.4: plane [1 0 0 -7], R0 = [2 3 4],
+// Rd = [0.577 0.577 0.577] give Vd = 0.577, V0 = 5, t = 8.66 and Pi = [7 8 9]; "Vd > 0: the plane
+// points away from the ray", so the ray-facing normal is [-1 0 0]. (Its source says "x = -7";
+// [1 0 0 -7] is the plane x = 7, as its numbers show.)
+TYPED_TEST(TriangleLiteral, RayPlaneWorkedExample) {
   using T = TypeParam;
-  // The seed's own arithmetic.
+  // The example's own arithmetic.
   const Eigen::Vector4d plane(1, 0, 0, -7);
   const Vector3d pn = plane.head<3>();
   const Vector3d r0(2, 3, 4), rd(0.577, 0.577, 0.577);
@@ -659,7 +659,7 @@ TYPED_TEST(TriangleLiteral, Seed004WorkedExample) {
   const double t = v0 / vd;
   EXPECT_DOUBLE_EQ(vd, 0.577);
   EXPECT_DOUBLE_EQ(v0, 5.0);
-  // 5 / 0.577 = 8.6655...: the seed truncates to its 3 digits.
+  // 5 / 0.577 = 8.6655...: the example truncates to its 3 digits.
   EXPECT_EQ(std::trunc(t * 100) / 100, 8.66);
   EXPECT_GT(vd, 0);  // the plane faces away from the ray
   const Vector3d pi = r0 + t * rd;
@@ -698,13 +698,14 @@ TYPED_TEST(TriangleLiteral, Seed004WorkedExample) {
   EXPECT_NEAR((facing - Vector3d(-1, 0, 0)).norm(), 0, 1e-15);
 }
 
-// Seed 001 prints v's numerator as (AB.AS)(AB.AC) - (AB.AB)(AC.AS), the negative of Cramer's rule
-// for AS = u AB + v AC. seed_uv uses the corrected sign. Here AB = (2,0,0), AC = (1,2,0) and the
-// hit S = (1,1,0) has u = 0.25, v = 0.5; the seed's sign would give v = -0.5 and reject the hit.
+// seed_uv's source prints v's numerator as (AB.AS)(AB.AC) - (AB.AB)(AC.AS), the negative of
+// Cramer's rule for AS = u AB + v AC (docs/design.md §6.2). seed_uv uses the corrected sign. Here
+// AB = (2,0,0), AC = (1,2,0) and the hit S = (1,1,0) has u = 0.25, v = 0.5; the printed sign would
+// give v = -0.5 and reject the hit.
 TYPED_TEST(TriangleLiteral, SeedUvUsesTheCorrectedSignOfV) {
   using T = TypeParam;
   const Vector3d a(0, 0, 0), b(2, 0, 0), c(1, 2, 0), s(1, 1, 0);
-  // The seed's formula, written out, really does fail here.
+  // The printed formula, written out, really does fail here.
   const Vector3d ab = b - a, ac = c - a, as = s - a;
   const double denom = ab.dot(ab) * ac.dot(ac) - ab.dot(ac) * ab.dot(ac);
   const double v_seed = (ab.dot(as) * ab.dot(ac) - ab.dot(ab) * ac.dot(as)) / denom;
@@ -725,7 +726,7 @@ TYPED_TEST(TriangleLiteral, SeedUvUsesTheCorrectedSignOfV) {
       EXPECT_NEAR(other->v, hit->v, 1e-6) << toString(m);
     }
   }
-  // A point with u = 0.1, v = 0.8 near the edge BC: the seed's sign gives v < 0 as well.
+  // A point with u = 0.1, v = 0.8 near the edge BC: the printed sign gives v < 0 as well.
   const Vector3d s2 = 0.1 * b + 0.8 * c;
   const auto hit2 = hitTriangle<T>(TriangleMethod::kSeedUv,
                                    makeRay<T>(s2 + Vector3d(0, 0, 3), Vector3d(0, 0, -1)), a, b, c);

@@ -1,5 +1,5 @@
 // Casts a scan pattern from a sensor pose against a scene: per beam, the nearest hit's distance,
-// body and triangle. All geometry is done relative to the sensor (DESIGN.md, decision 1).
+// body and triangle. All geometry is done relative to the sensor (docs/design.md §4.1).
 #pragma once
 
 #include <Eigen/Geometry>

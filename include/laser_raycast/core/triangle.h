@@ -1,6 +1,6 @@
 // Ray/triangle intersection: the watertight production test and the reference methods it is
-// measured against (the seed documents' two plane-then-barycentric tests, Cramer's rule,
-// Moller-Trumbore).
+// measured against (two plane-then-barycentric tests, Cramer's rule, Moller-Trumbore). Their
+// formulas and sources are in docs/design.md §6, the watertight test's reasoning in §4.3.
 //
 // Conventions shared by every method, so that they are interchangeable:
 // - A hit has t in [ray.tmin, tmax] (inclusive) and barycentrics u, v: the weights of b and c, so
@@ -115,10 +115,10 @@ inline bool ownsBoundary(T dx, T dy) {
 template <typename T, TriangleMethod M>
 class PreparedRay;
 
-// Seed 000: the plane H = [N, -N.A] with N = (B - A) x (C - B), t = -H.[V,1] / H.[W,0], then the
-// barycentrics from the in-plane perpendiculars pA = N x (C - B), pB = N x (A - C), pC = N x (B -
-// A). Kept as the seed writes it (with the complete-algorithm pB; the seed's prose once prints N x
-// (A - B)).
+// docs/design.md §6.1: the plane H = [N, -N.A] with N = (B - A) x (C - B), t = -H.[V,1] / H.[W,0],
+// then the barycentrics from the in-plane perpendiculars pA = N x (C - B), pB = N x (A - C),
+// pC = N x (B - A). Kept as its source writes it (with the complete algorithm's pB; the source's
+// prose once prints N x (A - B)).
 template <typename T>
 class PreparedRay<T, TriangleMethod::kSeedPlane> {
  public:
@@ -149,8 +149,8 @@ class PreparedRay<T, TriangleMethod::kSeedPlane> {
   bool cull_;
 };
 
-// Seed 001: unit normal n = AC x AB, S = R + r (n.RA / n.r), then u, v from the dot products of AB,
-// AC, AS.
+// docs/design.md §6.2: unit normal n = AC x AB, S = R + r (n.RA / n.r), then u, v from the dot
+// products of AB, AC, AS.
 template <typename T>
 class PreparedRay<T, TriangleMethod::kSeedUv> {
  public:
@@ -166,7 +166,7 @@ class PreparedRay<T, TriangleMethod::kSeedUv> {
     n /= length;
     const T n_dot_r = n.dot(ray_.dir);
     if (!(n_dot_r != 0)) return std::nullopt;
-    // The seed's normal is AC x AB, the opposite of our front normal, so a back face has n.r < 0.
+    // This normal is AC x AB, the opposite of our front normal, so a back face has n.r < 0.
     if (cull_ && n_dot_r < 0) return std::nullopt;
     const T t = n.dot(a - ray_.origin) / n_dot_r;
     if (!(t >= ray_.tmin && t <= tmax)) return std::nullopt;
@@ -178,7 +178,7 @@ class PreparedRay<T, TriangleMethod::kSeedUv> {
     const T ab_ab = ab.dot(ab);
     const T denom = ab_ab * ac_ac - ab_ac * ab_ac;
     const T u = (ab_as * ac_ac - ab_ac * ac_as) / denom;
-    // The seed prints this numerator with the opposite sign, (AB.AS)(AB.AC) - (AB.AB)(AC.AS);
+    // The source prints this numerator with the opposite sign, (AB.AS)(AB.AC) - (AB.AB)(AC.AS);
     // solving AS = u AB + v AC by Cramer's rule gives the form below, the only one that passes the
     // tests.
     const T v = (ab_ab * ac_as - ab_ac * ab_as) / denom;
@@ -191,8 +191,8 @@ class PreparedRay<T, TriangleMethod::kSeedUv> {
   bool cull_;
 };
 
-// Seed 003: [a - b, a - c, d] [beta, gamma, t]^T = a - p by Cramer's rule, det[x y z] = x . (y x
-// z).
+// docs/design.md §6.3: [a - b, a - c, d] [beta, gamma, t]^T = a - p by Cramer's rule,
+// det[x y z] = x . (y x z).
 template <typename T>
 class PreparedRay<T, TriangleMethod::kCramer> {
  public:
