@@ -35,8 +35,9 @@ constexpr int kExitBadArguments = 2;
 const char* const kUsage =
     "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--list-methods] [--list-scenes]\n"
     "Times every method on the workloads fan2d and rings3d and measures each beam's error\n"
-    "against a long double reference. Writes DIR/results.csv, results.md and pareto.png\n"
-    "(DIR defaults to bench_results). Scenes: sphere box_room tb3 million vertex_rows (default\n"
+    "against a long double reference. Writes DIR/results.csv, results.md, pareto.png (one\n"
+    "point per method) and pareto_matrix.png (every workload and scene) (DIR defaults to\n"
+    "bench_results). Scenes: sphere box_room tb3 million vertex_rows (default\n"
     "all; tb3 needs tb3_world_data: $LASER_RAYCAST_SHARED_DATA, the ROS package, or\n"
     "../shared/data beside the source). --quick: fewer poses and repetitions (under 2 minutes).\n"
     "Exit status: 0 ok, 1 the run failed, 2 bad arguments.\n";
@@ -295,14 +296,20 @@ std::vector<bench::Row> runBenchmark(const Options& options, const Settings& set
   return rows;
 }
 
-std::string runInfo(const Options& options, const Settings& settings, double seconds) {
-  std::ostringstream info;
+// "bench --quick on 2026-01-31 12:00 UTC, <cpu>": which run the results come from.
+std::string runLabel(const Options& options) {
   const std::time_t now = std::time(nullptr);
   char date[32];
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  return std::string("bench") + (options.quick ? " --quick" : "") + " on " + date + ", " +
+         cpuModel();
+}
+
+std::string runInfo(const Options& options, const Settings& settings, double seconds) {
+  std::ostringstream info;
   info << "# laser_raycast benchmark\n\n";
-  info << "Run: `bench" << (options.quick ? " --quick" : "") << "` on " << date << ", "
-       << cpuModel() << ", single-threaded, " << std::lround(seconds) << " s wall clock. ";
+  info << "Run: " << runLabel(options) << ", single-threaded, " << std::lround(seconds)
+       << " s wall clock. ";
   info << "Sensor poses per scene: ";
   for (const auto& w : bench::workloads()) {
     info << w.name << " " << (options.quick ? w.quick_poses : w.full_poses) << ", ";
@@ -327,12 +334,14 @@ int run(const Options& options) {
   const std::string csv = (out / "results.csv").string();
   const std::string md = (out / "results.md").string();
   const std::string png = (out / "pareto.png").string();
+  const std::string matrix_png = (out / "pareto_matrix.png").string();
   bench::writeCsv(csv, rows);
   bench::writeMarkdown(md, rows, runInfo(options, settings, secondsSince(start)));
-  const std::string plot_error = bench::runPlot(plotScript(), csv, png);
+  const std::string plot_error = bench::runPlot(
+      plotScript(), {csv, png, "--matrix", matrix_png, "--source", "Run: " + runLabel(options)});
   if (!plot_error.empty()) throw std::runtime_error("plotting failed: " + plot_error);
   std::cerr << "bench: done in " << secondsSince(start) << " s: " << csv << ", " << md << ", "
-            << png << "\n";
+            << png << ", " << matrix_png << "\n";
   return 0;
 }
 

@@ -105,15 +105,18 @@ void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
   if (!out) throw std::runtime_error("writing " + path + " failed");
 }
 
-std::string runPlot(const std::string& script, const std::string& csv, const std::string& png) {
+std::string runPlot(const std::string& script, const std::vector<std::string>& args) {
   // Debian's interpreter, which has python3-matplotlib, not whichever python3 is first on PATH.
   const char* const python = "/usr/bin/python3";
   if (access(python, X_OK) != 0) return std::string(python) + " is not there";
   if (access(script.c_str(), R_OK) != 0) return "the plot script " + script + " is not there";
+  std::vector<char*> argv = {const_cast<char*>(python), const_cast<char*>(script.c_str())};
+  for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+  argv.push_back(nullptr);
   const pid_t pid = fork();
   if (pid < 0) return "fork failed";
   if (pid == 0) {
-    execl(python, python, script.c_str(), csv.c_str(), png.c_str(), static_cast<char*>(nullptr));
+    execv(python, argv.data());
     _exit(127);
   }
   int status = 0;

@@ -39,8 +39,8 @@ void writeCsv(const std::string& path, const std::vector<Row>& rows);
 void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
                    const std::string& run_info);
 
-// Runs /usr/bin/python3 script csv png. Returns "" on success, else what went wrong.
-std::string runPlot(const std::string& script, const std::string& csv, const std::string& png);
+// Runs /usr/bin/python3 script args... Returns "" on success, else what went wrong.
+std::string runPlot(const std::string& script, const std::vector<std::string>& args);
 
 }  // namespace bench
 }  // namespace laser_raycast

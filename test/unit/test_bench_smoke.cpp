@@ -138,9 +138,11 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
   }
 
   EXPECT_FALSE(readFile(dir + "/results.md").empty());
-  const std::string png = readFile(dir + "/pareto.png");
-  ASSERT_GT(png.size(), 8u);
-  EXPECT_EQ(png.substr(1, 3), "PNG");
+  for (const std::string name : {"pareto.png", "pareto_matrix.png"}) {
+    const std::string png = readFile(dir + "/" + name);
+    ASSERT_GT(png.size(), 8u) << name;
+    EXPECT_EQ(png.substr(1, 3), "PNG") << name;
+  }
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
 }
