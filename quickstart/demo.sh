@@ -1,22 +1,41 @@
 #!/usr/bin/env bash
 # Quick start command (1): install what is missing, build, and run the demo headless: a robot drives
 # around a furnished room and the simulated laser's scan is summarised once a second.
-#   ./quickstart/demo.sh                 20 s, then stop
-#   ./quickstart/demo.sh --duration 0    until Ctrl-C
-#   ./quickstart/demo.sh --gui           with RViz (installs rviz; needs a display)
 set -euo pipefail
-source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+
+usage() {
+  cat <<'EOF'
+usage: quickstart/demo.sh [--duration SECONDS] [--gui] [--help]
+
+Installs the Debian packages that are missing (apt-get, as root), builds the package in .ws/ inside
+the clone, and runs launch/demo.launch: a robot drives around a furnished room and the simulated
+laser's scan is summarised once a second.
+
+  --duration SECONDS  stop after this long (default 20; 0: until Ctrl-C)
+  --gui               also start RViz (installs rviz; needs a display)
+  -h, --help          print this and exit
+
+Exit status: 0 the demo received scans, 1 it did not (or the build failed), 2 bad arguments.
+EOF
+}
 
 duration=20
 gui=false
 while [ $# -gt 0 ]; do
   case "$1" in
-    --duration) duration=${2:?--duration needs seconds}; shift 2 ;;
+    --duration)
+      if [ $# -lt 2 ] || ! [[ $2 =~ ^[0-9]+([.][0-9]+)?$ ]]; then
+        echo "quickstart/demo.sh: --duration needs a number of seconds >= 0 (try --help)" >&2
+        exit 2
+      fi
+      duration=$2; shift 2 ;;
     --gui) gui=true; shift ;;
-    -h|--help) sed -n '2,7p' "${BASH_SOURCE[0]}"; exit 0 ;;
-    *) log "unknown argument '$1' (try --help)"; exit 2 ;;
+    -h|--help) usage; exit 0 ;;
+    *) echo "quickstart/demo.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
+
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 packages=("${APT_PACKAGES[@]}")
 [ "$gui" = true ] && packages+=(rviz)

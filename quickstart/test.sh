@@ -5,6 +5,27 @@
 # Tests that use the real third-party scene in ../shared/data (beside the clone) run when it is present and
 # are skipped otherwise; LASER_RAYCAST_REQUIRE_SHARED_DATA=1 turns its absence into a failure.
 set -euo pipefail
+
+usage() {
+  cat <<'EOF'
+usage: quickstart/test.sh [--help]
+
+Installs the Debian packages that are missing (apt-get, as root), builds the package in .ws/ inside
+the clone, runs every test (gtest and rostest) and catkin_lint -W2, and prints the summary. Exits
+non-zero on any failure or if no test ran. CI (.ci/run) runs exactly this.
+
+Environment:
+  LASER_RAYCAST_REQUIRE_SHARED_DATA=1  fail instead of skipping when ../shared/data is missing
+  LASER_RAYCAST_WS=DIR                 build in DIR instead of .ws/
+  LASER_RAYCAST_JOBS=N                 parallel build jobs (default: the number of CPUs)
+EOF
+}
+case "${1:-}" in
+  -h|--help) usage; exit 0 ;;
+  "") ;;
+  *) echo "quickstart/test.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
+esac
+
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 install_missing "${APT_PACKAGES[@]}"

@@ -8,11 +8,13 @@ The meshes are closed, with vertices shared between neighbouring triangles, in m
 - table.stl (ASCII STL): a 1.6 m x 0.9 m table top at 0.75 m on four 0.06 m square legs.
 - sofa.obj (OBJ): an L-shaped seat block with a back rest.
 - pot.obj (OBJ): a plant pot, a 32-sided truncated cone.
-Pure Python, no dependencies.
+Pure Python, no dependencies. The output is deterministic: the same dimensions give the same files.
 """
+import argparse
 import math
 import os
 import struct
+import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = os.path.join(HERE, "meshes")
@@ -138,13 +140,36 @@ def pot(sides=32, r_bottom=0.16, r_top=0.22, height=0.45):
     return m
 
 
-def main():
-    os.makedirs(OUT, exist_ok=True)
-    write_binary_stl(room_walls(), os.path.join(OUT, "room_walls.stl"), "laser_raycast demo room walls")
-    write_ascii_stl(table(), os.path.join(OUT, "table.stl"), "table")
-    write_obj(sofa(), os.path.join(OUT, "sofa.obj"), "laser_raycast demo sofa (metres)")
-    write_obj(pot(), os.path.join(OUT, "pot.obj"), "laser_raycast demo plant pot (metres)")
+class ArgumentParser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit status 2
+        self.exit(2, "%s: %s (see --help)\n" % (self.prog, message))
+
+
+def parse_args(argv):
+    parser = ArgumentParser(prog="generate_meshes.py", description=__doc__.split("\n\n")[0],
+                            epilog=__doc__.split("\n", 2)[2],
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--out", metavar="DIR", default=OUT,
+                        help="directory to write the four meshes into, created if missing "
+                        "(default: %(default)s, which worlds/demo_room.urdf uses)")
+    return parser.parse_args(argv)
+
+
+def main(argv):
+    args = parse_args(argv)
+    try:
+        os.makedirs(args.out, exist_ok=True)
+        out = lambda name: os.path.join(args.out, name)
+        write_binary_stl(room_walls(), out("room_walls.stl"), "laser_raycast demo room walls")
+        write_ascii_stl(table(), out("table.stl"), "table")
+        write_obj(sofa(), out("sofa.obj"), "laser_raycast demo sofa (metres)")
+        write_obj(pot(), out("pot.obj"), "laser_raycast demo plant pot (metres)")
+    except OSError as e:
+        sys.stderr.write("generate_meshes.py: cannot write %s: %s\n"
+                         % (e.filename or args.out, e.strerror))
+        return 2
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main(sys.argv[1:]))
