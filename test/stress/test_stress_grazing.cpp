@@ -218,8 +218,8 @@ TEST(StressGrazing, SingleTrianglesDecideAndBoundT) {
   Table errors{"3b",
                "3b. Grazing rays at 10^-k rad: worst |dt| in units of u S / sin(theta)",
                "The same rays. S: farthest vertex from the origin, u: the precision's unit "
-               "roundoff. The analytic bound (derivation in test/test_stress_grazing.cpp) is 700 "
-               "(L^2/A) u S / sin(theta) + 10 u S, " +
+               "roundoff. The analytic bound (derivation in test/stress/test_stress_grazing.cpp) "
+               "is 700 (L^2/A) u S / sin(theta) + 10 u S, " +
                    fixed(bound_min, 0) + " to " + fixed(bound_max, 0) +
                    " units for these triangles. Asserted on production: every hit within the "
                    "bound. In brackets: hits beyond it.",

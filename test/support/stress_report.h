@@ -5,7 +5,7 @@
 // in float) and asserts a bound only on the production path (watertight, double, through the BVH
 // and the Caster). The figures are recorded as markdown tables: printed as each case finishes and,
 // when LASER_RAYCAST_STRESS_REPORT names a file, written there after the last test
-// (docs/stress.md is such a run).
+// (docs/stress.md is such a run; docs/testing.md describes the suite).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -188,10 +188,11 @@ inline void record(const Table& t) {
 
 inline std::string reportIntro() {
   return "# Numerical stress suite: figures\n\n"
-         "Written by the gtest executable `test_stress` (`test/test_stress_*.cpp`, run in CI "
-         "with the other tests). To regenerate this file, from the catkin workspace that holds "
-         "the package (`.ws/` after `quickstart/test.sh`), with `../shared/data` beside the "
-         "clone:\n\n"
+         "Written by the gtest executable `test_stress` (`test/stress/test_stress_*.cpp`, run "
+         "in CI with the other tests); what the suite asserts, and a summary of these tables, "
+         "are in [testing.md](testing.md). To regenerate this file, from the catkin workspace "
+         "that holds the package (`.ws/` after `quickstart/test.sh`), with `../shared/data` "
+         "beside the clone:\n\n"
          "```sh\n"
          "catkin_make -j2 test_stress\n"
          "LASER_RAYCAST_STRESS_REPORT=$PWD/src/laser_raycast/docs/stress.md "
