@@ -1,247 +1,224 @@
 #include "laser_raycast/node/node_params.h"
 
 #include <ros/console.h>
-#include <ros/param.h>
+#include <ros/names.h>
+#include <ros/node_handle.h>
 
+#include <algorithm>
 #include <cmath>
-#include <limits>
-#include <set>
-#include <sstream>
 #include <stdexcept>
-#include <type_traits>
 
+#include "param_reader.h"
+
+// The parameters are read in groups. The sensor's own groups (frames, fan, output, timing, pose
+// source) take a reader over one struct, so that a list of sensors could later be read entry by
+// entry with the same functions.
 namespace laser_raycast {
 namespace {
 
-const char* typeName(XmlRpc::XmlRpcValue::Type type) {
-  switch (type) {
-    case XmlRpc::XmlRpcValue::TypeBoolean:
-      return "bool";
-    case XmlRpc::XmlRpcValue::TypeInt:
-      return "int";
-    case XmlRpc::XmlRpcValue::TypeDouble:
-      return "double";
-    case XmlRpc::XmlRpcValue::TypeString:
-      return "string";
-    case XmlRpc::XmlRpcValue::TypeArray:
-      return "list";
-    case XmlRpc::XmlRpcValue::TypeStruct:
-      return "dict";
-    default:
-      return "other";
+// tf2 frame ids have no leading '/' (tf1 had one); an empty one names no frame.
+void checkFrame(ParamReader* r, const std::string& name, const std::string& frame, bool optional) {
+  if (frame.empty() && !optional) r->fail(name, "must not be empty");
+  if (!frame.empty() && frame[0] == '/') {
+    r->fail(name, "'" + frame + "': tf2 frame ids must not start with '/'");
   }
 }
 
-// Reads private parameters with type checks, logs each once, and keeps the first error. A parameter
-// of the wrong type is an error rather than a silent fall back to the default.
-class ParamReader {
- public:
-  explicit ParamReader(const ros::NodeHandle& pnh) : pnh_(pnh) {}
+void readFrames(ParamReader* r, NodeParams* p) {
+  p->frame_id = r->text("frame_id", p->frame_id);
+  checkFrame(r, "frame_id", p->frame_id, false);
+  p->fixed_frame = r->text("fixed_frame", p->fixed_frame);
+  checkFrame(r, "fixed_frame", p->fixed_frame, false);
+}
 
-  bool has(const std::string& name) {
-    read_.insert(name);
-    return pnh_.hasParam(name);
+// The beam count comes from exactly one of ~angle_increment and ~samples (neither:
+// kDefaultSamples); the core checks the angles and the beam count.
+void readFan(ParamReader* r, core::FanSpec* fan) {
+  fan->angle_min = r->number("angle_min", fan->angle_min, "rad");
+  fan->angle_max = r->number("angle_max", fan->angle_max, "rad");
+  const bool has_increment = r->has("angle_increment"), has_samples = r->has("samples");
+  if (has_increment) {
+    fan->angle_increment = r->number("angle_increment", 0.0, "rad");
+    if (!(std::isfinite(fan->angle_increment) && fan->angle_increment > 0)) {
+      r->fail("angle_increment",
+              "must be finite and > 0 rad, got " + formatNumber(fan->angle_increment));
+    }
+  } else {
+    r->note(r->prefix() + "angle_increment unset (beams from " + r->prefix() + "samples)");
   }
-
-  double number(const std::string& name, double fallback, const char* unit) {
-    return scalar<double>(name, fallback, unit, "a number",
-                          [](XmlRpc::XmlRpcValue& v, double* out) {
-                            if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
-                              *out = static_cast<double>(v);
-                            } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
-                              *out = static_cast<int>(v);
-                            } else {
-                              return false;
-                            }
-                            return true;
-                          });
+  if (has_samples || !has_increment) {
+    fan->samples = r->integer("samples", NodeParams::kDefaultSamples, "beams");
+    if (fan->samples < 2) r->fail("samples", "must be >= 2, got " + std::to_string(fan->samples));
+  } else {
+    r->note(r->prefix() + "samples unset (beams from " + r->prefix() + "angle_increment)");
   }
-
-  int integer(const std::string& name, int fallback, const char* unit) {
-    return scalar<int>(name, fallback, unit, "an integer", [](XmlRpc::XmlRpcValue& v, int* out) {
-      if (v.getType() != XmlRpc::XmlRpcValue::TypeInt) return false;
-      *out = static_cast<int>(v);
-      return true;
-    });
+  if (has_increment && has_samples) {
+    r->fail("samples", "set " + r->prefix() + "angle_increment or " + r->prefix() +
+                           "samples, not both (got angle_increment " +
+                           formatNumber(fan->angle_increment) + " and samples " +
+                           std::to_string(fan->samples) + ")");
   }
+}
 
-  bool boolean(const std::string& name, bool fallback) {
-    return scalar<bool>(name, fallback, "", "true or false", [](XmlRpc::XmlRpcValue& v, bool* out) {
-      if (v.getType() != XmlRpc::XmlRpcValue::TypeBoolean) return false;
-      *out = static_cast<bool>(v);
-      return true;
-    });
+// ~reflectivity: {link: value >= 0}; an empty dict is the same as none.
+void readReflectivity(ParamReader* r, std::map<std::string, double>* reflectivity) {
+  const XmlRpc::XmlRpcValue* v = r->get("reflectivity");
+  if (v && v->getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+    r->wrongType("reflectivity", *v, "a dict {link: reflectivity}");
+  } else if (v) {
+    for (auto it = v->begin(); it != v->end(); ++it) {
+      const std::string name = "reflectivity/" + it->first;
+      const auto type = it->second.getType();
+      if (type != XmlRpc::XmlRpcValue::TypeDouble && type != XmlRpc::XmlRpcValue::TypeInt) {
+        r->wrongType(name, it->second, "a number");
+        continue;
+      }
+      const double value = type == XmlRpc::XmlRpcValue::TypeInt
+                               ? static_cast<const int&>(it->second)
+                               : static_cast<const double&>(it->second);
+      if (!(std::isfinite(value) && value >= 0)) {
+        r->fail(name, "must be finite and >= 0, got " + formatNumber(value));
+      }
+      (*reflectivity)[it->first] = value;
+    }
   }
-
-  std::string text(const std::string& name, const std::string& fallback) {
-    return scalar<std::string>(name, fallback, "", "a string",
-                               [](XmlRpc::XmlRpcValue& v, std::string* out) {
-                                 if (v.getType() != XmlRpc::XmlRpcValue::TypeString) return false;
-                                 *out = static_cast<std::string>(v);
-                                 return true;
-                               });
+  std::string shown;
+  for (const auto& [link, value] : *reflectivity) {
+    shown += (shown.empty() ? "" : ", ") + link + ": " + formatNumber(value);
   }
+  r->note(r->prefix() + "reflectivity = {" + shown + "}");
+}
 
-  std::vector<std::string> textList(const std::string& name) {
-    XmlRpc::XmlRpcValue v;
-    std::vector<std::string> value;
-    if (get(name, &v)) {
-      if (v.getType() != XmlRpc::XmlRpcValue::TypeArray) {
-        wrongType(name, v, "a list of strings");
+// What the sensor reports: range limits, min-range policy, noise, intensity.
+void readOutput(ParamReader* r, NodeParams* p, std::vector<std::string>* warnings) {
+  core::EncoderConfig& out = p->scan.output;
+  out.range_min = r->number("range_min", out.range_min, "m");
+  out.range_max = r->number("range_max", out.range_max, "m");
+  out.min_range_policy =
+      r->choice("min_range_policy", out.min_range_policy, core::kMinRangePolicyNames);
+  out.noise_stddev = r->number("noise_stddev", out.noise_stddev, "m");
+  const int seed = r->integer("noise_seed", static_cast<int>(out.noise_seed), "");
+  if (seed < 0) r->fail("noise_seed", "must be >= 0, got " + std::to_string(seed));
+  out.noise_seed = static_cast<std::uint64_t>(std::max(seed, 0));
+  out.intensity = r->choice("intensity", out.intensity, kIntensityNames);
+  readReflectivity(r, &p->reflectivity);
+  p->default_reflectivity = r->number("default_reflectivity", p->default_reflectivity, "");
+  if (!(std::isfinite(p->default_reflectivity) && p->default_reflectivity >= 0)) {
+    r->fail("default_reflectivity",
+            "must be finite and >= 0, got " + formatNumber(p->default_reflectivity));
+  }
+  if (!out.intensity && !p->reflectivity.empty()) {
+    warnings->push_back(r->prefix() + "reflectivity is set but " + r->prefix() +
+                        "intensity is off: no intensities are published");
+  }
+}
+
+void readTiming(ParamReader* r, NodeParams* p) {
+  p->rate = r->number("rate", p->rate, "Hz");
+  if (!(std::isfinite(p->rate) && p->rate > 0 && p->rate <= NodeParams::kMaxRate)) {
+    r->fail("rate", "must be in (0, " + formatNumber(NodeParams::kMaxRate) + "] Hz, got " +
+                        formatNumber(p->rate));
+  }
+  p->tf_timeout = r->number("tf_timeout", p->tf_timeout, "s");
+  if (!(std::isfinite(p->tf_timeout) && p->tf_timeout >= 0 &&
+        p->tf_timeout <= NodeParams::kMaxTfTimeout)) {
+    r->fail("tf_timeout", "must be in [0, " + formatNumber(NodeParams::kMaxTfTimeout) +
+                              "] s, got " + formatNumber(p->tf_timeout));
+  }
+}
+
+// One entry of ~models: a parameter name, or a dict with exactly one of param and file, and an
+// optional tf_prefix. False (after r->fail) if it is malformed.
+bool readModel(ParamReader* r, const std::string& where, const XmlRpc::XmlRpcValue& e,
+               ModelSource* m) {
+  if (e.getType() == XmlRpc::XmlRpcValue::TypeString) {
+    m->param = static_cast<const std::string&>(e);
+  } else if (e.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
+    for (auto it = e.begin(); it != e.end(); ++it) {
+      if (it->second.getType() != XmlRpc::XmlRpcValue::TypeString) {
+        r->wrongType(where + "/" + it->first, it->second, "a string");
+        return false;
+      }
+      const std::string& value = it->second;
+      if (it->first == "param") {
+        m->param = value;
+      } else if (it->first == "file") {
+        m->file = value;
+      } else if (it->first == "tf_prefix") {
+        m->tf_prefix = value;
       } else {
-        for (int i = 0; i < v.size(); ++i) {
-          if (v[i].getType() != XmlRpc::XmlRpcValue::TypeString) {
-            fail(name, "entry " + std::to_string(i) + " is a " + typeName(v[i].getType()) +
-                           ", expected a string");
-            break;
-          }
-          value.push_back(static_cast<std::string>(v[i]));
-        }
+        r->fail(where, "unknown key '" + it->first + "' (expected param, file, tf_prefix)");
+        return false;
       }
     }
-    std::ostringstream s;
-    for (std::size_t i = 0; i < value.size(); ++i) s << (i ? ", " : "") << value[i];
-    ROS_INFO_STREAM("~" << name << " = [" << s.str() << "]");
-    return value;
-  }
-
-  // The raw value (for structured parameters); false if unset.
-  bool get(const std::string& name, XmlRpc::XmlRpcValue* v) {
-    read_.insert(name);
-    return pnh_.getParam(name, *v);
-  }
-
-  // A scalar parameter: the fallback if unset, an error if convert() refuses its type; logged once.
-  template <typename T, class Convert>
-  T scalar(const std::string& name, const T& fallback, const char* unit, const char* expected,
-           Convert convert) {
-    XmlRpc::XmlRpcValue v;
-    T value = fallback;
-    if (get(name, &v) && !convert(v, &value)) wrongType(name, v, expected);
-    std::ostringstream shown;
-    if constexpr (std::is_same_v<T, bool>) {
-      shown << (value ? "true" : "false");
-    } else if constexpr (std::is_same_v<T, std::string>) {
-      shown << "'" << value << "'";
-    } else {
-      shown << value << (*unit ? " " : "") << unit;
-    }
-    ROS_INFO_STREAM("~" << name << " = " << shown.str());
-    return value;
-  }
-
-  void fail(const std::string& name, const std::string& message) {
-    failWith("parameter ~" + name + ": " + message);
-  }
-  // For messages that already name the parameter (the core's validate() names its fields, which
-  // share the parameters' names).
-  void failWith(const std::string& message) {
-    if (error_.empty()) error_ = message;
-  }
-  void wrongType(const std::string& name, XmlRpc::XmlRpcValue& v, const char* expected) {
-    std::ostringstream msg;
-    msg << "is a " << typeName(v.getType()) << " (" << v.toXml() << "), expected " << expected;
-    fail(name, msg.str());
-  }
-
-  const std::string& error() const { return error_; }
-
-  // Private parameters that exist but were never read (typos such as ~angle_incremnt).
-  std::vector<std::string> unknown() const {
-    std::vector<std::string> names, unknown;
-    ros::param::getParamNames(names);
-    const std::string prefix = pnh_.getNamespace() + "/";
-    for (const std::string& full : names) {
-      if (full.compare(0, prefix.size(), prefix) != 0) continue;
-      const std::string name = full.substr(prefix.size());
-      const std::string top = name.substr(0, name.find('/'));
-      if (!read_.count(top)) unknown.push_back(top);
-    }
-    return unknown;
-  }
-
- private:
-  ros::NodeHandle pnh_;
-  std::set<std::string> read_;
-  std::string error_;
-};
-
-bool readModels(ParamReader* reader, std::vector<ModelSource>* models) {
-  XmlRpc::XmlRpcValue v;
-  if (!reader->get("models", &v)) {
-    models->push_back(ModelSource{"robot_description", "", ""});
-    ROS_INFO("~models unset: the URDF in parameter robot_description");
-    return true;
-  }
-  if (v.getType() != XmlRpc::XmlRpcValue::TypeArray || v.size() == 0) {
-    reader->wrongType("models", v, "a non-empty list of {param: NAME} or {file: PATH} entries");
+  } else {
+    r->wrongType(where, e, "a parameter name or a dict {param|file, tf_prefix}");
     return false;
   }
-  for (int i = 0; i < v.size(); ++i) {
-    const std::string where = "models[" + std::to_string(i) + "]";
-    ModelSource m;
-    XmlRpc::XmlRpcValue& e = v[i];
-    if (e.getType() == XmlRpc::XmlRpcValue::TypeString) {
-      m.param = static_cast<std::string>(e);
-    } else if (e.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
-      for (auto it = e.begin(); it != e.end(); ++it) {
-        if (it->second.getType() != XmlRpc::XmlRpcValue::TypeString) {
-          reader->fail(where, "'" + it->first + "' must be a string");
-          return false;
-        }
-        const std::string value = static_cast<std::string>(it->second);
-        if (it->first == "param") {
-          m.param = value;
-        } else if (it->first == "file") {
-          m.file = value;
-        } else if (it->first == "tf_prefix") {
-          m.tf_prefix = value;
-        } else {
-          reader->fail(where, "unknown key '" + it->first + "' (expected param, file, tf_prefix)");
-          return false;
-        }
-      }
-    } else {
-      reader->wrongType(where, e, "a parameter name or a dict {param|file, tf_prefix}");
-      return false;
-    }
-    if (m.param.empty() == m.file.empty()) {
-      reader->fail(where, "give exactly one of 'param' and 'file'");
-      return false;
-    }
-    ROS_INFO_STREAM("~" << where << " = " << m.describe()
-                        << (m.tf_prefix.empty() ? "" : ", tf_prefix '" + m.tf_prefix + "'"));
-    models->push_back(m);
+  if (m->param.empty() == m->file.empty()) {
+    r->fail(where, "give exactly one of 'param' and 'file', got " + describeValue(e));
+    return false;
+  }
+  if (!m->tf_prefix.empty() && m->tf_prefix[0] == '/') {
+    r->fail(where, "tf_prefix '" + m->tf_prefix + "': tf2 frame ids must not start with '/'");
+    return false;
   }
   return true;
 }
 
-bool readReflectivity(ParamReader* reader, std::map<std::string, double>* reflectivity) {
-  XmlRpc::XmlRpcValue v;
-  if (!reader->get("reflectivity", &v)) return true;
-  if (v.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
-    reader->wrongType("reflectivity", v, "a dict {link: value}");
-    return false;
-  }
-  for (auto it = v.begin(); it != v.end(); ++it) {
-    double value;
-    if (it->second.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
-      value = static_cast<double>(it->second);
-    } else if (it->second.getType() == XmlRpc::XmlRpcValue::TypeInt) {
-      value = static_cast<int>(it->second);
-    } else {
-      reader->wrongType("reflectivity/" + it->first, it->second, "a number");
-      return false;
+void readModels(ParamReader* r, std::vector<ModelSource>* models) {
+  const XmlRpc::XmlRpcValue* v = r->get("models");
+  if (v && (v->getType() != XmlRpc::XmlRpcValue::TypeArray || v->size() == 0)) {
+    r->wrongType("models", *v, "a non-empty list of {param: NAME} or {file: PATH} entries");
+  } else if (v) {
+    models->clear();
+    for (int i = 0; i < v->size(); ++i) {
+      ModelSource m;
+      if (!readModel(r, "models[" + std::to_string(i) + "]", (*v)[i], &m)) return;
+      models->push_back(m);
     }
-    if (!(std::isfinite(value) && value >= 0)) {
-      reader->fail("reflectivity/" + it->first,
-                   "must be finite and >= 0, got " + std::to_string(value));
-      return false;
-    }
-    ROS_INFO_STREAM("~reflectivity/" << it->first << " = " << value);
-    (*reflectivity)[it->first] = value;
   }
-  return true;
+  for (std::size_t i = 0; i < models->size(); ++i) {
+    const ModelSource& m = (*models)[i];
+    r->note(r->prefix() + "models[" + std::to_string(i) + "] = " + m.describe() +
+            (m.tf_prefix.empty() ? "" : ", tf_prefix '" + m.tf_prefix + "'"));
+  }
+}
+
+// Which geometry is cast against, and how.
+void readScene(ParamReader* r, NodeParams* p) {
+  p->geometry = r->choice("geometry", p->geometry, kGeometrySourceNames);
+  p->skip_bad_geometry = r->boolean("skip_bad_geometry", p->skip_bad_geometry);
+  readModels(r, &p->models);
+  p->ignore_links = r->textList("ignore_links");
+  p->scan.method = r->choice("method", p->scan.method, core::kTriangleMethodNames);
+  p->scan.cull_backfaces = r->boolean("cull_backfaces", p->scan.cull_backfaces);
+}
+
+// Where the sensor pose comes from: TF, or a topic giving the pose of pose_frame.
+void readPoseSource(ParamReader* r, NodeParams* p) {
+  p->pose_topic = r->text("pose_topic", p->pose_topic);
+  std::string why;
+  if (!p->pose_topic.empty() && !ros::names::validate(p->pose_topic, why)) {
+    r->fail("pose_topic", "'" + p->pose_topic + "' is not a valid topic name: " + why);
+  }
+  p->pose_frame = r->text("pose_frame", p->pose_frame);
+  checkFrame(r, "pose_frame", p->pose_frame, true);
+  if (!p->pose_frame.empty() && p->pose_topic.empty()) {
+    r->fail("pose_frame", "is set to '" + p->pose_frame + "' but " + r->prefix() +
+                              "pose_topic is not (pose_frame names the frame whose pose the "
+                              "topic gives)");
+  }
+}
+
+// Every group, in the order the log lists them.
+void readAll(ParamReader* r, NodeParams* p, std::vector<std::string>* warnings) {
+  readFrames(r, p);
+  readFan(r, &p->scan.fan);
+  readOutput(r, p, warnings);
+  readTiming(r, p);
+  readScene(r, p);
+  readPoseSource(r, p);
 }
 
 }  // namespace
@@ -250,79 +227,14 @@ std::string ModelSource::describe() const {
   return param.empty() ? "file " + file : "parameter " + param;
 }
 
-bool readNodeParams(const ros::NodeHandle& pnh, NodeParams* p, std::string* error) {
-  ParamReader r(pnh);
-  p->frame_id = r.text("frame_id", p->frame_id);
-  p->fixed_frame = r.text("fixed_frame", p->fixed_frame);
-  for (const auto& [name, frame] :
-       {std::pair<const char*, const std::string&>{"frame_id", p->frame_id},
-        {"fixed_frame", p->fixed_frame}}) {
-    if (frame.empty()) r.fail(name, "must not be empty");
-    if (!frame.empty() && frame[0] == '/')
-      r.fail(name, "'" + frame + "': tf2 frame ids must not start with '/'");
-  }
+std::string parseNodeParams(const XmlRpc::XmlRpcValue& values, NodeParams* p, ParamReport* report) {
+  *p = NodeParams();
+  *report = ParamReport();
+  ParamReader r(values, "~");
+  readAll(&r, p, &report->warnings);
 
-  p->scan.fan.angle_min = r.number("angle_min", -M_PI, "rad");
-  p->scan.fan.angle_max = r.number("angle_max", M_PI, "rad");
-  const bool has_increment = r.has("angle_increment"), has_samples = r.has("samples");
-  p->scan.fan.angle_increment = has_increment ? r.number("angle_increment", 0.0, "rad") : 0.0;
-  p->scan.fan.samples = has_samples || !has_increment ? r.integer("samples", 360, "beams") : 0;
-  if (has_increment && has_samples) r.fail("samples", "set ~angle_increment or ~samples, not both");
-
-  p->scan.output.range_min = r.number("range_min", 0.0, "m");
-  p->scan.output.range_max = r.number("range_max", 30.0, "m");
-  const std::string policy = r.text("min_range_policy", "-inf");
-  if (!core::parseMinRangePolicy(policy, &p->scan.output.min_range_policy)) {
-    r.fail("min_range_policy", core::kMinRangePolicyNames.notOneOf(policy));
-  }
-  p->scan.output.noise_stddev = r.number("noise_stddev", 0.0, "m");
-  const int seed = r.integer("noise_seed", 0, "");
-  if (seed < 0) r.fail("noise_seed", "must be >= 0, got " + std::to_string(seed));
-  p->scan.output.noise_seed = static_cast<std::uint64_t>(std::max(seed, 0));
-  const std::string intensity = r.text("intensity", "off");
-  if (intensity != "off" && intensity != "reflectivity") {
-    r.fail("intensity", "'" + intensity + "' is not one of off, reflectivity");
-  }
-  p->scan.output.intensity = intensity == "reflectivity";
-  readReflectivity(&r, &p->reflectivity);
-  p->default_reflectivity = r.number("default_reflectivity", 1.0, "");
-  if (!(std::isfinite(p->default_reflectivity) && p->default_reflectivity >= 0)) {
-    r.fail("default_reflectivity", "must be finite and >= 0");
-  }
-
-  p->rate = r.number("rate", 10.0, "Hz");
-  if (!(std::isfinite(p->rate) && p->rate > 0 && p->rate <= 1000)) {
-    r.fail("rate", "must be in (0, 1000] Hz, got " + std::to_string(p->rate));
-  }
-  p->tf_timeout = r.number("tf_timeout", 0.1, "s");
-  if (!(std::isfinite(p->tf_timeout) && p->tf_timeout >= 0 && p->tf_timeout <= 10)) {
-    r.fail("tf_timeout", "must be in [0, 10] s, got " + std::to_string(p->tf_timeout));
-  }
-
-  const std::string geometry = r.text("geometry", "visual");
-  if (!parseGeometrySource(geometry, &p->geometry)) {
-    r.fail("geometry", kGeometrySourceNames.notOneOf(geometry));
-  }
-  p->skip_bad_geometry = r.boolean("skip_bad_geometry", false);
-  readModels(&r, &p->models);
-  p->ignore_links = r.textList("ignore_links");
-
-  const std::string method = r.text("method", "watertight");
-  if (!core::parseTriangleMethod(method, &p->scan.method)) {
-    r.fail("method", core::kTriangleMethodNames.notOneOf(method));
-  }
-  p->scan.cull_backfaces = r.boolean("cull_backfaces", false);
-
-  p->pose_topic = r.text("pose_topic", "");
-  p->pose_frame = r.text("pose_frame", "");
-  if (!p->pose_frame.empty() && p->pose_topic.empty()) {
-    r.fail("pose_frame", "is set to '" + p->pose_frame + "' but ~pose_topic is not");
-  }
-  if (!p->pose_frame.empty() && p->pose_frame[0] == '/') {
-    r.fail("pose_frame", "'" + p->pose_frame + "': tf2 frame ids must not start with '/'");
-  }
-
-  // Ranges, angles and noise through the core's own validation, which names the field.
+  // The angles and beam count, ranges and noise through the core's own validation, which names
+  // the field (the fields share the parameters' names).
   if (r.error().empty()) {
     try {
       p->scan.validate();
@@ -330,11 +242,32 @@ bool readNodeParams(const ros::NodeHandle& pnh, NodeParams* p, std::string* erro
       r.failWith(std::string("bad parameter: ") + e.what());
     }
   }
-
   for (const std::string& name : r.unknown()) {
-    ROS_WARN_STREAM("~" << name << " is not a parameter of this node (ignored; a typo?)");
+    report->warnings.push_back(r.prefix() + name +
+                               " is not a parameter of this node (ignored; a typo?)");
   }
-  *error = r.error();
+  report->values = r.log();
+  return r.error();
+}
+
+std::vector<std::string> nodeParamNames() {
+  // Reading an empty namespace asks for every parameter.
+  const XmlRpc::XmlRpcValue none;
+  ParamReader r(none, "~");
+  NodeParams p;
+  std::vector<std::string> warnings;
+  readAll(&r, &p, &warnings);
+  return r.known();
+}
+
+bool readNodeParams(const ros::NodeHandle& pnh, NodeParams* params, std::string* error) {
+  // The whole private namespace in one struct (unset if nothing is set in it).
+  XmlRpc::XmlRpcValue values;
+  if (!pnh.getParam(pnh.getNamespace(), values)) values = XmlRpc::XmlRpcValue();
+  ParamReport report;
+  *error = parseNodeParams(values, params, &report);
+  for (const std::string& line : report.values) ROS_INFO_STREAM(line);
+  for (const std::string& warning : report.warnings) ROS_WARN_STREAM(warning);
   return error->empty();
 }
 

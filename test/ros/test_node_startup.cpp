@@ -1,6 +1,7 @@
-// rostest node_startup.test: a wrong parameter or bad geometry stops laser_raycast_node at start-up
-// with exit status 1 and a message naming the parameter or file; skip_bad_geometry lets it start
-// anyway. Each case runs the node executable with rosrun against the test's master.
+// rostest node_startup.test: what start-up needs a running node for. A wrong parameter, a missing
+// URDF or bad geometry stops laser_raycast_node with exit status 1 and a message naming the
+// parameter or file; skip_bad_geometry lets it start anyway. Each case runs the node executable
+// with rosrun against the test's master. (Every parameter check is in test_node_params.cpp.)
 #include <gtest/gtest.h>
 #include <ros/package.h>
 #include <ros/ros.h>
@@ -55,28 +56,9 @@ XmlRpc::XmlRpcValue modelFile(const std::string& path) {
   return models;
 }
 
-TEST(NodeStartup, NegativeRangeMax) {
-  expectRefused(scene("/a") + " _range_max:=-1.0", {"range_max", "-1"});
-}
-
-TEST(NodeStartup, SamplesAndIncrementTogether) {
-  expectRefused(scene("/b") + " _samples:=100 _angle_increment:=0.01", {"~samples", "not both"});
-}
-
-TEST(NodeStartup, UnknownGeometry) {
-  expectRefused(scene("/c") + " _geometry:=hull", {"~geometry", "'hull'"});
-}
-
-TEST(NodeStartup, WrongType) {
-  expectRefused(scene("/d") + " _rate:=fast", {"~rate", "expected a number"});
-}
-
-TEST(NodeStartup, UnknownMinRangePolicy) {
-  expectRefused(scene("/e") + " _min_range_policy:=zero", {"~min_range_policy", "'zero'"});
-}
-
-TEST(NodeStartup, AngleMaxBelowAngleMin) {
-  expectRefused(scene("/f") + " _angle_min:=1.0 _angle_max:=0.5", {"angle_max", "angle_min"});
+// One wrong parameter, end to end (test/unit/test_node_params.cpp checks every parameter).
+TEST(NodeStartup, AWrongParameterStopsTheNode) {
+  expectRefused(scene("/d") + " _rate:=fast", {"~rate", "'fast'", "expected a number"});
 }
 
 TEST(NodeStartup, ReflectivityOfAnUnknownLink) {
@@ -84,15 +66,6 @@ TEST(NodeStartup, ReflectivityOfAnUnknownLink) {
   reflectivity["no_such_link"] = 0.5;
   ros::NodeHandle().setParam("/g/node/reflectivity", reflectivity);
   expectRefused(scene("/g") + " _intensity:=reflectivity", {"no_such_link", "has no geometry"});
-}
-
-TEST(NodeStartup, ModelsOfTheWrongShape) {
-  XmlRpc::XmlRpcValue models;
-  models.setSize(1);
-  models[0]["param"] = "robot_description";
-  models[0]["file"] = "/both/given.urdf";
-  ros::NodeHandle().setParam("/k/node/models", models);
-  expectRefused(scene("/k"), {"~models[0]", "exactly one of"});
 }
 
 TEST(NodeStartup, MissingRobotDescription) {
@@ -110,13 +83,15 @@ TEST(NodeStartup, MissingMeshNamesTheFileAndLink) {
                 {"does_not_exist.stl", "broken_link", "skip_bad_geometry"});
 }
 
+// Also: a misspelt parameter gets a warning and is otherwise ignored.
 TEST(NodeStartup, SkipBadGeometryStartsWithAWarning) {
   ros::NodeHandle().setParam("/j/node/models", modelFile(data("bad_mesh.urdf")));
-  const NodeRun run = runNode("__ns:=/j __name:=node _skip_bad_geometry:=true", 4);
+  const NodeRun run = runNode("__ns:=/j __name:=node _skip_bad_geometry:=true _samplez:=5", 4);
   EXPECT_EQ(run.status, 124) << "the node should still be running when timeout stops it:\n"
                              << run.output;
   EXPECT_NE(run.output.find("broken_link"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("WARN"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("~samplez is not a parameter"), std::string::npos) << run.output;
 }
 
 }  // namespace

@@ -1,14 +1,21 @@
-// Every parameter of the node, read in one place, logged once with its unit, and validated.
+// Every parameter of the node: parsed in one place from the values of its private namespace,
+// validated, and logged once with its unit. Parsing is a function of the values alone (no
+// parameter server), so unit tests call it without roscore; readNodeParams() fetches and logs.
 #pragma once
 
-#include <ros/node_handle.h>
+#include <xmlrpcpp/XmlRpcValue.h>
 
 #include <map>
 #include <string>
 #include <vector>
 
+#include "laser_raycast/core/enum_names.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/scene_loader.h"
+
+namespace ros {
+class NodeHandle;
+}
 
 namespace laser_raycast {
 
@@ -22,15 +29,33 @@ struct ModelSource {
   std::string describe() const;  // "parameter robot_description" / "file /path/x.urdf"
 };
 
+// ~intensity: whether intensities are published.
+inline const core::EnumNames<bool, 2> kIntensityNames{{{
+    {false, "off"}, {true, "reflectivity"},  // reflectivity of the link hit x cos(incidence angle)
+}}};
+
 struct NodeParams {
+  // Beams when neither ~samples nor ~angle_increment is set: one a degree over the full turn.
+  static constexpr int kDefaultSamples = 360;
+  // ~rate above this is taken for a slip (a value meant in another unit) rather than served: it is
+  // ten times the fastest real planar scanners (about 100 Hz), and at 1 kHz the timer leaves 1 ms a
+  // scan for the TF look-ups, the cast and publishing.
+  static constexpr double kMaxRate = 1000.0;  // Hz
+  // ~tf_timeout above this is taken for a slip (milliseconds given as seconds): each scan waits up
+  // to tf_timeout for its transforms inside the timer callback, which delays every later scan by
+  // as much, and 10 s is far beyond any real TF latency.
+  static constexpr double kMaxTfTimeout = 10.0;  // s
+
   std::string frame_id = "laser";   // sensor frame; header.frame_id of the scans
   std::string fixed_frame = "map";  // frame the link and sensor poses are looked up in
-  core::ScanSpec scan;  // beams, range limits, min-range policy, noise, intensity, triangle test
-  double rate = 10.0;   // Hz
-  double tf_timeout = 0.1;  // s, longest wait for the transforms of one scan
+  // Beams, range limits, min-range policy, noise, intensity, triangle test. fan.samples is 0 here:
+  // the parser sets kDefaultSamples when neither it nor angle_increment is given.
+  core::ScanSpec scan;
+  double rate = 10.0;       // Hz, in (0, kMaxRate]
+  double tf_timeout = 0.1;  // s, in [0, kMaxTfTimeout]: longest wait for one scan's transforms
   GeometrySource geometry = GeometrySource::kVisual;
   bool skip_bad_geometry = false;
-  std::vector<ModelSource> models;
+  std::vector<ModelSource> models = {ModelSource{"robot_description", "", ""}};
   std::vector<std::string> ignore_links;
   std::map<std::string, double> reflectivity;  // link name (with TF prefix) -> reflectivity
   double default_reflectivity = 1.0;
@@ -38,10 +63,28 @@ struct NodeParams {
   std::string pose_frame;  // frame whose pose pose_topic gives; empty: frame_id
 };
 
-// Reads the private parameters of pnh into params, logging each with its value and unit. Returns
-// false and sets *error to a message naming the parameter and the bad value if any is wrong (wrong
-// type, out of range, inconsistent). Unknown private parameters are reported with a warning (they
-// are usually typos).
+// What parsing reports besides the values.
+struct ParamReport {
+  // One line per parameter with its value and unit ("~rate = 10 Hz"), for the start-up log.
+  std::vector<std::string> values;
+  // Set parameters the node does not read (usually typos), and settings that have no effect.
+  std::vector<std::string> warnings;
+};
+
+// Parses the node's private parameters from `values`, a struct of them as the parameter server
+// returns the private namespace (an invalid value: none set). Unset parameters take their
+// defaults. Entries of ~models that name a parameter are kept as names (the node reads the URDF).
+// Returns "" on success, or the first error: a message naming the parameter and its bad value
+// (wrong type, out of range, inconsistent with another parameter). The report is filled either
+// way.
+std::string parseNodeParams(const XmlRpc::XmlRpcValue& values, NodeParams* params,
+                            ParamReport* report);
+
+// The name of every parameter parseNodeParams reads, in the order it reads them.
+std::vector<std::string> nodeParamNames();
+
+// Fetches the private namespace of pnh from the parameter server and parses it, logging each value
+// (INFO) and each warning (WARN). Returns false with the message in *error on a bad value.
 bool readNodeParams(const ros::NodeHandle& pnh, NodeParams* params, std::string* error);
 
 }  // namespace laser_raycast
