@@ -34,13 +34,16 @@ std::string resolveModelFile(const std::string& file) {
   return *dir + rest.substr(package.size());
 }
 
-// A pose from a message: finite, with a quaternion within 1% of unit length (normalised here;
-// farther off is a bad message, not rounding).
+// A message's quaternion may be this far from unit length (relative) and is normalised; farther off
+// is a bad message, not rounding: poses written with 3 or 4 decimals are within 0.1%.
+constexpr double kQuaternionNormTolerance = 0.01;
+
+// A pose from a message: finite, with a quaternion near unit length.
 bool poseFromMsg(const geometry_msgs::Pose& msg, Eigen::Isometry3d* pose) {
   const Eigen::Vector3d t(msg.position.x, msg.position.y, msg.position.z);
   Eigen::Quaterniond q(msg.orientation.w, msg.orientation.x, msg.orientation.y, msg.orientation.z);
   const double norm = q.norm();
-  if (!t.allFinite() || !(std::abs(norm - 1.0) <= 0.01)) return false;
+  if (!t.allFinite() || !(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) return false;
   q.coeffs() /= norm;
   pose->setIdentity();
   pose->linear() = q.toRotationMatrix();
@@ -72,10 +75,10 @@ bool RaycastNode::init() {
   if (!loadScene()) return false;
 
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_, nh_);
-  scan_pub_ = nh_.advertise<sensor_msgs::LaserScan>("scan", 10);
-  labels_pub_ = nh_.advertise<laser_raycast::ScanLabels>("scan_labels", 10);
+  scan_pub_ = nh_.advertise<sensor_msgs::LaserScan>("scan", kPublishQueue);
+  labels_pub_ = nh_.advertise<laser_raycast::ScanLabels>("scan_labels", kPublishQueue);
   if (!params_.pose_topic.empty()) {
-    pose_sub_ = nh_.subscribe(params_.pose_topic, 10, &RaycastNode::onPose, this);
+    pose_sub_ = nh_.subscribe(params_.pose_topic, kPoseQueue, &RaycastNode::onPose, this);
   }
   timer_ = nh_.createTimer(ros::Duration(1.0 / params_.rate), &RaycastNode::onTimer, this);
   ROS_INFO_STREAM("laser_raycast: "
@@ -150,7 +153,7 @@ bool RaycastNode::loadScene() {
                        << entry.first
                        << "', which has no geometry in any model (links "
                           "with geometry: "
-                       << joinFirst(labels, 20) << ")");
+                       << joinFirst(labels, kLinksInError) << ")");
       return false;
     }
   }
@@ -192,7 +195,7 @@ bool RaycastNode::sensorPose(const ros::Time& stamp, const ros::Time& deadline,
   if (!params_.pose_topic.empty()) {
     std::lock_guard<std::mutex> lock(pose_mutex_);
     if (!topic_pose_) {
-      ROS_WARN_THROTTLE(5, "no pose received yet on %s: scan skipped (%lu of %lu so far)",
+      ROS_WARN_THROTTLE(kWarnPeriod, "no pose received yet on %s: scan skipped (%lu of %lu so far)",
                         pose_sub_.getTopic().c_str(),
                         static_cast<unsigned long>(scans_skipped_ + 1),
                         static_cast<unsigned long>(scans_ + scans_skipped_ + 1));
@@ -205,7 +208,7 @@ bool RaycastNode::sensorPose(const ros::Time& stamp, const ros::Time& deadline,
   Eigen::Isometry3d pose_frame_from_sensor;
   if (!lookup(pose_frame, params_.frame_id, stamp, deadline, &pose_frame_from_sensor, &error)) {
     ROS_WARN_THROTTLE(
-        5,
+        kWarnPeriod,
         "no transform from '%s' to '%s' at t = %.3f: scan skipped (%lu of %lu so far; "
         "%s)",
         params_.frame_id.c_str(), pose_frame.c_str(), stamp.toSec(),
@@ -230,7 +233,7 @@ void RaycastNode::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
     header = m->header;
     pose_msg = m->pose.pose;
   } else {
-    ROS_ERROR_THROTTLE(10,
+    ROS_ERROR_THROTTLE(kErrorPeriod,
                        "~pose_topic %s carries %s; expected geometry_msgs/PoseStamped or "
                        "geometry_msgs/PoseWithCovarianceStamped (message ignored)",
                        pose_sub_.getTopic().c_str(), type.c_str());
@@ -238,7 +241,8 @@ void RaycastNode::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
   }
   Eigen::Isometry3d pose;
   if (!poseFromMsg(pose_msg, &pose)) {
-    ROS_WARN_THROTTLE(5, "pose on %s is not finite or its quaternion is not unit length: ignored",
+    ROS_WARN_THROTTLE(kWarnPeriod,
+                      "pose on %s is not finite or its quaternion is not unit length: ignored",
                       pose_sub_.getTopic().c_str());
     return;
   }
@@ -249,7 +253,8 @@ void RaycastNode::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
                  tf_buffer_.lookupTransform(params_.fixed_frame, header.frame_id, header.stamp)) *
              pose;
     } catch (const tf2::TransformException& e) {
-      ROS_WARN_THROTTLE(5, "pose on %s is in '%s', which has no transform to '%s': ignored (%s)",
+      ROS_WARN_THROTTLE(kWarnPeriod,
+                        "pose on %s is in '%s', which has no transform to '%s': ignored (%s)",
                         pose_sub_.getTopic().c_str(), header.frame_id.c_str(),
                         params_.fixed_frame.c_str(), e.what());
       return;
@@ -283,12 +288,12 @@ void RaycastNode::onTimer(const ros::TimerEvent&) {
       &frame_poses_);
   if (!missing.empty()) {
     missing_link_poses_ += missing.size();
-    ROS_WARN_THROTTLE(5,
+    ROS_WARN_THROTTLE(kWarnPeriod,
                       "%zu of %zu link frames have no transform to '%s' at t = %.3f; their "
                       "geometry is skipped this scan (%lu skipped so far): %s (%s)",
                       missing.size(), scene_.frames().size(), params_.fixed_frame.c_str(),
                       stamp.toSec(), static_cast<unsigned long>(missing_link_poses_),
-                      joinFirst(missing, 5).c_str(), first_error.c_str());
+                      joinFirst(missing, kLinksInWarning).c_str(), first_error.c_str());
   }
 
   const core::ScanResult& result =

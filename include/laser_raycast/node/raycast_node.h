@@ -42,6 +42,19 @@ class RaycastNode {
   bool lookup(const std::string& target, const std::string& frame, const ros::Time& stamp,
               const ros::Time& deadline, Eigen::Isometry3d* pose, std::string* error);
 
+  // A condition that lasts (missing transforms, no pose yet, bad pose messages) is warned about at
+  // most this often: every scan (10 to 100 Hz) would flood the log.
+  static constexpr double kWarnPeriod = 5.0;  // s
+  // A pose topic of the wrong message type is a set-up error that does not go away by itself.
+  static constexpr double kErrorPeriod = 10.0;  // s
+  // Scans queued for a slow subscriber before the oldest is dropped (1 s at the default rate).
+  static constexpr std::uint32_t kPublishQueue = 10;
+  // Pose messages queued for the callback; only the latest is used.
+  static constexpr std::uint32_t kPoseQueue = 10;
+  // Link names a message lists before "... (N more)": a few in the repeated warning about missing
+  // transforms, more in the one-off error about an unknown reflectivity link.
+  static constexpr std::size_t kLinksInWarning = 5, kLinksInError = 20;
+
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
   core::Scene scene_;
