@@ -7,6 +7,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <algorithm>
+#include <iomanip>
 #include <set>
 #include <sstream>
 
@@ -187,7 +188,7 @@ bool RaycastNode::lookup(const std::string& target, const std::string& frame,
 }
 
 bool RaycastNode::sensorPose(const ros::Time& stamp, const ros::Time& deadline,
-                             Eigen::Isometry3d* pose) {
+                             Eigen::Isometry3d* pose, std::string* why, std::string* detail) {
   // Without a pose topic the sensor is a TF frame like any other; with one, the topic gives the
   // pose of pose_frame, and TF (usually a static mount) the sensor relative to it.
   Eigen::Isometry3d world_from_pose_frame = Eigen::Isometry3d::Identity();
@@ -195,29 +196,51 @@ bool RaycastNode::sensorPose(const ros::Time& stamp, const ros::Time& deadline,
   if (!params_.pose_topic.empty()) {
     std::lock_guard<std::mutex> lock(pose_mutex_);
     if (!topic_pose_) {
-      ROS_WARN_THROTTLE(kWarnPeriod, "no pose received yet on %s: scan skipped (%lu of %lu so far)",
-                        pose_sub_.getTopic().c_str(),
-                        static_cast<unsigned long>(scans_skipped_ + 1),
-                        static_cast<unsigned long>(scans_ + scans_skipped_ + 1));
+      *why = "no pose received yet on " + pose_sub_.getTopic();
       return false;
     }
     world_from_pose_frame = *topic_pose_;
     pose_frame = params_.pose_frame.empty() ? params_.frame_id : params_.pose_frame;
   }
-  std::string error;
   Eigen::Isometry3d pose_frame_from_sensor;
-  if (!lookup(pose_frame, params_.frame_id, stamp, deadline, &pose_frame_from_sensor, &error)) {
-    ROS_WARN_THROTTLE(
-        kWarnPeriod,
-        "no transform from '%s' to '%s' at t = %.3f: scan skipped (%lu of %lu so far; "
-        "%s)",
-        params_.frame_id.c_str(), pose_frame.c_str(), stamp.toSec(),
-        static_cast<unsigned long>(scans_skipped_ + 1),
-        static_cast<unsigned long>(scans_ + scans_skipped_ + 1), error.c_str());
+  if (!lookup(pose_frame, params_.frame_id, stamp, deadline, &pose_frame_from_sensor, detail)) {
+    std::ostringstream s;
+    s << "no transform from '" << params_.frame_id << "' to '" << pose_frame
+      << "' at t = " << std::fixed << std::setprecision(3) << stamp.toSec();
+    *why = s.str();
     return false;
   }
   *pose = world_from_pose_frame * pose_frame_from_sensor;
   return true;
+}
+
+bool RaycastNode::linkPoses(const ros::Time& stamp, const ros::Time& deadline, bool waiting) {
+  std::vector<std::string> missing;
+  std::string first_error;
+  core::resolveFramePoses(
+      scene_,
+      [&](const std::string& frame, Eigen::Isometry3d& pose) {
+        std::string error;
+        if (lookup(params_.fixed_frame, frame, stamp, deadline, &pose, &error)) return true;
+        missing.push_back(frame);
+        if (first_error.empty()) first_error = error;
+        return false;
+      },
+      &frame_poses_);
+  if (missing.empty()) return true;
+  if (waiting) {
+    ROS_DEBUG("waiting for the first transforms: %zu link frames have none yet (%s)",
+              missing.size(), joinFirst(missing, kLinksInWarning).c_str());
+    return false;
+  }
+  missing_link_poses_ += missing.size();
+  ROS_WARN_THROTTLE(kWarnPeriod,
+                    "%zu of %zu link frames have no transform to '%s' at t = %.3f; their "
+                    "geometry is skipped this scan (%lu skipped so far): %s (%s)",
+                    missing.size(), scene_.frames().size(), params_.fixed_frame.c_str(),
+                    stamp.toSec(), static_cast<unsigned long>(missing_link_poses_),
+                    joinFirst(missing, kLinksInWarning).c_str(), first_error.c_str());
+  return true;  // cast without those links
 }
 
 void RaycastNode::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
@@ -267,33 +290,35 @@ void RaycastNode::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
 void RaycastNode::onTimer(const ros::TimerEvent&) {
   const ros::Time stamp = ros::Time::now();
   if (stamp.isZero()) return;  // simulated time has not started
+  if (first_attempt_.isZero()) first_attempt_ = stamp;
+  // Until the first scan, for a grace period, missing transforms are waited for without warnings.
+  const bool waiting = scans_ == 0 && stamp - first_attempt_ < ros::Duration(kTfGracePeriod);
   const ros::Time deadline = stamp + ros::Duration(params_.tf_timeout);
 
   Eigen::Isometry3d world_from_sensor;
-  if (!sensorPose(stamp, deadline, &world_from_sensor)) {
+  std::string why, detail;
+  if (!sensorPose(stamp, deadline, &world_from_sensor, &why, &detail)) {
+    ++scans_skipped_;
+    if (waiting) {
+      ROS_DEBUG_STREAM("waiting for the first transforms: " << why);
+    } else {
+      ROS_WARN_THROTTLE(kWarnPeriod, "%s: scan skipped (%lu of %lu so far%s%s)", why.c_str(),
+                        static_cast<unsigned long>(scans_skipped_),
+                        static_cast<unsigned long>(scans_ + scans_skipped_),
+                        detail.empty() ? "" : "; ", detail.c_str());
+    }
+    return;
+  }
+  if (!linkPoses(stamp, deadline, waiting)) {
     ++scans_skipped_;
     return;
   }
-  std::vector<std::string> missing;
-  std::string first_error;
-  core::resolveFramePoses(
-      scene_,
-      [&](const std::string& frame, Eigen::Isometry3d& pose) {
-        std::string error;
-        if (lookup(params_.fixed_frame, frame, stamp, deadline, &pose, &error)) return true;
-        missing.push_back(frame);
-        if (first_error.empty()) first_error = error;
-        return false;
-      },
-      &frame_poses_);
-  if (!missing.empty()) {
-    missing_link_poses_ += missing.size();
-    ROS_WARN_THROTTLE(kWarnPeriod,
-                      "%zu of %zu link frames have no transform to '%s' at t = %.3f; their "
-                      "geometry is skipped this scan (%lu skipped so far): %s (%s)",
-                      missing.size(), scene_.frames().size(), params_.fixed_frame.c_str(),
-                      stamp.toSec(), static_cast<unsigned long>(missing_link_poses_),
-                      joinFirst(missing, kLinksInWarning).c_str(), first_error.c_str());
+  if (scans_ == 0 && scans_skipped_ > 0) {
+    ROS_INFO(
+        "first scan at t = %.3f, %.3f s after the first attempt: %lu skipped while waiting "
+        "for transforms",
+        stamp.toSec(), (stamp - first_attempt_).toSec(),
+        static_cast<unsigned long>(scans_skipped_));
   }
 
   const core::ScanResult& result =

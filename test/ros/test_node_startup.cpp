@@ -2,15 +2,21 @@
 // URDF or bad geometry stops laser_raycast_node with exit status 1 and a message naming the
 // parameter or file; skip_bad_geometry lets it start anyway. Each case runs the node executable
 // with rosrun against the test's master. (Every parameter check is in test_node_params.cpp.)
+#include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/package.h>
 #include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
+#include <regex>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "laser_raycast/node/raycast_node.h"
 #include "run_command.h"
 
 namespace laser_raycast_test {
@@ -19,8 +25,9 @@ namespace {
 using NodeRun = CommandResult;
 
 // Runs the node with the given arguments for at most `seconds` (status 124: it was still running).
+// Its INFO lines (stdout) are line-buffered so that none is lost when timeout stops it.
 NodeRun runNode(const std::string& args, int seconds = 20) {
-  return runCommand("timeout " + std::to_string(seconds) +
+  return runCommand("ROSCONSOLE_STDOUT_LINE_BUFFERED=1 timeout " + std::to_string(seconds) +
                     " rosrun laser_raycast laser_raycast_node " + args + " 2>&1");
 }
 
@@ -92,6 +99,52 @@ TEST(NodeStartup, SkipBadGeometryStartsWithAWarning) {
   EXPECT_NE(run.output.find("broken_link"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("WARN"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("~samplez is not a parameter"), std::string::npos) << run.output;
+}
+
+// The ROS time (s) of the first console line of `severity` ("INFO", "WARN") containing `text`;
+// NaN if there is none.
+double logTime(const std::string& output, const std::string& severity, const std::string& text) {
+  const std::regex line("\\[ *" + severity + "\\] \\[([0-9]+\\.[0-9]+)\\]: ([^\n]*)");
+  for (auto it = std::sregex_iterator(output.begin(), output.end(), line);
+       it != std::sregex_iterator(); ++it) {
+    if ((*it)[2].str().find(text) != std::string::npos) return std::stod((*it)[1].str());
+  }
+  return std::nan("");
+}
+
+// Transforms that arrive a second after the node starts are waited for without a warning.
+TEST(NodeStartup, WaitsQuietlyForTheFirstTransforms) {
+  tf2_ros::StaticTransformBroadcaster broadcaster;
+  std::thread late([&broadcaster] {
+    ros::WallDuration(1.0).sleep();
+    geometry_msgs::TransformStamped laser, mover;
+    laser.header.stamp = ros::Time::now();
+    laser.header.frame_id = "world";
+    laser.child_frame_id = "late_laser";
+    laser.transform.rotation.w = 1;
+    mover = laser;
+    mover.child_frame_id = "mover";
+    mover.transform.translation.z = 5;
+    broadcaster.sendTransform({laser, mover});
+  });
+  const NodeRun run = runNode(scene("/t") + " _frame_id:=late_laser _rate:=20", 4);
+  late.join();
+  EXPECT_EQ(run.status, 124) << run.output;
+  EXPECT_EQ(run.output.find("WARN"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::isnan(logTime(run.output, "INFO", "first scan at"))) << run.output;
+}
+
+// Transforms that never come are warned about once the grace period is over.
+TEST(NodeStartup, WarnsWhenTheTransformsNeverCome) {
+  const double grace = laser_raycast::RaycastNode::kTfGracePeriod;
+  const NodeRun run =
+      runNode(scene("/u") + " _frame_id:=no_such_laser", static_cast<int>(grace) + 4);
+  const double ready = logTime(run.output, "INFO", "laser_raycast: ");
+  const double warned = logTime(run.output, "WARN", "no transform from 'no_such_laser'");
+  ASSERT_FALSE(std::isnan(ready)) << run.output;
+  ASSERT_FALSE(std::isnan(warned)) << run.output;
+  EXPECT_GE(warned - ready, grace) << run.output;
+  EXPECT_NE(run.output.find("scan skipped"), std::string::npos) << run.output;
 }
 
 }  // namespace

@@ -24,6 +24,13 @@ namespace laser_raycast {
 
 class RaycastNode {
  public:
+  // TF publishers usually start with or after the node (robot_state_publisher, a driver, a
+  // simulator), so for this long after the first scan attempt, until the first scan, scans that
+  // lack a transform are skipped without a warning. ROS time, like the scan timer: under
+  // use_sim_time it follows /clock, as the TF publishers do. Then missing transforms are warned
+  // about.
+  static constexpr double kTfGracePeriod = 5.0;  // s
+
   RaycastNode(ros::NodeHandle nh, ros::NodeHandle pnh);
 
   // Reads and validates the parameters, loads the scene, and starts publishing. Returns false after
@@ -34,9 +41,14 @@ class RaycastNode {
   bool loadScene();
   void onTimer(const ros::TimerEvent& event);
   void onPose(const topic_tools::ShapeShifter::ConstPtr& msg);
-  // The pose of frame_id in fixed_frame for this scan; false (after a throttled warning) if
-  // unknown.
-  bool sensorPose(const ros::Time& stamp, const ros::Time& deadline, Eigen::Isometry3d* pose);
+  // The pose of frame_id in fixed_frame for this scan; false if unknown, with what is missing in
+  // *why and TF's message (if any) in *detail.
+  bool sensorPose(const ros::Time& stamp, const ros::Time& deadline, Eigen::Isometry3d* pose,
+                  std::string* why, std::string* detail);
+  // The link poses for this scan into frame_poses_. Links without a transform are left out with a
+  // throttled warning; while `waiting` (for the first transforms) the scan is skipped quietly
+  // instead (false).
+  bool linkPoses(const ros::Time& stamp, const ros::Time& deadline, bool waiting);
   // The pose of `frame` in `target` from TF at stamp, waiting until deadline at most (identity if
   // they are the same frame); false with the reason in *error.
   bool lookup(const std::string& target, const std::string& frame, const ros::Time& stamp,
@@ -79,6 +91,7 @@ class RaycastNode {
 
   // Reported in the throttled warnings.
   std::uint64_t scans_ = 0, scans_skipped_ = 0, missing_link_poses_ = 0;
+  ros::Time first_attempt_;  // the first timer tick with a non-zero time
 };
 
 }  // namespace laser_raycast
