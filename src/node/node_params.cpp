@@ -60,27 +60,39 @@ void readFan(ParamReader* r, core::FanSpec* fan) {
   }
 }
 
+// The entries of a reflectivity dict, `link` being the path to it. The parameter server splits
+// names at '/', so a link with a TF prefix ("robot2/wall") arrives as a nested dict ({robot2:
+// {wall: 0.5}}): nested keys are joined with '/' again.
+void readReflectivityEntries(ParamReader* r, const std::string& link, const XmlRpc::XmlRpcValue& v,
+                             std::map<std::string, double>* reflectivity) {
+  for (auto it = v.begin(); it != v.end(); ++it) {
+    const std::string name = link.empty() ? it->first : link + "/" + it->first;
+    const auto type = it->second.getType();
+    if (type == XmlRpc::XmlRpcValue::TypeStruct) {
+      readReflectivityEntries(r, name, it->second, reflectivity);
+      continue;
+    }
+    if (type != XmlRpc::XmlRpcValue::TypeDouble && type != XmlRpc::XmlRpcValue::TypeInt) {
+      r->wrongType("reflectivity/" + name, it->second, "a number");
+      continue;
+    }
+    const double value = type == XmlRpc::XmlRpcValue::TypeInt
+                             ? static_cast<const int&>(it->second)
+                             : static_cast<const double&>(it->second);
+    if (!(std::isfinite(value) && value >= 0)) {
+      r->fail("reflectivity/" + name, "must be finite and >= 0, got " + formatNumber(value));
+    }
+    (*reflectivity)[name] = value;
+  }
+}
+
 // ~reflectivity: {link: value >= 0}; an empty dict is the same as none.
 void readReflectivity(ParamReader* r, std::map<std::string, double>* reflectivity) {
   const XmlRpc::XmlRpcValue* v = r->get("reflectivity");
   if (v && v->getType() != XmlRpc::XmlRpcValue::TypeStruct) {
     r->wrongType("reflectivity", *v, "a dict {link: reflectivity}");
   } else if (v) {
-    for (auto it = v->begin(); it != v->end(); ++it) {
-      const std::string name = "reflectivity/" + it->first;
-      const auto type = it->second.getType();
-      if (type != XmlRpc::XmlRpcValue::TypeDouble && type != XmlRpc::XmlRpcValue::TypeInt) {
-        r->wrongType(name, it->second, "a number");
-        continue;
-      }
-      const double value = type == XmlRpc::XmlRpcValue::TypeInt
-                               ? static_cast<const int&>(it->second)
-                               : static_cast<const double&>(it->second);
-      if (!(std::isfinite(value) && value >= 0)) {
-        r->fail(name, "must be finite and >= 0, got " + formatNumber(value));
-      }
-      (*reflectivity)[it->first] = value;
-    }
+    readReflectivityEntries(r, "", *v, reflectivity);
   }
   std::string shown;
   for (const auto& [link, value] : *reflectivity) {

@@ -132,11 +132,10 @@ TEST(NodeParams, EveryParameterIsLoggedOnceWithItsExactValue) {
     EXPECT_EQ(lines, 1) << name;
   }
   const auto& log = parsed.report.values;
-  for (const char* line :
-       {"~angle_min = -3.141592653589793 rad", "~tf_timeout = 0.1 s", "~rate = 10 Hz",
-        "~frame_id = 'laser'", "~samples = 360 beams", "~min_range_policy = '-inf'",
-        "~models[0] = parameter robot_description", "~reflectivity = {}", "~ignore_links = []",
-        "~cull_backfaces = false"}) {
+  for (const char* line : {"~angle_min = -3.141592653589793 rad", "~tf_timeout = 0.1 s",
+                           "~rate = 10 Hz", "~frame_id = 'laser'", "~samples = 360 beams",
+                           "~min_range_policy = '-inf'", "~models[0] = parameter robot_description",
+                           "~reflectivity = {}", "~ignore_links = []", "~cull_backfaces = false"}) {
     EXPECT_NE(std::find(log.begin(), log.end(), line), log.end()) << line;
   }
 }
@@ -342,6 +341,20 @@ TEST(NodeParams, BadModelsEntriesNameTheEntry) {
   expectRefused(models(XmlRpcValue(3)), {"~models[1]", "int (3)", "a parameter name or a dict"});
   expectRefused(models(values({{"file", "/b.urdf"}, {"tf_prefix", "/r2/"}})),
                 {"~models[1]", "tf_prefix '/r2/'", "'/'"});
+}
+
+TEST(NodeParams, ReflectivityOfLinksWithATfPrefix) {
+  // The parameter server stores {r2/wall: 0.5} as the nested dict {r2: {wall: 0.5}}.
+  const Parsed parsed =
+      parse(values({{"intensity", "reflectivity"},
+                    {"reflectivity", values({{"r2", values({{"wall", 0.5}})}, {"floor", 0}})}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.params.reflectivity,
+            (std::map<std::string, double>{{"r2/wall", 0.5}, {"floor", 0.0}}));
+  expectRefused(values({{"reflectivity", values({{"r2", values({{"wall", -2}})}})}}),
+                {"~reflectivity/r2/wall", "got -2"});
+  expectRefused(values({{"reflectivity", values({{"r2", values({{"wall", "x"}})}})}}),
+                {"~reflectivity/r2/wall", "'x'", "a number"});
 }
 
 TEST(NodeParams, UnknownParametersGetAWarning) {
