@@ -59,6 +59,20 @@ void expectRefused(const XmlRpcValue& v, const std::vector<std::string>& mention
   expectMentions(parsed.error, mentions);
 }
 
+// One parameter set to a bad value, and what the message must say.
+struct BadValue {
+  const char* name;
+  XmlRpcValue value;
+  std::vector<std::string> mentions;
+};
+
+void expectEachRefused(const std::vector<BadValue>& cases) {
+  for (const BadValue& c : cases) {
+    SCOPED_TRACE(c.name);
+    expectRefused(values({{c.name, c.value}}), c.mentions);
+  }
+}
+
 void expectAccepted(const XmlRpcValue& v) {
   const Parsed parsed = parse(v);
   EXPECT_EQ(parsed.error, "") << v.toXml();
@@ -211,12 +225,7 @@ TEST(NodeParams, AngleIncrementInsteadOfSamples) {
 }
 
 TEST(NodeParams, WrongTypesNameTheParameterAndTheValue) {
-  struct Case {
-    const char* name;
-    XmlRpcValue value;
-    std::vector<std::string> mentions;
-  };
-  const std::vector<Case> cases = {
+  expectEachRefused({
       {"rate", "fast", {"~rate", "string ('fast')", "expected a number"}},
       {"range_max", true, {"~range_max", "bool (true)", "expected a number"}},
       {"samples", 100.5, {"~samples", "double (100.5)", "expected an integer"}},
@@ -231,20 +240,11 @@ TEST(NodeParams, WrongTypesNameTheParameterAndTheValue) {
       {"models", list({}), {"~models", "list ([])", "non-empty list"}},
       {"reflectivity", list({0.5}), {"~reflectivity", "[0.5]", "a dict"}},
       {"reflectivity", values({{"wall", "high"}}), {"~reflectivity/wall", "'high'", "a number"}},
-  };
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.name);
-    expectRefused(values({{c.name, c.value}}), c.mentions);
-  }
+  });
 }
 
 TEST(NodeParams, OutOfRangeValuesNameTheParameterAndTheValue) {
-  struct Case {
-    const char* name;
-    XmlRpcValue value;
-    std::vector<std::string> mentions;
-  };
-  const std::vector<Case> cases = {
+  expectEachRefused({
       {"rate", 0.0, {"~rate", "(0, 1000] Hz", "got 0"}},
       {"rate", -10, {"~rate", "got -10"}},
       {"rate", 1000.5, {"~rate", "got 1000.5"}},
@@ -268,11 +268,7 @@ TEST(NodeParams, OutOfRangeValuesNameTheParameterAndTheValue) {
       {"noise_stddev", -0.01, {"noise_stddev", "-0.01"}},
       {"angle_min", kNan, {"angle_min", "nan"}},
       {"samples", 20000000, {"samples", "20000000"}},
-  };
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.name);
-    expectRefused(values({{c.name, c.value}}), c.mentions);
-  }
+  });
 }
 
 TEST(NodeParams, TheLimitsThemselvesAreAccepted) {
