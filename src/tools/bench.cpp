@@ -1,7 +1,7 @@
 // bench: speed and accuracy of every triangle method (double and float, brute force and BVH), the
 // pipeline (Caster::cast as the node runs it) and the peers (Embree, Bullet) on identical rays,
-// every distance measured against a long double reference. See kUsage and the README's
-// "Benchmark" section.
+// every distance measured against a long double reference and compared with Embree's robust mode.
+// See kUsage and the README's "Benchmark" section.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,8 +9,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <limits>
-#include <numeric>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -19,27 +17,29 @@
 
 #include "bench_methods.h"
 #include "bench_peers.h"
-#include "bench_reference.h"
 #include "bench_report.h"
+#include "bench_run.h"
 #include "bench_scenes.h"
 
 namespace {
 
 namespace bench = laser_raycast::bench;
 namespace core = laser_raycast::core;
-using bench::Real;
 
 constexpr int kExitRunFailed = 1;
 constexpr int kExitBadArguments = 2;
 
 const char* const kUsage =
-    "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--list-methods] [--list-scenes]\n"
+    "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--method NAME ...] [--list-methods]\n"
+    "             [--list-scenes]\n"
     "Times every method on the workloads fan2d and rings3d and measures each beam's error\n"
-    "against a long double reference. Writes DIR/results.csv, results.md, pareto.png (one\n"
-    "point per method) and pareto_matrix.png (every workload and scene) (DIR defaults to\n"
-    "bench_results). Scenes: sphere box_room tb3 million vertex_rows (default\n"
-    "all; tb3 needs tb3_world_data: $LASER_RAYCAST_SHARED_DATA, the ROS package, or\n"
-    "../shared/data beside the source). --quick: fewer poses and repetitions (under 2 minutes).\n"
+    "against a long double reference and its agreement with Embree's robust mode. Writes\n"
+    "DIR/results.csv, results.md, pareto.png (one point per method) and pareto_matrix.png\n"
+    "(every workload and scene) (DIR defaults to bench_results). Scenes: sphere box_room tb3\n"
+    "million vertex_rows forest warehouse (default all; tb3 needs tb3_world_data:\n"
+    "$LASER_RAYCAST_SHARED_DATA, the ROS package, or ../shared/data beside the source).\n"
+    "--method: only these rows (default all; --list-methods names them). --quick: fewer poses\n"
+    "and repetitions (under 2 minutes).\n"
     "Exit status: 0 ok, 1 the run failed, 2 bad arguments.\n";
 
 class ArgError : public std::runtime_error {
@@ -50,21 +50,47 @@ class ArgError : public std::runtime_error {
 struct Options {
   bool quick = false;
   std::string out_dir = "bench_results";
-  std::vector<std::string> scenes;  // empty: all
+  std::vector<std::string> scenes;   // empty: all
+  std::vector<std::string> methods;  // empty: all
   bool list_methods = false, list_scenes = false, help = false;
 };
 
-// How much work a run does. Every number here only trades run time for noise.
-struct Settings {
-  int reps;                  // timed batches per row; the median is reported
-  double min_batch_seconds;  // a batch repeats its pass until it lasts this long
-  double brute_tests;        // triangle tests a brute-force row may do per pass ...
-  int brute_min_rays;        // ... but at least this many rays
-  double range_max = 100.0;  // m, every method's tmax
-};
+// The full run times more and longer batches on more rays; --quick is a smoke test.
+bench::Settings settingsFor(bool quick) {
+  return quick ? bench::Settings{3, 0.01, 1e6, 1, 3} : bench::Settings{5, 0.05, 4e7, 32, 3};
+}
 
-Settings settingsFor(bool quick) {
-  return quick ? Settings{3, 0.01, 4e6, 8} : Settings{5, 0.05, 4e7, 32};
+std::vector<std::string> allMethodNames() {
+  std::vector<std::string> names = bench::coreMethodNames();
+  const std::vector<std::string> peers = bench::peerMethodNames();
+  names.insert(names.end(), peers.begin(), peers.end());
+  return names;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : " ") + name;
+  return out;
+}
+
+// The names after a list flag (--flag A B ..., or --flag=A; repeatable) into *out, each checked
+// against known.
+void takeNames(const std::vector<std::string>& words, std::size_t* i, const std::string& flag,
+               const std::optional<std::string>& inline_value,
+               const std::vector<std::string>& known, std::vector<std::string>* out) {
+  std::vector<std::string> names;
+  if (inline_value) names.push_back(*inline_value);
+  while (!inline_value && *i + 1 < words.size() && words[*i + 1].compare(0, 2, "--") != 0) {
+    names.push_back(words[++*i]);
+  }
+  const std::string what = flag.substr(2);
+  if (names.empty()) throw ArgError(flag + " needs a " + what + " name");
+  for (const std::string& name : names) {
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      throw ArgError("unknown " + what + " '" + name + "' (" + what + "s: " + joined(known) + ")");
+    }
+    if (std::find(out->begin(), out->end(), name) == out->end()) out->push_back(name);
+  }
 }
 
 Options parseArgs(int argc, char** argv) {
@@ -88,21 +114,11 @@ Options parseArgs(int argc, char** argv) {
       if (value.empty()) throw ArgError("--out needs a directory");
       options.out_dir = value;
     } else if (flag == "--scene") {
-      // --scene A --scene B, or --scene A B.
-      std::vector<std::string> names;
-      if (inline_value) names.push_back(value);
-      while (!inline_value && i + 1 < words.size() && words[i + 1].compare(0, 2, "--") != 0) {
-        names.push_back(words[++i]);
-      }
-      if (names.empty()) throw ArgError("--scene needs a scene name");
-      for (const std::string& name : names) {
-        if (std::find(known.begin(), known.end(), name) == known.end()) {
-          throw ArgError("unknown scene '" + name +
-                         "' (scenes: sphere box_room tb3 million vertex_rows)");
-        }
-        if (std::find(options.scenes.begin(), options.scenes.end(), name) == options.scenes.end())
-          options.scenes.push_back(name);
-      }
+      takeNames(words, &i, flag, inline_value ? std::optional(value) : std::nullopt, known,
+                &options.scenes);
+    } else if (flag == "--method") {
+      takeNames(words, &i, flag, inline_value ? std::optional(value) : std::nullopt,
+                allMethodNames(), &options.methods);
     } else if (flag == "--list-methods" && !inline_value) {
       options.list_methods = true;
     } else if (flag == "--list-scenes" && !inline_value) {
@@ -115,13 +131,6 @@ Options parseArgs(int argc, char** argv) {
   }
   if (options.scenes.empty()) options.scenes = known;
   return options;
-}
-
-std::vector<std::string> allMethodNames() {
-  std::vector<std::string> names = bench::coreMethodNames();
-  const std::vector<std::string> peers = bench::peerMethodNames();
-  names.insert(names.end(), peers.begin(), peers.end());
-  return names;
 }
 
 // Installed, the script sits beside the executable (both in lib/laser_raycast); in a devel space
@@ -145,121 +154,39 @@ std::string cpuModel() {
   return "unknown CPU";
 }
 
-// Ray indices for brute-force rows: evenly spread over every pose and ring, as many as the budget
-// of triangle tests allows (all of them on small scenes).
-std::vector<int> bruteSubset(std::size_t rays, std::size_t triangles, const Settings& settings) {
-  const double budget = settings.brute_tests / std::max<double>(1.0, triangles);
-  const std::size_t count = std::min(
-      rays, std::max<std::size_t>(settings.brute_min_rays, static_cast<std::size_t>(budget)));
-  std::vector<int> subset;
-  for (std::size_t k = 0; k < count; ++k) {
-    subset.push_back(static_cast<int>((2 * k + 1) * rays / (2 * count)));
+bool contains(const std::vector<std::string>& list, const std::string& name) {
+  return std::find(list.begin(), list.end(), name) != list.end();
+}
+
+// The scene's rows (those asked for) and Embree's robust mode for the agreement columns.
+bench::SceneMethods sceneMethods(const Options& options, bench::SceneGeometry* geometry) {
+  const bench::BenchScene& scene = *geometry->scene;
+  const auto wanted = [&](const std::string& name) {
+    return options.methods.empty() || contains(options.methods, name);
+  };
+  geometry->bvh = core::Bvh::build(scene.soup.vertices, scene.soup.triangles);  // the reference's
+  const auto names = allMethodNames();
+  if (std::any_of(names.begin(), names.end(), [&](const std::string& name) {
+        return name.find("_f32") != std::string::npos && wanted(name);
+      })) {
+    geometry->bvh_f = core::BvhF::build(scene.soup.vertices, scene.soup.triangles);
   }
-  return subset;
-}
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-// The triangle reference (on the tessellated boxes) against the analytic boxes on the same rays:
-// independent code, the same room up to the double rounding of the vertices.
-void crossCheckReference(const std::string& label, const std::vector<Real>& triangles,
-                         const std::vector<Real>& analytic) {
-  long disagree = 0;
-  Real max_diff = 0;
-  for (std::size_t i = 0; i < triangles.size(); ++i) {
-    const bool a = std::isfinite(static_cast<double>(triangles[i]));
-    const bool b = std::isfinite(static_cast<double>(analytic[i]));
-    if (a != b) ++disagree;
-    if (a && b) max_diff = std::max(max_diff, std::fabs(triangles[i] - analytic[i]));
+  bench::SceneMethods methods;
+  methods.rows = bench::coreMethods(*geometry, wanted);
+  const auto wanted_or_robust = [&](const std::string& name) {
+    return wanted(name) || name == "embree_robust";
+  };
+  for (bench::Method& peer : bench::peerMethods(scene.soup, wanted_or_robust)) {
+    if (peer.name == "embree_robust") methods.robust = peer;
+    if (wanted(peer.name)) methods.rows.push_back(std::move(peer));
   }
-  std::cerr << "  " << label << ": reference cross-check, triangles vs analytic boxes: " << disagree
-            << " hit/miss disagreements in " << triangles.size() << " beams, max |difference| "
-            << static_cast<double>(max_diff) << " m\n";
+  return methods;
 }
 
-// The pipeline's beams as it holds them: the double sensor poses and the double directions of
-// core::ScanPattern, composed in long double.
-std::vector<bench::RayL> pipelineInputRays(const bench::WorkloadRays& w) {
-  std::vector<bench::RayL> out;
-  for (const Eigen::Isometry3d& sensor : w.sensors) {
-    for (const Eigen::Vector3d& d : w.pattern->directions()) {
-      bench::RayL ray;
-      ray.origin = sensor.translation().cast<Real>();
-      ray.dir = sensor.linear().cast<Real>() * d.cast<Real>();
-      ray.tmin = 0;
-      ray.tmax = w.tmax;
-      out.push_back(ray);
-    }
-  }
-  return out;
-}
-
-long countHits(const std::vector<Real>& reference) {
-  return std::count_if(reference.begin(), reference.end(),
-                       [](Real r) { return std::isfinite(static_cast<double>(r)); });
-}
-
-// One workload on one scene: the rays, both references, then every method's row.
-void runWorkload(const Options& options, const Settings& settings, const bench::BenchScene& scene,
-                 const bench::SceneGeometry& geometry, const std::vector<bench::Method>& methods,
-                 const bench::Workload& workload, std::vector<bench::Row>* rows) {
-  const int poses = options.quick ? workload.quick_poses : workload.full_poses;
-  const bench::WorkloadRays rays = bench::makeRays(scene, workload, poses, settings.range_max);
-  const auto ref_start = std::chrono::steady_clock::now();
-  const std::vector<bench::RayL> exact = bench::exactRays(rays.rays);
-  const std::vector<Real> ref_soup = bench::referenceSoup(geometry.bvh, exact);
-  const std::vector<Real> ref_pipeline = bench::referenceBodies(
-      scene,
-      bench::pipelineRays(rays.poses, workload.fan, workload.elevations, settings.range_max));
-  std::cerr << "  " << workload.name << ": " << rays.rays.size() << " rays from "
-            << rays.poses.size() << " poses; the reference hits " << countHits(ref_soup)
-            << " (soup) and " << countHits(ref_pipeline) << " (pipeline), computed in "
-            << secondsSince(ref_start) << " s\n";
-  // The pipeline's error splits into the rounding of its inputs (pose and beam directions to
-  // double) and its arithmetic; the log shows the second alone.
-  const std::vector<Real> ref_pipeline_inputs =
-      bench::referenceBodies(scene, pipelineInputRays(rays));
-  if (scene.name == "box_room") {
-    crossCheckReference(workload.name, ref_soup, bench::referenceBodies(scene, exact));
-  }
-
-  std::vector<int> all(rays.rays.size());
-  std::iota(all.begin(), all.end(), 0);
-  const std::vector<int> subset =
-      bruteSubset(rays.rays.size(), scene.soup.triangles.size(), settings);
-  for (const bench::Method& method : methods) {
-    const std::vector<int>& used = method.brute ? subset : all;
-    std::vector<double> dist(rays.rays.size(), std::numeric_limits<double>::quiet_NaN());
-    const double seconds =
-        bench::timePass(method.pass, rays, used, &dist, settings.reps, settings.min_batch_seconds);
-    bench::Row row;
-    row.workload = workload.name;
-    row.scene = scene.name;
-    row.method = method.name;
-    row.triangles = method.triangles;
-    row.rays = used.size();
-    row.ns_per_ray = seconds * 1e9 / static_cast<double>(used.size());
-    row.errors = bench::compareWithReference(dist, method.pipeline ? ref_pipeline : ref_soup, used);
-    std::cerr << "    " << method.name << ": " << row.ns_per_ray << " ns/ray, max error "
-              << row.errors.max_abs_err_m << " m, " << row.errors.leaks << " leaks, "
-              << row.errors.false_hits << " false hits";
-    if (method.pipeline) {
-      const auto arithmetic = bench::compareWithReference(dist, ref_pipeline_inputs, used);
-      std::cerr << " (against its double inputs: max error " << arithmetic.max_abs_err_m << " m, "
-                << arithmetic.leaks << " leaks, " << arithmetic.false_hits << " false hits)";
-    }
-    std::cerr << "\n";
-    rows->push_back(row);
-  }
-}
-
-std::vector<bench::Row> runBenchmark(const Options& options, const Settings& settings) {
+std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settings& settings) {
   std::vector<bench::Row> rows;
-  const bool wants_tb3 =
-      std::find(options.scenes.begin(), options.scenes.end(), "tb3") != options.scenes.end();
-  const std::string shared_dir = wants_tb3 ? bench::findSharedData() : std::string();
+  const std::string shared_dir =
+      contains(options.scenes, "tb3") ? bench::findSharedData() : std::string();
   for (const std::string& name : options.scenes) {
     const auto build_start = std::chrono::steady_clock::now();
     std::optional<bench::BenchScene> scene = bench::makeScene(name, shared_dir);
@@ -271,16 +198,14 @@ std::vector<bench::Row> runBenchmark(const Options& options, const Settings& set
     }
     bench::SceneGeometry geometry;
     geometry.scene = &*scene;
-    geometry.bvh = core::Bvh::build(scene->soup.vertices, scene->soup.triangles);
-    geometry.bvh_f = core::BvhF::build(scene->soup.vertices, scene->soup.triangles);
-    std::vector<bench::Method> methods = bench::coreMethods(geometry);
-    for (auto& peer : bench::peerMethods(scene->soup)) methods.push_back(std::move(peer));
+    const bench::SceneMethods methods = sceneMethods(options, &geometry);
     std::cerr << "bench: scene " << name << " (" << scene->note
               << "): " << scene->soup.triangles.size() << " triangles in the soup, "
-              << scene->scene.bodies().size() << " bodies, built in " << secondsSince(build_start)
-              << " s\n";
+              << scene->scene.bodies().size() << " bodies, range max " << scene->range_max
+              << " m, built in " << bench::secondsSince(build_start) << " s\n";
     for (const bench::Workload& workload : bench::workloads()) {
-      runWorkload(options, settings, *scene, geometry, methods, workload, &rows);
+      const int poses = options.quick ? workload.quick_poses : workload.full_poses;
+      bench::runWorkload(settings, poses, *scene, geometry, methods, workload, &rows);
     }
   }
   // Workload-major, as the output promises; scenes and methods keep their order.
@@ -296,16 +221,25 @@ std::vector<bench::Row> runBenchmark(const Options& options, const Settings& set
   return rows;
 }
 
+// The command line as given (defaults left out).
+std::string commandLine(const Options& options) {
+  std::string command = "bench";
+  if (options.quick) command += " --quick";
+  if (options.scenes != bench::sceneNames()) command += " --scene " + joined(options.scenes);
+  if (!options.methods.empty()) command += " --method " + joined(options.methods);
+  return command;
+}
+
 // "bench --quick on 2026-01-31 12:00 UTC, <cpu>": which run the results come from.
 std::string runLabel(const Options& options) {
   const std::time_t now = std::time(nullptr);
   char date[32];
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
-  return std::string("bench") + (options.quick ? " --quick" : "") + " on " + date + ", " +
-         cpuModel();
+  return commandLine(options) + " on " + date + ", " + cpuModel();
 }
 
-std::string runInfo(const Options& options, const Settings& settings, double seconds) {
+std::string runInfo(const Options& options, const bench::Settings& settings,
+                    const std::vector<bench::Row>& rows, double seconds) {
   std::ostringstream info;
   info << "# laser_raycast benchmark\n\n";
   info << "Run: " << runLabel(options) << ", single-threaded, " << std::lround(seconds)
@@ -314,19 +248,30 @@ std::string runInfo(const Options& options, const Settings& settings, double sec
   for (const auto& w : bench::workloads()) {
     info << w.name << " " << (options.quick ? w.quick_poses : w.full_poses) << ", ";
   }
-  info << "range max " << settings.range_max << " m. ns_per_ray: median of " << settings.reps
-       << " timed batches (each at least " << settings.min_batch_seconds
-       << " s). Brute-force rows use an evenly spread subset of at most " << settings.brute_tests
+  info << "range max";
+  std::string last_scene;
+  for (const bench::Row& row : rows) {
+    if (row.scene == last_scene || row.workload != rows.front().workload) continue;
+    info << (last_scene.empty() ? " " : ", ") << row.scene << " " << row.range_max << " m";
+    last_scene = row.scene;
+  }
+  info << ". ns_per_ray: median of " << settings.reps << " timed batches (each at least "
+       << settings.min_batch_seconds << " s); the pipeline and Embree rows are timed alternately "
+       << "in " << settings.rounds << " such rounds and report the median round. Brute-force rows "
+       << "use an evenly spread subset of at most " << settings.brute_tests
        << " triangle tests per pass (at least " << settings.brute_min_rays
        << " rays). Peers: " << bench::peerVersions() << ". ";
   info << "Errors against a long double reference on the geometry each method was given; "
-          "vs_embree = embree_default's ns_per_ray / the row's (> 1: faster than Embree).\n";
+          "vs_embree = embree_default's ns_per_ray / the row's (> 1: faster than Embree); "
+          "agree_robust: the fraction of the row's beams on which it and embree_robust both miss "
+          "or both hit within "
+       << bench::kAgreementTolerance << " m, disagree_robust: the beams where they do not.\n";
   return info.str();
 }
 
 int run(const Options& options) {
   const auto start = std::chrono::steady_clock::now();
-  const Settings settings = settingsFor(options.quick);
+  const bench::Settings settings = settingsFor(options.quick);
   const std::filesystem::path out(options.out_dir);
   std::filesystem::create_directories(out);
   const std::vector<bench::Row> rows = runBenchmark(options, settings);
@@ -336,12 +281,12 @@ int run(const Options& options) {
   const std::string png = (out / "pareto.png").string();
   const std::string matrix_png = (out / "pareto_matrix.png").string();
   bench::writeCsv(csv, rows);
-  bench::writeMarkdown(md, rows, runInfo(options, settings, secondsSince(start)));
+  bench::writeMarkdown(md, rows, runInfo(options, settings, rows, bench::secondsSince(start)));
   const std::string plot_error = bench::runPlot(
       plotScript(), {csv, png, "--matrix", matrix_png, "--source", "Run: " + runLabel(options)});
   if (!plot_error.empty()) throw std::runtime_error("plotting failed: " + plot_error);
-  std::cerr << "bench: done in " << secondsSince(start) << " s: " << csv << ", " << md << ", "
-            << png << ", " << matrix_png << "\n";
+  std::cerr << "bench: done in " << bench::secondsSince(start) << " s: " << csv << ", " << md
+            << ", " << png << ", " << matrix_png << "\n";
   return 0;
 }
 

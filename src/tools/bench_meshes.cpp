@@ -49,8 +49,17 @@ void MeshData::quad(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint
 }
 
 MeshData cylinderMesh(double radius, const std::vector<double>& ring_z, int segments, bool caps) {
+  return taperedCylinderMesh(radius, radius, ring_z, segments, caps);
+}
+
+MeshData taperedCylinderMesh(double bottom_radius, double top_radius,
+                             const std::vector<double>& ring_z, int segments, bool caps) {
   MeshData m;
+  const double z0 = ring_z.front(), height = ring_z.back() - ring_z.front();
   for (const double z : ring_z) {
+    // With equal radii the second term is exactly 0, whatever the height.
+    const double radius =
+        bottom_radius + (height > 0 ? (top_radius - bottom_radius) * ((z - z0) / height) : 0.0);
     for (int k = 0; k < segments; ++k) {
       const double a = kTwoPi * k / segments;
       m.vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), z);
@@ -116,6 +125,12 @@ MeshData boxMesh(const Eigen::Vector3d& size) {
   m.quad(2, 6, 7, 3);
   m.quad(0, 2, 3, 1);
   m.quad(4, 5, 7, 6);
+  return m;
+}
+
+MeshData boxMesh(const Eigen::Vector3d& size, const Eigen::Isometry3d& pose) {
+  MeshData m = boxMesh(size);
+  for (auto& v : m.vertices) v = pose * v;
   return m;
 }
 

@@ -47,6 +47,10 @@ struct MeshData {
 // The side of a cylinder (axis z, centred on it): a ring of `segments` vertices at each height in
 // ring_z (ascending), joined by quads facing outwards; with caps, a centre vertex closes each end.
 MeshData cylinderMesh(double radius, const std::vector<double>& ring_z, int segments, bool caps);
+// The same with the radius going linearly from bottom_radius at ring_z.front() to top_radius at
+// ring_z.back() (a tapered trunk). Equal radii give cylinderMesh's vertices exactly.
+MeshData taperedCylinderMesh(double bottom_radius, double top_radius,
+                             const std::vector<double>& ring_z, int segments, bool caps);
 
 // A latitude-longitude sphere centred at the origin: `segments` vertices per ring, `stacks` bands
 // from pole to pole (triangle fans at the poles, so no degenerate triangles).
@@ -54,6 +58,8 @@ MeshData uvSphereMesh(double radius, int segments, int stacks);
 
 // A box centred at the origin with edge lengths size: 8 vertices, 12 triangles facing outwards.
 MeshData boxMesh(const Eigen::Vector3d& size);
+// The same box moved to pose (its vertices transformed and rounded once, in double).
+MeshData boxMesh(const Eigen::Vector3d& size, const Eigen::Isometry3d& pose);
 
 // A height field over [x0, x1] x [y0, y1] with nx x ny cells, z = height(x, y).
 template <class Height>

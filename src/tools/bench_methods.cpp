@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <type_traits>
+#include <utility>
 
 namespace laser_raycast {
 namespace bench {
@@ -98,12 +99,16 @@ const core::BvhF& bvhOf<float>(const SceneGeometry& g) {
 
 // Row order within a method: double BVH, double brute, float BVH, float brute.
 template <typename T, core::TriangleMethod M>
-void addMethodRows(const SceneGeometry& g, std::vector<Method>* out) {
+void addMethodRows(const SceneGeometry& g, const MethodFilter& wanted, std::vector<Method>* out) {
   const std::string base =
       std::string(core::toString(M)) + (std::is_same<T, float>::value ? "_f32" : "");
   const std::size_t triangles = g.scene->soup.triangles.size();
-  out->push_back(Method{base + "_bvh", false, false, triangles, bvhPass<T, M>(bvhOf<T>(g))});
-  out->push_back(Method{base + "_brute", true, false, triangles, brutePass<T, M>(bvhOf<T>(g))});
+  if (wanted(base + "_bvh")) {
+    out->push_back(Method{base + "_bvh", false, false, triangles, bvhPass<T, M>(bvhOf<T>(g))});
+  }
+  if (wanted(base + "_brute")) {
+    out->push_back(Method{base + "_brute", true, false, triangles, brutePass<T, M>(bvhOf<T>(g))});
+  }
 }
 
 }  // namespace
@@ -124,7 +129,7 @@ const std::vector<Workload>& workloads() {
     rings3d.fan.angle_min = -M_PI;
     rings3d.fan.angle_max = M_PI - 2 * M_PI / 1024;
     rings3d.fan.samples = 1024;
-    for (int k = 0; k < 64; ++k) rings3d.elevations.push_back((-22.5 + 45.0 * k / 63) * kDeg);
+    for (int k = 0; k < 64; ++k) rings3d.elevations.push_back((-15.0 + 30.0 * k / 63) * kDeg);
     rings3d.full_poses = 6;
     rings3d.quick_poses = 1;
     return std::vector<Workload>{fan2d, rings3d};
@@ -159,17 +164,19 @@ WorkloadRays makeRays(const BenchScene& scene, const Workload& workload, int pos
   return w;
 }
 
-std::vector<Method> coreMethods(const SceneGeometry& g) {
+std::vector<Method> coreMethods(const SceneGeometry& g, const MethodFilter& wanted) {
   std::vector<Method> methods;
   for (const core::TriangleMethod m : core::kAllTriangleMethods) {
     core::dispatchTriangleMethod(m, [&](auto method) {
       constexpr core::TriangleMethod M = decltype(method)::value;
-      addMethodRows<double, M>(g, &methods);
-      addMethodRows<float, M>(g, &methods);
+      addMethodRows<double, M>(g, wanted, &methods);
+      addMethodRows<float, M>(g, wanted, &methods);
     });
   }
-  methods.push_back(
-      Method{"pipeline", false, true, g.scene->scene.triangleCount(), pipelinePass(*g.scene)});
+  if (wanted("pipeline")) {
+    methods.push_back(Method{"pipeline", false, true, g.scene->scene.triangleCount(),
+                             pipelinePass(*g.scene), true});
+  }
   return methods;
 }
 
@@ -186,25 +193,31 @@ std::vector<std::string> coreMethodNames() {
   return names;
 }
 
-double timePass(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
-                std::vector<double>* dist, int reps, double min_batch_seconds) {
-  using Clock = std::chrono::steady_clock;
-  auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
-  // The first pass warms caches and gives the distances the errors are computed from.
-  const auto t0 = Clock::now();
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+int firstPass(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
+              std::vector<double>* dist, double min_batch_seconds) {
+  const auto start = std::chrono::steady_clock::now();
   pass(w, rays, dist);
-  const double first = seconds(Clock::now() - t0);
-  const int per_batch =
-      std::max(1, static_cast<int>(std::ceil(min_batch_seconds / std::max(first, 1e-9))));
-  std::vector<double> scratch(dist->size());
+  const double first =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return std::max(1, static_cast<int>(std::ceil(min_batch_seconds / std::max(first, 1e-9))));
+}
+
+double timeBatches(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
+                   int per_batch, int reps) {
+  using Clock = std::chrono::steady_clock;
+  std::vector<double> scratch(w.rays.size());
   std::vector<double> per_pass;
   for (int r = 0; r < reps; ++r) {
     const auto start = Clock::now();
     for (int k = 0; k < per_batch; ++k) pass(w, rays, &scratch);
-    per_pass.push_back(seconds(Clock::now() - start) / per_batch);
+    per_pass.push_back(std::chrono::duration<double>(Clock::now() - start).count() / per_batch);
   }
-  std::nth_element(per_pass.begin(), per_pass.begin() + per_pass.size() / 2, per_pass.end());
-  return per_pass[per_pass.size() / 2];
+  return median(std::move(per_pass));
 }
 
 }  // namespace bench

@@ -22,8 +22,8 @@ struct Workload {
   int full_poses, quick_poses;     // sensor poses used (a prefix of the scene's list)
 };
 
-// fan2d: 1081 beams over 270 degrees; rings3d: 64 rings from -22.5 to +22.5 degrees elevation x
-// 1024 azimuths over the full turn.
+// fan2d: 1081 beams over 270 degrees; rings3d: 64 rings from -15 to +15 degrees elevation x 1024
+// azimuths over the full turn.
 const std::vector<Workload>& workloads();
 
 // Every beam of a workload from each sensor pose, pose-major, as the triangle methods and peers get
@@ -54,7 +54,11 @@ struct Method {
   bool pipeline = false;      // measured against the pipeline reference
   std::size_t triangles = 0;  // triangles in the geometry it is given
   Pass pass;
+  bool paired = false;  // timed in alternating rounds with the other paired rows (speed ratios)
 };
+
+// Which methods to build (--method); a method not wanted costs nothing.
+using MethodFilter = std::function<bool(const std::string& name)>;
 
 // The soup's BVHs, in both precisions, and the scene (for the pipeline); built once per scene.
 struct SceneGeometry {
@@ -64,16 +68,23 @@ struct SceneGeometry {
 };
 
 // The core's methods: every intersector in double and float, brute force and BVH, then the
-// pipeline (Caster::cast, with Caster::forget() before every cast so nothing is reused).
-std::vector<Method> coreMethods(const SceneGeometry& geometry);
+// pipeline (Caster::cast, with Caster::forget() before every cast so nothing is reused); those
+// wanted. The float rows need geometry.bvh_f.
+std::vector<Method> coreMethods(const SceneGeometry& geometry, const MethodFilter& wanted);
 // Their names, in the same order, for --list-methods.
 std::vector<std::string> coreMethodNames();
 
-// Runs pass once over rays (its result is kept in dist), then `reps` timed batches of passes, each
-// batch repeated until it lasts at least min_batch_seconds; returns the median seconds per pass.
-// Single-threaded, std::chrono::steady_clock.
-double timePass(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
-                std::vector<double>* dist, int reps, double min_batch_seconds);
+// The median of values (the upper one of an even count); values must not be empty.
+double median(std::vector<double> values);
+
+// Runs pass once over rays (warming caches; its result is kept in dist) and returns how many
+// passes a batch needs to last at least min_batch_seconds.
+int firstPass(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
+              std::vector<double>* dist, double min_batch_seconds);
+// Times `reps` batches of per_batch passes; returns the median seconds per pass. Single-threaded,
+// std::chrono::steady_clock.
+double timeBatches(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
+                   int per_batch, int reps);
 
 }  // namespace bench
 }  // namespace laser_raycast

@@ -187,24 +187,29 @@ std::string peerVersions() {
   return versions.empty() ? "none" : versions;
 }
 
-std::vector<Method> peerMethods([[maybe_unused]] const MeshData& soup) {
+std::vector<Method> peerMethods([[maybe_unused]] const MeshData& soup,
+                                [[maybe_unused]] const MethodFilter& wanted) {
   std::vector<Method> methods;
-  const std::size_t triangles = soup.triangles.size();
+  [[maybe_unused]] const std::size_t triangles = soup.triangles.size();
 #ifdef LASER_RAYCAST_HAVE_EMBREE
   for (const bool robust : {false, true}) {
+    const std::string name = robust ? "embree_robust" : "embree_default";
+    if (!wanted(name)) continue;
     auto scene = std::make_shared<const EmbreeScene>(soup, robust);
-    methods.push_back(Method{robust ? "embree_robust" : "embree_default", false, false, triangles,
+    methods.push_back(Method{name, false, false, triangles,
                              [scene](const WorkloadRays& w, const std::vector<int>& rays,
-                                     std::vector<double>* out) { scene->pass(w, rays, out); }});
+                                     std::vector<double>* out) { scene->pass(w, rays, out); },
+                             true});
   }
 #endif
 #ifdef LASER_RAYCAST_HAVE_BULLET
-  auto bullet = std::make_shared<const BulletScene>(soup);
-  methods.push_back(Method{"bullet", false, false, triangles,
-                           [bullet](const WorkloadRays& w, const std::vector<int>& rays,
-                                    std::vector<double>* out) { bullet->pass(w, rays, out); }});
+  if (wanted("bullet")) {
+    auto bullet = std::make_shared<const BulletScene>(soup);
+    methods.push_back(Method{"bullet", false, false, triangles,
+                             [bullet](const WorkloadRays& w, const std::vector<int>& rays,
+                                      std::vector<double>* out) { bullet->pass(w, rays, out); }});
+  }
 #endif
-  (void)triangles;
   return methods;
 }
 

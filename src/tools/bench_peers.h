@@ -13,9 +13,10 @@
 namespace laser_raycast {
 namespace bench {
 
-// The peers' rows for a soup (each holds its own acceleration structure, built here). Throws
-// std::runtime_error if a peer reports an error.
-std::vector<Method> peerMethods(const MeshData& soup);
+// The peers' rows for a soup, those wanted (each holds its own acceleration structure, built
+// here); the Embree rows are paired with the pipeline for timing. Throws std::runtime_error if a
+// peer reports an error.
+std::vector<Method> peerMethods(const MeshData& soup, const MethodFilter& wanted);
 // Their names, in the same order, for --list-methods.
 std::vector<std::string> peerMethodNames();
 // The peers compiled in, with their versions (e.g. "Embree 3.13.5, Bullet 3.24"), or "none".

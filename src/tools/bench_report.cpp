@@ -29,6 +29,14 @@ std::string format(const char* spec, double value) {
   return buffer;
 }
 
+// A fraction rounded down to `digits` decimals, so that 1 means no exception at all.
+std::string fractionDown(double fraction, int digits) {
+  const double scale = std::pow(10.0, digits);
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", digits, std::floor(fraction * scale) / scale);
+  return buffer;
+}
+
 std::ofstream openForWriting(const std::string& path) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
@@ -39,7 +47,7 @@ std::ofstream openForWriting(const std::string& path) {
 
 const char* const kCsvHeader =
     "workload,scene,method,triangles,rays,ns_per_ray,mrays_per_s,max_abs_err_m,p99_abs_err_m,"
-    "max_ulp,leaks,false_hits";
+    "max_ulp,leaks,false_hits,agree_robust,disagree_robust";
 
 ErrorStats compareWithReference(const std::vector<double>& dist, const std::vector<Real>& reference,
                                 const std::vector<int>& rays) {
@@ -67,6 +75,29 @@ ErrorStats compareWithReference(const std::vector<double>& dist, const std::vect
   return stats;
 }
 
+bool agrees(double a, double b) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // inf - x is inf and NaN compares false: only real agreement passes.
+  return (a == kInf && b == kInf) || std::fabs(a - b) <= kAgreementTolerance;
+}
+
+Agreement compareWithPeer(const std::vector<double>& dist, const std::vector<double>& peer,
+                          const std::vector<int>& rays, const std::vector<char>& comparable) {
+  Agreement agreement;
+  agreement.disagree = 0;
+  for (const int i : rays) {
+    if (!comparable.empty() && !comparable[i]) {
+      ++agreement.excluded;
+    } else if (!agrees(dist[i], peer[i])) {
+      ++agreement.disagree;
+    }
+  }
+  const auto compared = static_cast<double>(rays.size() - agreement.excluded);
+  agreement.fraction =
+      compared > 0 ? 1.0 - static_cast<double>(agreement.disagree) / compared : 1.0;
+  return agreement;
+}
+
 void writeCsv(const std::string& path, const std::vector<Row>& rows) {
   std::ofstream out = openForWriting(path);
   out << kCsvHeader << "\n";
@@ -75,7 +106,13 @@ void writeCsv(const std::string& path, const std::vector<Row>& rows) {
         << "," << format("%.6g", r.ns_per_ray) << "," << format("%.6g", 1000.0 / r.ns_per_ray)
         << "," << format("%.6g", r.errors.max_abs_err_m) << ","
         << format("%.6g", r.errors.p99_abs_err_m) << "," << format("%.6g", r.errors.max_ulp) << ","
-        << r.errors.leaks << "," << r.errors.false_hits << "\n";
+        << r.errors.leaks << "," << r.errors.false_hits << ",";
+    if (r.agree_robust.available()) {
+      out << fractionDown(r.agree_robust.fraction, 8) << "," << r.agree_robust.disagree;
+    } else {
+      out << ",";
+    }
+    out << "\n";
   }
   if (!out) throw std::runtime_error("writing " + path + " failed");
 }
@@ -89,9 +126,11 @@ void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
   std::ofstream out = openForWriting(path);
   out << run_info << "\n";
   out << "| workload | scene | method | triangles | rays | ns_per_ray | mrays_per_s | "
-         "max_abs_err_m | p99_abs_err_m | max_ulp | leaks | false_hits | vs_embree |\n";
+         "max_abs_err_m | p99_abs_err_m | max_ulp | leaks | false_hits | vs_embree | agree_robust "
+         "| "
+         "disagree_robust |\n";
   out << "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: "
-         "|\n";
+         "| ---: | ---: |\n";
   for (const Row& r : rows) {
     const auto it = embree.find({r.workload, r.scene});
     const std::string vs = it == embree.end() ? "n/a" : format("%.3g", it->second / r.ns_per_ray);
@@ -100,7 +139,12 @@ void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
         << format("%.4g", 1000.0 / r.ns_per_ray) << " | " << format("%.3g", r.errors.max_abs_err_m)
         << " | " << format("%.3g", r.errors.p99_abs_err_m) << " | "
         << format("%.3g", r.errors.max_ulp) << " | " << r.errors.leaks << " | "
-        << r.errors.false_hits << " | " << vs << " |\n";
+        << r.errors.false_hits << " | " << vs << " | ";
+    if (r.agree_robust.available()) {
+      out << fractionDown(r.agree_robust.fraction, 6) << " | " << r.agree_robust.disagree << " |\n";
+    } else {
+      out << "n/a | n/a |\n";
+    }
   }
   if (!out) throw std::runtime_error("writing " + path + " failed");
 }

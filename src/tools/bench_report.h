@@ -23,11 +23,34 @@ struct ErrorStats {
 ErrorStats compareWithReference(const std::vector<double>& dist, const std::vector<Real>& reference,
                                 const std::vector<int>& rays);
 
+// Per beam, whether a method and a peer (Embree's robust mode) give the same answer: both miss,
+// or both hit within the tolerance. Unavailable (no such peer): disagree < 0.
+struct Agreement {
+  double fraction = 0;  // of the beams compared
+  long disagree = -1;   // beams compared that do not agree
+  long excluded = 0;    // beams not compared: the method's geometry differs from the peer's there
+  bool available() const { return disagree >= 0; }
+};
+
+// The tolerance of the agreement column (m): the performance issue's criterion.
+constexpr double kAgreementTolerance = 1e-4;
+
+// Whether two distances (+inf: no hit) agree: both miss, or both hit within the tolerance. NaN,
+// and a hit against a miss, never agree.
+bool agrees(double a, double b);
+
+// Compares the method's distances with the peer's at the given ray indices where comparable is
+// non-zero (an empty comparable: at all of them).
+Agreement compareWithPeer(const std::vector<double>& dist, const std::vector<double>& peer,
+                          const std::vector<int>& rays, const std::vector<char>& comparable);
+
 struct Row {
   std::string workload, scene, method;
   std::size_t triangles = 0, rays = 0;
   double ns_per_ray = 0;
   ErrorStats errors;
+  Agreement agree_robust;  // with embree_robust
+  double range_max = 0;    // m, the scene's (for the run's description)
 };
 
 // The stable header of results.csv.
@@ -36,6 +59,7 @@ extern const char* const kCsvHeader;
 void writeCsv(const std::string& path, const std::vector<Row>& rows);
 // The table of results.csv plus vs_embree (embree_default's ns_per_ray over the row's, same
 // workload and scene), after a few lines that say how the run was made (run_info, markdown).
+// Unavailable agreement columns are empty in the CSV and n/a in the table.
 void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
                    const std::string& run_info);
 

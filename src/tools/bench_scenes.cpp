@@ -9,6 +9,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "bench_scene_builder.h"
 #include "laser_raycast/loader/kinematics.h"
 #include "laser_raycast/loader/scene_loader.h"
 
@@ -16,34 +17,11 @@ namespace laser_raycast {
 namespace bench {
 namespace {
 
-// Tessellation of primitives for the soup: fine enough that the facets are within 0.1 mm of the
-// surface at the sizes used here. The error columns do not depend on it (each method is compared
-// with a reference on the geometry it was given).
+// Tessellation of primitives for the soup. The error columns do not depend on it (each method is
+// compared with a reference on the geometry it was given), nor does the pipeline's agreement with
+// a peer (bench_run.cpp takes the difference of the two geometries out).
 constexpr int kSphereSegments = 192, kSphereStacks = 96;
 constexpr int kCylinderSegments = 96;
-
-// Adds bodies on one frame, "world", at the identity.
-class SceneBuilder {
- public:
-  explicit SceneBuilder(BenchScene* out) : out_(out) { frame_ = out_->scene.addFrame("world"); }
-
-  void add(const core::Shape& shape, const PoseL& pose, const std::string& label) {
-    core::Body body;
-    body.shape = shape;
-    body.frame = frame_;
-    body.label = out_->scene.addLabel(label);
-    body.frame_from_body = toIsometry(pose);
-    out_->scene.addBody(body);
-    out_->body_poses.push_back(pose);
-  }
-  void add(const MeshData& mesh, const PoseL& pose, const std::string& label) {
-    add(std::make_shared<const core::Mesh>(mesh.vertices, mesh.triangles), pose, label);
-  }
-
- private:
-  BenchScene* out_;
-  int frame_;
-};
 
 // The soup: every body's triangles (primitives tessellated) placed in the world in long double and
 // rounded once. Vertices a body's triangles share stay shared.
@@ -78,19 +56,6 @@ std::optional<std::string> rosPackagePath(const std::string& package) {
 bool hasTb3Data(const std::string& dir) {
   return !dir.empty() &&
          std::filesystem::exists(dir + "/tb3_world_data/urdf/turtlebot3_world.urdf");
-}
-
-// A deterministic uniform double in [lo, hi): the mapping is written out, unlike
-// std::uniform_real_distribution's, so every platform places the same trees.
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
-}
-
-std::vector<double> steps(double from, double to, double step) {
-  std::vector<double> v;
-  const int n = static_cast<int>(std::lround((to - from) / step));
-  for (int i = 0; i <= n; ++i) v.push_back(from + i * step);
-  return v;
 }
 
 // One analytic sphere; half the poses inside it, half outside looking at it.
@@ -251,11 +216,52 @@ void buildVertexRows(BenchScene* s) {
   }
 }
 
+// One mesh of 400 slightly tapered trunks (a single body, as one STL file holding many objects
+// loads), 2,500 triangles each, scattered over a disc of 60 m radius: 354 stems per hectare, a
+// managed forest's density, so that a laser in the middle sees near and far trunks within 30 m and
+// many beams between them. Every trunk has rings of vertices at the same heights (every 0.5 m) and
+// every laser is level at a ring's height: the fan's scan plane runs exactly along the rings'
+// shared edges, the worst case for watertightness.
+void buildForest(BenchScene* s) {
+  constexpr std::size_t kTrunks = 400;
+  constexpr int kSegments = 50;
+  constexpr double kDiscRadius = 60, kSpacing = 1.5, kLaserZ = 1.0;
+  const std::vector<double> rings = steps(0.0, 12.5, 0.5);  // 25 bands x 50 segments x 2
+  s->note = "a forest: one mesh of 400 trunks of 2500 triangles on a 60 m disc, laser at a ring";
+  s->range_max = 30;
+  const double z = kLaserZ;  // rings[2], exactly
+  s->sensor_poses = {{0.0, 0.0, z, 0, 0, 0.3},    {8.4, -5.1, z, 0, 0, 2.2},
+                     {-13.7, 9.2, z, 0, 0, -0.8}, {17.5, 12.6, z, 0, 0, -2.6},
+                     {-5.9, -19.3, z, 0, 0, 1.2}, {22.4, -2.8, z, 0, 0, 3.0}};
+
+  std::mt19937_64 rng(20250301);
+  MeshData forest;
+  std::vector<Eigen::Vector2d> placed;
+  for (int attempt = 0; placed.size() < kTrunks && attempt < 1000000; ++attempt) {
+    const Eigen::Vector2d p(uniform(rng, -kDiscRadius, kDiscRadius),
+                            uniform(rng, -kDiscRadius, kDiscRadius));
+    bool free = p.norm() <= kDiscRadius;
+    for (const auto& q : placed) free = free && (p - q).norm() >= kSpacing;
+    for (const auto& v : s->sensor_poses) {
+      free = free && (p - Eigen::Vector2d(v.x, v.y)).norm() >= kSpacing;
+    }
+    if (!free) continue;
+    // Breast-height diameters of 20 to 60 cm, 40% thinner at the top.
+    const double radius = uniform(rng, 0.10, 0.30);
+    MeshData trunk = taperedCylinderMesh(radius, 0.6 * radius, rings, kSegments, false);
+    for (auto& v : trunk.vertices) v.head<2>() += p;  // z, the ring heights, untouched
+    forest.append(trunk);
+    placed.push_back(p);
+  }
+  if (placed.size() < kTrunks) throw std::runtime_error("forest: could not place the trunks");
+  SceneBuilder(s).add(forest, PoseL{}, "forest");
+}
+
 }  // namespace
 
 const std::vector<std::string>& sceneNames() {
-  static const std::vector<std::string> names = {"sphere", "box_room", "tb3", "million",
-                                                 "vertex_rows"};
+  static const std::vector<std::string> names = {"sphere",      "box_room", "tb3",      "million",
+                                                 "vertex_rows", "forest",   "warehouse"};
   return names;
 }
 
@@ -284,6 +290,10 @@ std::optional<BenchScene> makeScene(const std::string& name, const std::string& 
     buildMillion(&s);
   } else if (name == "vertex_rows") {
     buildVertexRows(&s);
+  } else if (name == "forest") {
+    buildForest(&s);
+  } else if (name == "warehouse") {
+    buildWarehouse(&s);
   } else {
     throw std::runtime_error("unknown scene '" + name + "'");
   }

@@ -34,8 +34,9 @@ struct BenchScene {
   std::vector<PoseL> body_poses;
   // The sensor poses, most varied first: --quick uses the first few.
   std::vector<SensorPose> sensor_poses;
-  MeshData soup;     // world frame
-  std::string note;  // one line on what the scene is, for the log
+  MeshData soup;           // world frame
+  std::string note;        // one line on what the scene is, for the log
+  double range_max = 100;  // m: every method's tmax on this scene
 };
 
 // The scene names, in output order.

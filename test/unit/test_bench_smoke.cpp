@@ -1,11 +1,14 @@
 // The benchmark tool run as a user would: `bench --quick --out DIR`. Checks the outputs' format
-// (a stable interface), that every method has a row for every workload and scene that ran, and
-// that the production rows (watertight_bvh, pipeline) neither leak nor hit what is not there.
-// Never timings: the machine may be busy. The quick run takes up to about 2 minutes; catkin
-// ignores a gtest TIMEOUT, so the command itself is bounded by timeout(1) at 15 minutes.
+// (a stable interface), that every method has a row for every workload and scene that ran, that
+// the production rows (watertight_bvh, pipeline) neither leak nor hit what is not there, that the
+// agreement columns compare beam for beam (embree_robust agrees with itself on every beam), and
+// that --method keeps only the rows asked for. Never timings: the machine may be busy. The quick
+// run takes up to about 2 minutes; catkin ignores a gtest TIMEOUT, so the command itself is
+// bounded by timeout(1) at 15 minutes.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -24,7 +27,8 @@ namespace {
 const std::string kBench = BENCH_PATH;
 const char* const kHeader =
     "workload,scene,method,triangles,rays,ns_per_ray,mrays_per_s,max_abs_err_m,p99_abs_err_m,"
-    "max_ulp,leaks,false_hits";
+    "max_ulp,leaks,false_hits,agree_robust,disagree_robust";
+constexpr std::size_t kFields = 14;
 
 std::vector<std::string> splitLines(const std::string& text) {
   std::vector<std::string> lines;
@@ -66,10 +70,27 @@ bool parseCount(const std::string& text, long* value) {
   return true;
 }
 
+std::string tempDir(const std::string& name) {
+  const std::string dir = ::testing::TempDir() + name + "_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
 TEST(BenchSmoke, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runCommand(kBench + " --no-such-flag 2>/dev/null").status, 2);
   EXPECT_EQ(runCommand(kBench + " --scene nowhere 2>/dev/null").status, 2);
   EXPECT_EQ(runCommand(kBench + " --scene 2>/dev/null").status, 2);
+  EXPECT_EQ(runCommand(kBench + " --method nothing 2>/dev/null").status, 2);
+  EXPECT_EQ(runCommand(kBench + " --method 2>/dev/null").status, 2);
+  EXPECT_EQ(runCommand(kBench + " --method pipeline --scene 2>/dev/null").status, 2);
+}
+
+TEST(BenchSmoke, ListsTheScenes) {
+  const auto result = runCommand(kBench + " --list-scenes");
+  ASSERT_EQ(result.status, 0);
+  EXPECT_EQ(splitLines(result.output),
+            (std::vector<std::string>{"sphere", "box_room", "tb3", "million", "vertex_rows",
+                                      "forest", "warehouse"}));
 }
 
 TEST(BenchSmoke, ListsTheCoreMethods) {
@@ -85,13 +106,33 @@ TEST(BenchSmoke, ListsTheCoreMethods) {
   EXPECT_EQ(methods.count("pipeline"), 1u);
 }
 
+// agree_robust is a fraction in [0, 1] that is 1 exactly when disagree_robust is 0, and at most
+// the row's rays disagree; both are empty without Embree. embree_robust compared with itself
+// agrees on every beam (a misaligned comparison would not).
+void expectAgreementFields(const std::string& fraction_text, const std::string& count_text,
+                           bool has_robust, long rays, bool is_robust, const std::string& line) {
+  if (!has_robust) {
+    EXPECT_TRUE(fraction_text.empty() && count_text.empty()) << line;
+    return;
+  }
+  double fraction = -1;
+  long disagree = -1;
+  ASSERT_TRUE(parseDouble(fraction_text, &fraction) && fraction >= 0 && fraction <= 1) << line;
+  ASSERT_TRUE(parseCount(count_text, &disagree) && disagree <= rays) << line;
+  EXPECT_EQ(fraction == 1.0, disagree == 0) << line;
+  if (is_robust) {
+    EXPECT_EQ(disagree, 0) << line;
+  }
+}
+
 TEST(BenchSmoke, QuickRunWritesEveryRow) {
   const auto listed = runCommand(kBench + " --list-methods");
   ASSERT_EQ(listed.status, 0);
   const std::vector<std::string> methods = splitLines(listed.output);
 
-  const std::string dir = ::testing::TempDir() + "bench_smoke_" + std::to_string(getpid());
-  std::filesystem::remove_all(dir);
+  const bool has_robust =
+      std::find(methods.begin(), methods.end(), "embree_robust") != methods.end();
+  const std::string dir = tempDir("bench_smoke");
   const std::string log = dir + ".log";
   const auto run = runCommand("timeout 900 " + kBench + " --quick --out " + dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
@@ -103,11 +144,11 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
   std::map<std::pair<std::string, std::string>, std::set<std::string>> ran;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const auto f = splitFields(lines[i]);
-    ASSERT_EQ(f.size(), 12u) << lines[i];
+    ASSERT_EQ(f.size(), kFields) << lines[i];
     const std::string& method = f[2];
     ran[{f[0], f[1]}].insert(method);
-    long triangles, rays, leaks, false_hits;
-    double ns, mrays, max_err, p99_err, max_ulp;
+    long triangles = 0, rays = 0, leaks = 0, false_hits = 0;
+    double ns = 0, mrays = 0, max_err = 0, p99_err = 0, max_ulp = 0;
     EXPECT_TRUE(parseCount(f[3], &triangles)) << lines[i];
     EXPECT_TRUE(parseCount(f[4], &rays) && rays > 0) << lines[i];
     EXPECT_TRUE(parseDouble(f[5], &ns) && ns > 0) << lines[i];
@@ -121,6 +162,7 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
       EXPECT_EQ(leaks, 0) << lines[i];
       EXPECT_EQ(false_hits, 0) << lines[i];
     }
+    expectAgreementFields(f[12], f[13], has_robust, rays, method == "embree_robust", lines[i]);
   }
 
   // Every method for every workload and scene that ran; every generated scene in both workloads
@@ -131,7 +173,8 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
     }
     EXPECT_EQ(present.size(), methods.size()) << key.first << ", " << key.second;
   }
-  for (const std::string scene : {"sphere", "box_room", "million", "vertex_rows"}) {
+  for (const std::string scene :
+       {"sphere", "box_room", "million", "vertex_rows", "forest", "warehouse"}) {
     for (const std::string workload : {"fan2d", "rings3d"}) {
       EXPECT_EQ(ran.count({workload, scene}), 1u) << workload << ", " << scene;
     }
@@ -143,6 +186,29 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
     ASSERT_GT(png.size(), 8u) << name;
     EXPECT_EQ(png.substr(1, 3), "PNG") << name;
   }
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(log);
+}
+
+TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
+  const std::string dir = tempDir("bench_method");
+  const std::string log = dir + ".log";
+  const auto run = runCommand("timeout 300 " + kBench +
+                              " --quick --scene box_room --method "
+                              "watertight_bvh pipeline --out " +
+                              dir + " 2>" + log);
+  ASSERT_EQ(run.status, 0) << readFile(log);
+  const auto lines = splitLines(readFile(dir + "/results.csv"));
+  ASSERT_EQ(lines.size(), 5u) << readFile(dir + "/results.csv");  // header, 2 workloads x 2 rows
+  std::multiset<std::string> rows;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const auto f = splitFields(lines[i]);
+    ASSERT_EQ(f.size(), kFields) << lines[i];
+    EXPECT_EQ(f[1], "box_room") << lines[i];
+    rows.insert(f[0] + " " + f[2]);
+  }
+  EXPECT_EQ(rows, (std::multiset<std::string>{"fan2d watertight_bvh", "fan2d pipeline",
+                                              "rings3d watertight_bvh", "rings3d pipeline"}));
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
 }
