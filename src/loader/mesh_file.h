@@ -7,7 +7,8 @@
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
-#include "laser_raycast/loader/scene_loader.h"
+#include "laser_raycast/loader/errors.h"
+#include "laser_raycast/loader/package_resolver.h"
 
 namespace laser_raycast {
 namespace mesh_file {

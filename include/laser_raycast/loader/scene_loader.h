@@ -4,22 +4,18 @@
 
 #include <Eigen/Geometry>
 #include <array>
-#include <functional>
 #include <map>
 #include <memory>
-#include <optional>
-#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "laser_raycast/core/enum_names.h"
 #include "laser_raycast/core/scene.h"
+#include "laser_raycast/loader/errors.h"
+#include "laser_raycast/loader/package_resolver.h"
 
 namespace laser_raycast {
-
-// Returns the directory of a ROS package, or nullopt if it is unknown.
-using PackageResolver = std::function<std::optional<std::string>(const std::string& package)>;
 
 // Which URDF geometry becomes the scene.
 enum class GeometrySource {
@@ -34,12 +30,6 @@ inline const char* toString(GeometrySource source) { return kGeometrySourceNames
 inline bool parseGeometrySource(const std::string& name, GeometrySource* source) {
   return kGeometrySourceNames.parse(name, source);
 }
-
-// A bad model: the message names the file, the link and the problem.
-class SceneLoadError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct LoaderOptions {
   GeometrySource geometry = GeometrySource::kVisual;  // which elements to load
