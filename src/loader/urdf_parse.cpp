@@ -1,0 +1,103 @@
+#include "urdf_parse.h"
+
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <exception>
+#include <mutex>
+#include <regex>
+
+#include "laser_raycast/loader/errors.h"
+
+namespace laser_raycast {
+namespace {
+
+// Collects what urdfdom reports through console_bridge while it parses: that is the only place
+// it says why a parse failed, and it drops a <visual> or <collision> it cannot parse (a "nan" size,
+// an empty <geometry>) without failing the parse. Errors are kept; the rest goes on to the
+// previous handler.
+class UrdfParseLog : public console_bridge::OutputHandler {
+ public:
+  UrdfParseLog()
+      : lock_(mutex()),
+        previous_(console_bridge::getOutputHandler()),
+        previous_level_(console_bridge::getLogLevel()) {
+    console_bridge::useOutputHandler(this);
+    // Errors must reach us even if the application silenced console_bridge.
+    if (previous_level_ > console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+      console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_ERROR);
+    }
+  }
+  ~UrdfParseLog() override {
+    console_bridge::setLogLevel(previous_level_);
+    console_bridge::restorePreviousOutputHandler();
+  }
+  UrdfParseLog(const UrdfParseLog&) = delete;
+  UrdfParseLog& operator=(const UrdfParseLog&) = delete;
+
+  void log(const std::string& text, console_bridge::LogLevel level, const char* filename,
+           int line) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+      errors_.push_back(text);
+    } else if (previous_) {
+      previous_->log(text, level, filename, line);
+    }
+  }
+  void forward(const std::string& text) const {
+    if (previous_ && previous_level_ <= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+      previous_->log(text, console_bridge::CONSOLE_BRIDGE_LOG_ERROR, __FILE__, __LINE__);
+    }
+  }
+  const std::vector<std::string>& errors() const { return errors_; }
+
+ private:
+  // One capture at a time: console_bridge keeps a single previous handler.
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  console_bridge::OutputHandler* previous_;
+  console_bridge::LogLevel previous_level_;
+  std::vector<std::string> errors_;
+};
+
+}  // namespace
+
+urdf::ModelInterfaceSharedPtr parseUrdf(const std::string& xml, const std::string& source,
+                                        DroppedElements* dropped) {
+  urdf::ModelInterfaceSharedPtr model;
+  std::vector<std::string> errors;
+  UrdfParseLog log;
+  try {
+    model = urdf::parseURDF(xml);
+  } catch (const std::exception& e) {
+    model.reset();
+    errors.push_back(e.what());
+  }
+  // urdfdom logs the reasons first, then "Could not parse visual element for Link [name]".
+  static const std::regex kDropped(
+      "Could not parse (visual|collision) element for Link \\[(.*)\\]");
+  std::vector<std::string> reasons;
+  for (const std::string& text : log.errors()) {
+    std::smatch match;
+    if (model && std::regex_search(text, match, kDropped)) {
+      std::string why;
+      for (const std::string& reason : reasons) why += (why.empty() ? "" : "; ") + reason;
+      (*dropped)[{match[2].str(), match[1].str()}].push_back(why.empty() ? text : why);
+      reasons.clear();
+    } else {
+      reasons.push_back(text);
+    }
+  }
+  if (!model) {
+    errors.insert(errors.begin(), reasons.begin(), reasons.end());
+    std::string msg = source + ": malformed URDF (urdfdom cannot parse it)";
+    for (const std::string& e : errors) msg += "; " + e;
+    throw SceneLoadError(msg);
+  }
+  for (const std::string& text : reasons) log.forward(text);  // not ours to judge
+  return model;
+}
+
+}  // namespace laser_raycast
