@@ -11,7 +11,6 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
-#include <optional>
 #include <sstream>
 
 namespace laser_raycast {
@@ -97,22 +96,7 @@ std::string resolveUri(const std::string& uri, const std::string& base_dir,
   if (uri.empty()) throw SceneLoadError("the mesh filename is empty");
   const std::string scheme = uriScheme(uri);
   const std::string rest = scheme.empty() ? uri : uri.substr(scheme.size() + 3);
-  if (scheme == "package") {
-    const std::size_t slash = rest.find('/');
-    if (slash == 0 || slash == std::string::npos || slash + 1 == rest.size()) {
-      throw SceneLoadError("a package:// URI needs a package name and a path");
-    }
-    const std::string package = rest.substr(0, slash);
-    if (!resolver) throw SceneLoadError("no package resolver to find package " + inQuotes(package));
-    std::optional<std::string> dir;
-    try {
-      dir = resolver(package);
-    } catch (const std::exception& e) {
-      throw SceneLoadError("resolving package " + inQuotes(package) + " failed: " + e.what());
-    }
-    if (!dir || dir->empty()) throw SceneLoadError("unknown package " + inQuotes(package));
-    return (fs::path(*dir) / rest.substr(slash + 1)).string();
-  }
+  if (scheme == "package") return resolvePackageUri(uri, resolver);
   if (scheme == "file") {
     // file:///abs/path; a host part (file://host/...) is not a local file.
     if (rest.empty() || rest[0] != '/') {

@@ -347,18 +347,28 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
   }
 }
 
-LoadedModel SceneLoader::addUrdfFile(const std::string& path, const LoaderOptions& options,
+LoadedModel SceneLoader::addUrdfFile(const std::string& uri, const LoaderOptions& options,
                                      core::Scene* scene) {
+  // A package:// URI is named with the file it resolved to, as a mesh is.
+  std::string path = uri, source = uri;
+  if (isPackageUri(uri)) {
+    try {
+      path = resolvePackageUri(uri, resolver_);
+    } catch (const SceneLoadError& e) {
+      throw SceneLoadError(uri + ": " + e.what());
+    }
+    source = uri + " (" + path + ")";
+  }
   std::error_code ec;
-  if (fs::is_directory(path, ec)) throw SceneLoadError(path + ": a directory, not a URDF file");
+  if (fs::is_directory(path, ec)) throw SceneLoadError(source + ": a directory, not a URDF file");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneLoadError(path + ": cannot open the URDF file for reading");
+  if (!in) throw SceneLoadError(source + ": cannot open the URDF file for reading");
   std::ostringstream xml;
   xml << in.rdbuf();
-  if (!in && !in.eof()) throw SceneLoadError(path + ": error reading the URDF file");
+  if (!in && !in.eof()) throw SceneLoadError(source + ": error reading the URDF file");
   std::string dir = fs::path(path).parent_path().string();
   if (dir.empty()) dir = ".";  // a bare file name: relative meshes are next to it
-  return addUrdf(xml.str(), dir, path, options, scene);
+  return addUrdf(xml.str(), dir, source, options, scene);
 }
 
 LoadedModel SceneLoader::addUrdfString(const std::string& urdf_xml, const std::string& base_dir,

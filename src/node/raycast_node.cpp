@@ -2,7 +2,6 @@
 
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
-#include <ros/package.h>
 #include <sensor_msgs/LaserScan.h>
 #include <tf2_eigen/tf2_eigen.h>
 
@@ -13,27 +12,11 @@
 
 #include "laser_raycast/ScanLabels.h"
 #include "laser_raycast/core/pose.h"
+#include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 
 namespace laser_raycast {
 namespace {
-
-std::optional<std::string> rosPackagePath(const std::string& package) {
-  const std::string path = ros::package::getPath(package);
-  if (path.empty()) return std::nullopt;
-  return path;
-}
-
-// A URDF file given as a path or a package:// URI.
-std::string resolveModelFile(const std::string& file) {
-  const std::string scheme = "package://";
-  if (file.compare(0, scheme.size(), scheme) != 0) return file;
-  const std::string rest = file.substr(scheme.size());
-  const std::string package = rest.substr(0, rest.find('/'));
-  const auto dir = rosPackagePath(package);
-  if (!dir) return file;  // the loader reports the unreadable file
-  return *dir + rest.substr(package.size());
-}
 
 // A message's quaternion may be this far from unit length (relative) and is normalised; farther off
 // is a bad message, not rounding: poses written with 3 or 4 decimals are within 0.1%.
@@ -120,7 +103,7 @@ bool RaycastNode::loadScene() {
         loaded = loader.addUrdfString(xml, "", options, &scene_,
                                       "parameter " + nh_.resolveName(model.param));
       } else {
-        loaded = loader.addUrdfFile(resolveModelFile(model.file), options, &scene_);
+        loaded = loader.addUrdfFile(model.file, options, &scene_);
       }
     } catch (const SceneLoadError& e) {
       // The message starts with the URDF's source (file or parameter).

@@ -1,7 +1,5 @@
 #include "bench_scenes.h"
 
-#include <ros/package.h>
-
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -11,6 +9,7 @@
 
 #include "bench_scene_builder.h"
 #include "laser_raycast/loader/kinematics.h"
+#include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 
 namespace laser_raycast {
@@ -45,12 +44,6 @@ MeshData flattenToSoup(const BenchScene& s) {
     soup.append(local);
   }
   return soup;
-}
-
-std::optional<std::string> rosPackagePath(const std::string& package) {
-  const std::string path = ros::package::getPath(package);
-  if (path.empty()) return std::nullopt;
-  return path;
 }
 
 bool hasTb3Data(const std::string& dir) {

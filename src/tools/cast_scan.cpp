@@ -1,7 +1,5 @@
 // cast_scan: one simulated scan of URDF models from a sensor pose, printed as CSV. Needs no
 // roscore: package:// URIs are resolved through ROS_PACKAGE_PATH. See usage() and the README.
-#include <ros/package.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,6 +15,7 @@
 #include "laser_raycast/core/scan_encoder.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/kinematics.h"
+#include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 
 namespace {
@@ -196,12 +195,6 @@ std::string formatNumber(double value) {
   return buffer;
 }
 
-std::optional<std::string> packagePath(const std::string& package) {
-  const std::string path = ros::package::getPath(package);
-  if (path.empty()) return std::nullopt;
-  return path;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -222,7 +215,7 @@ int main(int argc, char** argv) {
 
   // Load every model; with several, give each a private prefix so that equal link names stay apart
   // (the prefix is not printed).
-  laser_raycast::SceneLoader loader(packagePath);
+  laser_raycast::SceneLoader loader(laser_raycast::rosPackagePath);
   core::Scene scene;
   std::vector<laser_raycast::LoadedModel> loaded;
   const bool prefixed = args.models.size() > 1;

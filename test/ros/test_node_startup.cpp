@@ -90,6 +90,17 @@ TEST(NodeStartup, MissingMeshNamesTheFileAndLink) {
                 {"does_not_exist.stl", "broken_link", "skip_bad_geometry"});
 }
 
+TEST(NodeStartup, UrdfFileAsPackageUri) {
+  // Found through ROS_PACKAGE_PATH: the loader reads the file and then names its missing mesh.
+  ros::NodeHandle().setParam("/l/node/models",
+                             modelFile("package://laser_raycast/test/data/bad_mesh.urdf"));
+  expectRefused("__ns:=/l __name:=node",
+                {"package://laser_raycast/test/data/bad_mesh.urdf", "does_not_exist.stl"});
+  ros::NodeHandle().setParam("/m/node/models",
+                             modelFile("package://laser_raycast_no_such_package/model.urdf"));
+  expectRefused("__ns:=/m __name:=node", {"unknown package 'laser_raycast_no_such_package'"});
+}
+
 // Also: a misspelt parameter gets a warning and is otherwise ignored.
 TEST(NodeStartup, SkipBadGeometryStartsWithAWarning) {
   ros::NodeHandle().setParam("/j/node/models", modelFile(data("bad_mesh.urdf")));

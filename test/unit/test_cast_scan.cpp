@@ -243,6 +243,17 @@ TEST(CastScan, PackageUrisResolveThroughRosPackagePath) {
   EXPECT_EQ(rows[3].link, "mover");
 }
 
+TEST(CastScan, UrdfAsPackageUri) {
+  // The same model through ROS_PACKAGE_PATH (it holds this package when the tests run) gives the
+  // same scan as through its path.
+  const std::string rest = " --sensor 0,0,0,0,0,0" + kFour;
+  const CliRun by_uri =
+      runCli("--urdf package://laser_raycast/test/data/cli_joints.urdf@0.5,0,0,0,0,0" + rest);
+  ASSERT_EQ(by_uri.status, 0) << by_uri.err;
+  EXPECT_NEAR(value(parse(by_uri.out)[1]), 2.4, 1e-8);
+  EXPECT_EQ(by_uri.out, runCli("--urdf " + kData + "cli_joints.urdf@0.5,0,0,0,0,0" + rest).out);
+}
+
 TEST(CastScan, RepeatReportsTheMedianCastTime) {
   const CliRun run = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0 --repeat 5");
   ASSERT_EQ(run.status, 0) << run.err;
@@ -299,6 +310,8 @@ TEST(CastScan, BadSceneExitsThree) {
   expectBadScene("/nonexistent/robot.urdf", "/nonexistent/robot.urdf");
   expectBadScene(kData + "malformed.urdf", "malformed.urdf");
   expectBadScene(kData + "bad_mesh.urdf", "does_not_exist.stl");
+  expectBadScene("package://laser_raycast_no_such_package/robot.urdf",
+                 "unknown package 'laser_raycast_no_such_package'");
 }
 
 }  // namespace

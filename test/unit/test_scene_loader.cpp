@@ -15,10 +15,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
 
+#include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 #include "shared_data.h"
 
@@ -236,6 +238,57 @@ TEST_F(SceneLoaderTest, RelativePathIsRelativeToTheUrdfFile) {
   EXPECT_EQ(model.name, "relative_mesh");
   ASSERT_EQ(model.bodies, 1u);
   EXPECT_EQ(meshOf(scene_, 0)->triangles().size(), 12u);
+}
+
+TEST_F(SceneLoaderTest, UrdfFileAsPackageUriGoesThroughTheResolver) {
+  // Its mesh path is relative: relative to the file the URI resolved to.
+  const LoadedModel model =
+      loader_.addUrdfFile("package://test_pkg/urdf/relative_mesh.urdf", {}, &scene_);
+  EXPECT_EQ(resolved_, std::vector<std::string>{"test_pkg"});
+  EXPECT_EQ(model.name, "relative_mesh");
+  ASSERT_EQ(model.bodies, 1u);
+  expectBounds(*meshOf(scene_, 0), Vector3d::Zero(), kCuboidHi, 0.0);
+}
+
+TEST_F(SceneLoaderTest, UrdfFileAsPackageUriIsNamedWithItsFile) {
+  const std::string uri = "package://test_pkg/malformed.urdf";
+  try {
+    loader_.addUrdfFile(uri, {}, &scene_);
+    FAIL() << "no exception";
+  } catch (const SceneLoadError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(uri + " (" + kSourceDir + "/test/data/malformed.urdf): malformed URDF", 0),
+              0u)
+        << msg;
+  }
+  // An unknown package, and a URI without a path, are errors that name the URI.
+  for (const auto& [bad, problem] :
+       {std::pair<std::string, std::string>{"package://no_pkg/robot.urdf",
+                                            "unknown package 'no_pkg'"},
+        {"package://test_pkg", "a package:// URI needs a package name and a path"}}) {
+    try {
+      loader_.addUrdfFile(bad, {}, &scene_);
+      ADD_FAILURE() << bad << ": no exception";
+    } catch (const SceneLoadError& e) {
+      EXPECT_EQ(std::string(e.what()), bad + ": " + problem);
+    }
+  }
+  EXPECT_TRUE(scene_.bodies().empty());
+}
+
+TEST(RosPackagePath, FindsThisPackageOnRosPackagePath) {
+  // catkin runs the tests with the workspace's ROS_PACKAGE_PATH, which holds this package.
+  const std::optional<std::string> dir = rosPackagePath("laser_raycast");
+  ASSERT_TRUE(dir) << "laser_raycast is not on ROS_PACKAGE_PATH="
+                   << (std::getenv("ROS_PACKAGE_PATH") ? std::getenv("ROS_PACKAGE_PATH") : "");
+  EXPECT_TRUE(fs::equivalent(*dir, kSourceDir)) << *dir;
+  EXPECT_FALSE(rosPackagePath("laser_raycast_no_such_package"));
+
+  SceneLoader loader(rosPackagePath);
+  core::Scene scene;
+  const LoadedModel model =
+      loader.addUrdfFile("package://laser_raycast/test/data/urdf/relative_mesh.urdf", {}, &scene);
+  EXPECT_EQ(model.bodies, 1u);
 }
 
 TEST_F(SceneLoaderTest, RelativePathInAStringWithoutBaseDirIsAnError) {

@@ -1,5 +1,6 @@
 // Turns URDF models and their meshes into a core::Scene (urdfdom + assimp; no roscpp). package://
-// URIs are resolved through a callback, so tests and tools pass plain paths or their own lookup.
+// URIs are resolved through a callback: rosPackagePath (package_resolver.h) for ROS_PACKAGE_PATH,
+// or a test's own look-up.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -66,6 +67,7 @@ struct LoadedModel {
 
 class SceneLoader {
  public:
+  // resolver finds the packages of package:// URIs, of URDF files and meshes alike.
   explicit SceneLoader(PackageResolver resolver);
 
   // Adds the model's geometry to scene: frames named after the (merged) links, labels after the
@@ -75,9 +77,9 @@ class SceneLoader {
   LoadedModel addUrdfString(const std::string& urdf_xml, const std::string& base_dir,
                             const LoaderOptions& options, core::Scene* scene,
                             const std::string& source = "<URDF string>");
-  // The same for a file; relative mesh paths are relative to the file's directory.
-  LoadedModel addUrdfFile(const std::string& path, const LoaderOptions& options,
-                          core::Scene* scene);
+  // The same for a file, given as a path or a package:// URI (found through the resolver);
+  // relative mesh paths are relative to the file's directory.
+  LoadedModel addUrdfFile(const std::string& uri, const LoaderOptions& options, core::Scene* scene);
 
   // The mesh at uri (package://, file://, absolute, or relative to base_dir), with the URDF scale
   // and the Collada <unit> applied. Each (file, scale) is read and its BVH built once; later calls
