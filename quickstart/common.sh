@@ -11,7 +11,7 @@ JOBS=${LASER_RAYCAST_JOBS:-$(nproc)}
 # Everything the package needs to build, test, run the demo and benchmark, from Debian 12's archive.
 APT_PACKAGES=(
   build-essential cmake catkin python3-catkin-pkg
-  libeigen3-dev libassimp-dev liburdfdom-dev liburdfdom-headers-dev
+  libeigen3-dev libassimp-dev liburdfdom-dev liburdfdom-headers-dev liborocos-kdl-dev
   libroscpp-dev libroslib-dev libtf2-ros-dev libtf2-eigen-dev libtf2-geometry-msgs-dev
   libsensor-msgs-dev libgeometry-msgs-dev libstd-msgs-dev ros-std-msgs
   ros-message-generation ros-message-runtime libnodeletlib-dev libnodeletlib-tools libtopic-tools-dev
