@@ -1,7 +1,7 @@
 // bench: speed and accuracy of every triangle method (double and float, brute force and BVH), the
 // pipeline (Caster::cast as the node runs it) and the peers (Embree, Bullet) on identical rays,
 // every distance measured against a long double reference and compared with Embree's robust mode.
-// See kUsage and the README's "Benchmark" section.
+// See kSynopsis, flags() and the README's "Benchmark" section.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,18 +20,22 @@
 #include "bench_report.h"
 #include "bench_run.h"
 #include "bench_scenes.h"
+#include "command_line.h"
 
 namespace {
 
 namespace bench = laser_raycast::bench;
 namespace core = laser_raycast::core;
+namespace po = boost::program_options;
+using laser_raycast::tools::ArgError;
 
 constexpr int kExitRunFailed = 1;
 constexpr int kExitBadArguments = 2;
 
-const char* const kUsage =
+const char* const kSynopsis =
     "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--method NAME ...] [--list-methods]\n"
-    "             [--list-scenes]\n"
+    "             [--list-scenes]\n";
+const char* const kNotes =
     "Times every method on the workloads fan2d and rings3d and measures each beam's error\n"
     "against a long double reference and its agreement with Embree's robust mode. Writes\n"
     "DIR/results.csv, results.md, pareto.png (one point per method) and pareto_matrix.png\n"
@@ -42,17 +46,12 @@ const char* const kUsage =
     "and repetitions (under 2 minutes).\n"
     "Exit status: 0 ok, 1 the run failed, 2 bad arguments.\n";
 
-class ArgError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
 struct Options {
   bool quick = false;
   std::string out_dir = "bench_results";
   std::vector<std::string> scenes;   // empty: all
   std::vector<std::string> methods;  // empty: all
-  bool list_methods = false, list_scenes = false, help = false;
+  bool list_methods = false, list_scenes = false;
 };
 
 // The full run times more and longer batches on more rays; --quick is a smoke test.
@@ -73,63 +72,60 @@ std::string joined(const std::vector<std::string>& names) {
   return out;
 }
 
-// The names after a list flag (--flag A B ..., or --flag=A; repeatable) into *out, each checked
-// against known.
-void takeNames(const std::vector<std::string>& words, std::size_t* i, const std::string& flag,
-               const std::optional<std::string>& inline_value,
-               const std::vector<std::string>& known, std::vector<std::string>* out) {
-  std::vector<std::string> names;
-  if (inline_value) names.push_back(*inline_value);
-  while (!inline_value && *i + 1 < words.size() && words[*i + 1].compare(0, 2, "--") != 0) {
-    names.push_back(words[++*i]);
-  }
-  const std::string what = flag.substr(2);
-  if (names.empty()) throw ArgError(flag + " needs a " + what + " name");
+// The names given to a list flag, each checked against known and kept once, in the order given.
+std::vector<std::string> knownNames(const std::string& what, const std::vector<std::string>& names,
+                                    const std::vector<std::string>& known) {
+  std::vector<std::string> out;
   for (const std::string& name : names) {
     if (std::find(known.begin(), known.end(), name) == known.end()) {
       throw ArgError("unknown " + what + " '" + name + "' (" + what + "s: " + joined(known) + ")");
     }
-    if (std::find(out->begin(), out->end(), name) == out->end()) out->push_back(name);
+    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
   }
+  return out;
 }
 
-Options parseArgs(int argc, char** argv) {
+// A list flag: --flag A B ..., or --flag A --flag B; the names must be among known.
+po::typed_value<std::vector<std::string>>* nameList(const std::string& what,
+                                                    std::vector<std::string> known,
+                                                    std::vector<std::string>* out) {
+  return po::value<std::vector<std::string>>()
+      ->multitoken()
+      ->composing()
+      ->value_name("NAME ...")
+      ->notifier([what, known, out](const std::vector<std::string>& names) {
+        *out = knownNames(what, names, known);
+      });
+}
+
+// The flags, in the order the help lists them; the notifiers store the values into *options.
+po::options_description flags(Options* options) {
+  po::options_description flags("Options");
+  auto add = flags.add_options();
+  add("quick", po::bool_switch(&options->quick), "fewer poses and repetitions");
+  add("out",
+      po::value<std::string>()->value_name("DIR")->notifier([options](const std::string& dir) {
+        if (dir.empty()) throw ArgError("--out needs a directory");
+        options->out_dir = dir;
+      }),
+      "where the results go (default bench_results)");
+  add("scene", nameList("scene", bench::sceneNames(), &options->scenes),
+      "the scenes to run (default all)");
+  add("method", nameList("method", allMethodNames(), &options->methods),
+      "the rows to run (default all)");
+  add("list-methods", po::bool_switch(&options->list_methods),
+      "print the methods this build has and exit");
+  add("list-scenes", po::bool_switch(&options->list_scenes), "print the scenes and exit");
+  add("help,h", "print this help");
+  return flags;
+}
+
+// Throws ArgError.
+Options parseArgs(int argc, char** argv, bool* help) {
   Options options;
-  const std::vector<std::string> words(argv + 1, argv + argc);
-  const auto& known = bench::sceneNames();
-  for (std::size_t i = 0; i < words.size(); ++i) {
-    std::string flag = words[i], value;
-    const bool inline_value = flag.compare(0, 2, "--") == 0 && flag.find('=') != std::string::npos;
-    if (inline_value) {
-      value = flag.substr(flag.find('=') + 1);
-      flag = flag.substr(0, flag.find('='));
-    }
-    if (flag == "--quick" && !inline_value) {
-      options.quick = true;
-    } else if (flag == "--out") {
-      if (!inline_value) {
-        if (i + 1 >= words.size()) throw ArgError("--out needs a directory");
-        value = words[++i];
-      }
-      if (value.empty()) throw ArgError("--out needs a directory");
-      options.out_dir = value;
-    } else if (flag == "--scene") {
-      takeNames(words, &i, flag, inline_value ? std::optional(value) : std::nullopt, known,
-                &options.scenes);
-    } else if (flag == "--method") {
-      takeNames(words, &i, flag, inline_value ? std::optional(value) : std::nullopt,
-                allMethodNames(), &options.methods);
-    } else if (flag == "--list-methods" && !inline_value) {
-      options.list_methods = true;
-    } else if (flag == "--list-scenes" && !inline_value) {
-      options.list_scenes = true;
-    } else if ((flag == "-h" || flag == "--help") && !inline_value) {
-      options.help = true;
-    } else {
-      throw ArgError("unknown argument '" + words[i] + "'");
-    }
-  }
-  if (options.scenes.empty()) options.scenes = known;
+  po::variables_map values;
+  *help = !laser_raycast::tools::parseCommandLine(argc, argv, flags(&options), &values);
+  if (options.scenes.empty()) options.scenes = bench::sceneNames();
   return options;
 }
 
@@ -294,14 +290,16 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   Options options;
+  bool help = false;
   try {
-    options = parseArgs(argc, argv);
+    options = parseArgs(argc, argv, &help);
   } catch (const ArgError& e) {
-    std::cerr << "bench: " << e.what() << "\n" << kUsage;
+    std::cerr << "bench: " << e.what() << "\n" << kSynopsis << kNotes;
     return kExitBadArguments;
   }
-  if (options.help) {
-    std::cout << kUsage;
+  if (help) {
+    Options unused;
+    std::cout << kSynopsis << "\n" << flags(&unused) << "\n" << kNotes;
     return 0;
   }
   if (options.list_methods || options.list_scenes) {

@@ -1,16 +1,19 @@
 // cast_scan: one simulated scan of URDF models from a sensor pose, printed as CSV. Needs no
-// roscore: package:// URIs are resolved through ROS_PACKAGE_PATH. See usage() and the README.
+// roscore: package:// URIs are resolved through ROS_PACKAGE_PATH. See kSynopsis, flags() and the
+// README.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/scan_encoder.h"
 #include "laser_raycast/core/scan_spec.h"
@@ -21,27 +24,25 @@
 namespace {
 
 using laser_raycast::GeometrySource;
+using laser_raycast::tools::ArgError;
 namespace core = laser_raycast::core;
+namespace po = boost::program_options;
 
 constexpr int kExitBadArguments = 2;
 constexpr int kExitBadScene = 3;
 
-const char* const kUsage =
+const char* const kSynopsis =
     "usage: cast_scan --urdf PATH[@x,y,z,roll,pitch,yaw] [--urdf ...] --sensor "
     "x,y,z,roll,pitch,yaw\n"
     "                 [--angle-min RAD] [--angle-max RAD] [--samples N | --angle-increment RAD]\n"
     "                 [--range-min M] [--range-max M] [--geometry visual|collision]\n"
     "                 [--method seed_plane|seed_uv|cramer|moller_trumbore|watertight]\n"
-    "                 [--joint NAME=VALUE ...] [--repeat N]\n"
+    "                 [--joint NAME=VALUE ...] [--repeat N]\n";
+const char* const kNotes =
     "Prints CSV 'index,angle,range,link' (REP 117: inf, -inf, nan). Defaults: angles -pi..pi, 360 "
     "samples,\n"
     "ranges 0..30 m, geometry visual, method watertight. Poses in metres and radians (URDF rpy).\n"
     "Exit status: 0 ok, 2 bad arguments, 3 bad scene input.\n";
-
-class ArgError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct Model {
   std::string path;
@@ -50,7 +51,6 @@ struct Model {
 
 struct Args {
   std::vector<Model> models;
-  bool has_sensor = false;
   Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
   core::ScanSpec scan;  // the fan, ranges and method; REP 117 with the default -inf policy
   GeometrySource geometry = GeometrySource::kVisual;
@@ -93,87 +93,119 @@ bool parsePose(const std::string& text, Eigen::Isometry3d* pose) {
   return true;
 }
 
-Args parseArgs(int argc, char** argv) {
-  Args args;
-  bool has_samples = false, has_increment = false;
-  std::vector<std::string> words(argv + 1, argv + argc);
-  for (std::size_t i = 0; i < words.size(); ++i) {
-    std::string flag = words[i];
-    std::string value;
-    bool inline_value = false;
-    if (flag.compare(0, 2, "--") == 0 && flag.find('=') != std::string::npos) {
-      value = flag.substr(flag.find('=') + 1);
-      flag = flag.substr(0, flag.find('='));
-      inline_value = true;
-    }
-    auto next = [&]() -> std::string {
-      if (inline_value) return value;
-      if (i + 1 >= words.size()) throw ArgError(flag + " needs a value");
-      return words[++i];
-    };
-    if (flag == "--urdf") {
-      const std::string spec = next();
-      Model model;
-      model.path = spec;
-      const std::size_t at = spec.rfind('@');
-      if (at != std::string::npos && parsePose(spec.substr(at + 1), &model.pose)) {
-        model.path = spec.substr(0, at);
-      }
-      if (model.path.empty()) throw ArgError("--urdf: empty path");
-      args.models.push_back(model);
-    } else if (flag == "--sensor") {
-      const std::string spec = next();
-      if (!parsePose(spec, &args.sensor)) {
-        throw ArgError("--sensor: '" + spec + "' is not x,y,z,roll,pitch,yaw (6 finite numbers)");
-      }
-      args.has_sensor = true;
-    } else if (flag == "--angle-min") {
-      args.scan.fan.angle_min = parseNumber(flag, next());
-    } else if (flag == "--angle-max") {
-      args.scan.fan.angle_max = parseNumber(flag, next());
-    } else if (flag == "--samples") {
-      args.scan.fan.samples = parseCount(flag, next());
-      has_samples = true;
-    } else if (flag == "--angle-increment") {
-      args.scan.fan.angle_increment = parseNumber(flag, next());
-      has_increment = true;
-    } else if (flag == "--range-min") {
-      args.scan.output.range_min = parseNumber(flag, next());
-    } else if (flag == "--range-max") {
-      args.scan.output.range_max = parseNumber(flag, next());
-    } else if (flag == "--geometry") {
-      const std::string name = next();
-      if (!laser_raycast::parseGeometrySource(name, &args.geometry)) {
-        throw ArgError("--geometry: " + laser_raycast::kGeometrySourceNames.notOneOf(name));
-      }
-    } else if (flag == "--method") {
-      const std::string name = next();
-      if (!core::parseTriangleMethod(name, &args.scan.method)) {
-        throw ArgError("--method: " + core::kTriangleMethodNames.notOneOf(name));
-      }
-    } else if (flag == "--joint") {
-      // One NAME=VALUE per --joint, or several after one --joint.
-      std::vector<std::string> specs{next()};
-      while (!inline_value && i + 1 < words.size() && words[i + 1].compare(0, 2, "--") != 0 &&
-             words[i + 1].find('=') != std::string::npos) {
-        specs.push_back(words[++i]);
-      }
-      for (const std::string& spec : specs) {
-        const std::size_t eq = spec.find('=');
-        if (eq == std::string::npos || eq == 0) {
-          throw ArgError("--joint: '" + spec + "' is not NAME=VALUE");
-        }
-        args.joints[spec.substr(0, eq)] =
-            parseNumber("--joint " + spec.substr(0, eq), spec.substr(eq + 1));
-      }
-    } else if (flag == "--repeat") {
-      args.repeat = parseCount(flag, next());
-    } else {
-      throw ArgError("unknown argument '" + words[i] + "'");
-    }
+// "PATH" or "PATH@x,y,z,roll,pitch,yaw"
+Model parseModel(const std::string& spec) {
+  Model model;
+  model.path = spec;
+  const std::size_t at = spec.rfind('@');
+  if (at != std::string::npos && parsePose(spec.substr(at + 1), &model.pose)) {
+    model.path = spec.substr(0, at);
   }
+  if (model.path.empty()) throw ArgError("--urdf: empty path");
+  return model;
+}
+
+void parseSensor(const std::string& spec, Eigen::Isometry3d* pose) {
+  if (!parsePose(spec, pose)) {
+    throw ArgError("--sensor: '" + spec + "' is not x,y,z,roll,pitch,yaw (6 finite numbers)");
+  }
+}
+
+// "NAME=VALUE"
+void parseJoint(const std::string& spec, std::map<std::string, double>* joints) {
+  const std::size_t eq = spec.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw ArgError("--joint: '" + spec + "' is not NAME=VALUE");
+  (*joints)[spec.substr(0, eq)] = parseNumber("--joint " + spec.substr(0, eq), spec.substr(eq + 1));
+}
+
+GeometrySource parseGeometry(const std::string& name) {
+  GeometrySource geometry;
+  if (!laser_raycast::parseGeometrySource(name, &geometry)) {
+    throw ArgError("--geometry: " + laser_raycast::kGeometrySourceNames.notOneOf(name));
+  }
+  return geometry;
+}
+
+core::TriangleMethod parseMethod(const std::string& name) {
+  core::TriangleMethod method;
+  if (!core::parseTriangleMethod(name, &method)) {
+    throw ArgError("--method: " + core::kTriangleMethodNames.notOneOf(name));
+  }
+  return method;
+}
+
+// A flag with one value, which store converts and keeps.
+po::typed_value<std::string>* single(const char* value_name,
+                                     std::function<void(const std::string&)> store) {
+  return po::value<std::string>()->value_name(value_name)->notifier(std::move(store));
+}
+
+// A flag that may be given several times, each value kept by store.
+po::typed_value<std::vector<std::string>>* repeated(const char* value_name,
+                                                    std::function<void(const std::string&)> store) {
+  return po::value<std::vector<std::string>>()
+      ->composing()
+      ->value_name(value_name)
+      ->notifier([store](const std::vector<std::string>& values) {
+        for (const std::string& value : values) store(value);
+      });
+}
+
+// The flags, in the order the help lists them. Values are read as text and converted by the
+// notifiers into *args: the messages then say what is wrong with a value (program_options' own
+// say only that it is invalid), and a number must be finite.
+po::options_description flags(Args* args) {
+  const auto number = [](const char* flag, const char* unit, double* out) {
+    return single(unit, [flag, out](const std::string& v) { *out = parseNumber(flag, v); });
+  };
+  const auto count = [](const char* flag, int* out) {
+    return single("N", [flag, out](const std::string& v) { *out = parseCount(flag, v); });
+  };
+  po::options_description options("Options");
+  auto add = options.add_options();
+  add("urdf",
+      repeated("PATH[@POSE]",
+               [args](const std::string& v) { args->models.push_back(parseModel(v)); }),
+      "a URDF file or package:// URI, placed at POSE x,y,z,roll,pitch,yaw (default: the "
+      "identity); repeat for several models");
+  add("sensor", single("POSE", [args](const std::string& v) { parseSensor(v, &args->sensor); }),
+      "the sensor pose x,y,z,roll,pitch,yaw (required)");
+  add("angle-min", number("--angle-min", "RAD", &args->scan.fan.angle_min), "the first beam");
+  add("angle-max", number("--angle-max", "RAD", &args->scan.fan.angle_max), "the last beam");
+  add("samples", count("--samples", &args->scan.fan.samples),
+      "beams from --angle-min to --angle-max");
+  add("angle-increment", number("--angle-increment", "RAD", &args->scan.fan.angle_increment),
+      "the beam spacing, instead of --samples");
+  add("range-min", number("--range-min", "M", &args->scan.output.range_min),
+      "the shortest valid range");
+  add("range-max", number("--range-max", "M", &args->scan.output.range_max),
+      "the longest valid range");
+  add("geometry",
+      single("NAME", [args](const std::string& v) { args->geometry = parseGeometry(v); }),
+      "visual or collision");
+  add("method",
+      single("NAME", [args](const std::string& v) { args->scan.method = parseMethod(v); }),
+      "the triangle test");
+  add("joint",
+      repeated("NAME=VALUE ...", [args](const std::string& v) { parseJoint(v, &args->joints); })
+          ->multitoken(),
+      "joint values (rad or m; 0 if not given): several after one --joint, or one each");
+  add("repeat", count("--repeat", &args->repeat),
+      "cast N more times after loading and print the median cast time to stderr");
+  add("help,h", "print this help");
+  return options;
+}
+
+// Throws ArgError.
+Args parseArgs(int argc, char** argv, bool* help) {
+  Args args;
+  po::variables_map values;
+  *help = !laser_raycast::tools::parseCommandLine(argc, argv, flags(&args), &values);
+  if (*help) return args;
+  const bool has_samples = values.count("samples"), has_increment = values.count("angle-increment");
   if (args.models.empty()) throw ArgError("give at least one --urdf");
-  if (!args.has_sensor) throw ArgError("--sensor is required");
+  if (!values.count("sensor")) throw ArgError("--sensor is required");
   if (has_samples && has_increment) throw ArgError("give --samples or --angle-increment, not both");
   if (!has_samples && !has_increment) args.scan.fan.samples = 360;
   if (!(args.scan.output.range_min >= 0)) throw ArgError("--range-min must be >= 0");
@@ -198,19 +230,18 @@ std::string formatNumber(double value) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
-      std::cout << kUsage;
-      return 0;
-    }
-  }
   Args args;
+  bool help = false;
   try {
-    args = parseArgs(argc, argv);
+    args = parseArgs(argc, argv, &help);
   } catch (const ArgError& e) {
-    std::cerr << "cast_scan: " << e.what() << "\n" << kUsage;
+    std::cerr << "cast_scan: " << e.what() << "\n" << kSynopsis << kNotes;
     return kExitBadArguments;
+  }
+  if (help) {
+    Args unused;
+    std::cout << kSynopsis << "\n" << flags(&unused) << "\n" << kNotes;
+    return 0;
   }
 
   // Load every model; with several, give each a private prefix so that equal link names stay apart

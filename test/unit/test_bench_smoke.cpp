@@ -93,6 +93,16 @@ TEST(BenchSmoke, ListsTheScenes) {
                                       "forest", "warehouse"}));
 }
 
+TEST(BenchSmoke, HelpListsEveryFlag) {
+  const auto result = runCommand(kBench + " --help");
+  ASSERT_EQ(result.status, 0);
+  for (const char* flag : {"--quick", "--out", "--scene", "--method", "--list-methods",
+                           "--list-scenes", "Exit status"}) {
+    EXPECT_NE(result.output.find(flag), std::string::npos) << flag << "\n" << result.output;
+  }
+  EXPECT_EQ(runCommand(kBench + " --qui 2>/dev/null").status, 2);
+}
+
 TEST(BenchSmoke, ListsTheCoreMethods) {
   const auto result = runCommand(kBench + " --list-methods");
   ASSERT_EQ(result.status, 0);

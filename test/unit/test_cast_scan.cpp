@@ -268,6 +268,26 @@ TEST(CastScan, HelpExitsZero) {
   EXPECT_NE(run.out.find("usage: cast_scan"), std::string::npos);
 }
 
+TEST(CastScan, HelpListsEveryFlag) {
+  const CliRun run = runCli("-h");
+  ASSERT_EQ(run.status, 0);
+  for (const char* flag : {"--urdf", "--sensor", "--angle-min", "--angle-max", "--samples",
+                           "--angle-increment", "--range-min", "--range-max", "--geometry",
+                           "--method", "--joint", "--repeat", "Exit status"}) {
+    EXPECT_NE(run.out.find(flag), std::string::npos) << flag << "\n" << run.out;
+  }
+}
+
+TEST(CastScan, ValuesAfterAnEqualsSign) {
+  const CliRun spaced = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0" + kFour);
+  const CliRun joined = runCli("--urdf=" + kData +
+                               "cli_joints.urdf --sensor=0,0,0,0,0,0 "
+                               "--angle-min=-1.5707963267948966 --angle-max=3.141592653589793 "
+                               "--samples=4");
+  ASSERT_EQ(joined.status, 0) << joined.err;
+  EXPECT_EQ(joined.out, spaced.out);
+}
+
 // Exit status 2 for bad arguments, with a message naming the problem and nothing on stdout.
 void expectBadArguments(const std::string& args, const std::string& mention) {
   const CliRun run = runCli(args);
@@ -296,6 +316,13 @@ TEST(CastScan, BadArgumentsExitTwo) {
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint plate_fix=1", "plate_fix");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint swing", "NAME=VALUE");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --repeat", "--repeat");
+}
+
+TEST(CastScan, FlagsAreNotAbbreviatedAndStrayWordsAreErrors) {
+  const std::string model = "--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0 ";
+  expectBadArguments(model + "--sam 4", "'--sam'");
+  expectBadArguments(model + "stray", "'stray'");
+  expectBadArguments(model + "--samples 4 --samples 5", "--samples");
 }
 
 // Exit status 3 for bad scene input, naming the file.

@@ -1,0 +1,40 @@
+#include "command_line.h"
+
+#include <string>
+#include <vector>
+
+namespace laser_raycast {
+namespace tools {
+
+namespace po = boost::program_options;
+
+bool parseCommandLine(int argc, char** argv, const po::options_description& options,
+                      po::variables_map* values) {
+  // program_options would otherwise accept any unambiguous prefix of a flag.
+  const int style = po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
+  std::vector<std::string> unknown;
+  try {
+    // Unregistered flags and stray words are collected rather than rejected, so that --help works
+    // beside them and the message names the word as given.
+    const po::parsed_options parsed = po::command_line_parser(argc, argv)
+                                          .options(options)
+                                          .style(style)
+                                          .allow_unregistered()
+                                          .run();
+    unknown = po::collect_unrecognized(parsed.options, po::include_positional);
+    po::store(parsed, *values);
+  } catch (const po::error& e) {
+    throw ArgError(e.what());
+  }
+  if (values->count("help")) return false;
+  if (!unknown.empty()) throw ArgError("unknown argument '" + unknown.front() + "'");
+  try {
+    po::notify(*values);
+  } catch (const po::error& e) {
+    throw ArgError(e.what());
+  }
+  return true;
+}
+
+}  // namespace tools
+}  // namespace laser_raycast

@@ -1,0 +1,26 @@
+// The tools' command lines, through boost::program_options: one grammar and one error type for
+// cast_scan and bench.
+#pragma once
+
+#include <boost/program_options.hpp>
+#include <stdexcept>
+
+namespace laser_raycast {
+namespace tools {
+
+// A bad command line; the message names the flag and the problem.
+class ArgError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Reads argv against options: --name VALUE or --name=VALUE, a multi-value option takes the words
+// up to the next flag, a flag may not be abbreviated, and a word that is no flag's value is an
+// error. Returns false, without running the notifiers, if --help (or -h) is given; otherwise
+// stores the values in *values and runs the notifiers. Throws ArgError.
+bool parseCommandLine(int argc, char** argv,
+                      const boost::program_options::options_description& options,
+                      boost::program_options::variables_map* values);
+
+}  // namespace tools
+}  // namespace laser_raycast
