@@ -3,6 +3,7 @@
 // file's #include lines, and the core library's dynamic dependencies.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -56,8 +57,8 @@ bool startsWith(const std::string& s, const std::string& prefix) {
 // headers are the compiler's own.
 bool isStandardOrCompilerHeader(const std::string& name) {
   static const std::set<std::string> kIntrinsics = {"emmintrin.h", "immintrin.h", "xmmintrin.h",
-                                                     "pmmintrin.h", "smmintrin.h", "nmmintrin.h",
-                                                     "cpuid.h"};
+                                                    "pmmintrin.h", "smmintrin.h", "nmmintrin.h",
+                                                    "cpuid.h"};
   if (kIntrinsics.count(name)) return true;
   return name.find('/') == std::string::npos && name.find('.') == std::string::npos;
 }
@@ -91,8 +92,7 @@ TEST(Layers, TheLoaderIncludesNoRoscppTfMessagesOrNode) {
 }
 
 TEST(Layers, NothingOutsideTheNodeIncludesTheNode) {
-  const auto includes = includesUnder({kSource / "include/laser_raycast/core",
-                                       kSource / "src/core",
+  const auto includes = includesUnder({kSource / "include/laser_raycast/core", kSource / "src/core",
                                        kSource / "include/laser_raycast/loader",
                                        kSource / "src/loader", kSource / "src/tools"});
   for (const Include& inc : includes) {
@@ -101,20 +101,61 @@ TEST(Layers, NothingOutsideTheNodeIncludesTheNode) {
   }
 }
 
-TEST(Layers, TheCoreLibraryLinksNothingFromRosOrTheLoader) {
-  const CommandResult r =
-      runCommand("objdump -p '" + std::string(CORE_LIBRARY_PATH) + "' 2>&1 | grep NEEDED");
-  ASSERT_EQ(r.status, 0) << "objdump found no NEEDED entries in " << CORE_LIBRARY_PATH << ": "
-                         << r.output;
-  static const std::regex kForbidden("ros|urdf|assimp|console_bridge|tinyxml|boost|tf2");
+// The shared libraries a binary loads directly (its NEEDED entries).
+std::vector<std::string> neededLibraries(const std::string& binary) {
+  const CommandResult r = runCommand("objdump -p '" + binary + "' 2>&1 | grep NEEDED");
+  EXPECT_EQ(r.status, 0) << "objdump found no NEEDED entries in " << binary << ": " << r.output;
+  std::vector<std::string> needed;
   std::istringstream lines(r.output);
-  std::string line;
-  int needed = 0;
-  for (; std::getline(lines, line); ++needed) {
-    EXPECT_FALSE(std::regex_search(line, kForbidden))
-        << "the core library " << CORE_LIBRARY_PATH << " links " << line;
+  std::string word;
+  while (lines >> word) {
+    if (word == "NEEDED" && lines >> word) needed.push_back(word);
   }
-  EXPECT_GT(needed, 0);  // at least the C++ runtime: the grep did see the dynamic section
+  return needed;
+}
+
+TEST(Layers, TheCoreLibraryLinksNothingFromRosOrTheLoader) {
+  static const std::regex kForbidden("ros|urdf|assimp|console_bridge|tinyxml|boost|tf2");
+  const std::vector<std::string> needed = neededLibraries(CORE_LIBRARY_PATH);
+  for (const std::string& library : needed) {
+    EXPECT_FALSE(std::regex_search(library, kForbidden))
+        << "the core library " << CORE_LIBRARY_PATH << " links " << library;
+  }
+  EXPECT_FALSE(needed.empty());  // at least the C++ runtime: objdump did see the dynamic section
+}
+
+// The tools depend directly only on what they use: the core, the loader, the kinematics and their
+// own libraries (program_options, the bench's peers). The loader's libraries (urdfdom, assimp,
+// roslib, KDL) reach them only through it, so the package:// resolver stays the loader's.
+TEST(Layers, TheToolsDependDirectlyOnlyOnWhatTheyUse) {
+  static const std::regex kForbidden(
+      "^lib(ros|urdf|assimp|console_bridge|tinyxml|orocos|python|tf2|message|xmlrpc|cpp_common)");
+  for (const std::string tool : {CAST_SCAN_PATH, BENCH_PATH}) {
+    const std::vector<std::string> needed = neededLibraries(tool);
+    for (const std::string& library : needed) {
+      EXPECT_FALSE(std::regex_search(library, kForbidden)) << tool << " links " << library;
+    }
+    for (const std::string used : {"liblaser_raycast_core.so", "liblaser_raycast_scene_loader.so",
+                                   "liblaser_raycast_kinematics.so"}) {
+      EXPECT_EQ(std::count(needed.begin(), needed.end(), used), 1) << tool << " needs " << used;
+    }
+  }
+}
+
+// Nor do they load roscpp at all, not even through a library (kdl_parser, the ROS urdf library).
+TEST(Layers, TheToolsLoadNoRoscpp) {
+  static const std::regex kRoscpp(
+      "(^|\\s)lib(roscpp|rosconsole|xmlrpcpp|tf2|kdl_parser|urdf\\.so)");
+  for (const std::string tool : {CAST_SCAN_PATH, BENCH_PATH}) {
+    const CommandResult r = runCommand("ldd '" + tool + "' 2>&1");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("liblaser_raycast_scene_loader.so"), std::string::npos) << r.output;
+    std::istringstream lines(r.output);
+    std::string line;
+    while (std::getline(lines, line)) {
+      EXPECT_FALSE(std::regex_search(line, kRoscpp)) << tool << " loads " << line;
+    }
+  }
 }
 
 }  // namespace
