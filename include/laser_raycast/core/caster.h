@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scene.h"
 #include "laser_raycast/core/triangle.h"
@@ -56,6 +57,14 @@ class Caster {
   const ScanResult& cast(const Scene& scene, const FramePoses& poses,
                          const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
                          const CastConfig& config);
+
+  // A rotating scan: the beams of azimuth index c (all rings) are taken at time c * time_increment
+  // (s after the first beam, >= 0), each from the sensor and frame poses at that time, interpolated
+  // in samples (PoseSamples). This is the motion distortion of a real scan. Never reused. Throws
+  // std::invalid_argument for bad samples or a bad time_increment.
+  const ScanResult& castSweep(const Scene& scene, const PoseSamples& samples,
+                              const ScanPattern& pattern, const CastConfig& config,
+                              double time_increment);
 
   // Drops the remembered inputs, so that the next cast() computes even if nothing moved (timing).
   void forget() { previous_.reset(); }
