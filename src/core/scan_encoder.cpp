@@ -22,6 +22,12 @@ void EncoderConfig::validate() const {
         << std::numeric_limits<float>::max() << " m)";
   } else if (!(std::isfinite(noise_stddev) && noise_stddev >= 0)) {
     msg << "noise_stddev must be finite and >= 0, got " << noise_stddev;
+  } else if (!std::isfinite(range_bias)) {
+    msg << "range_bias must be finite, got " << range_bias;
+  } else if (!(std::isfinite(range_resolution) && range_resolution >= 0)) {
+    msg << "range_resolution must be finite and >= 0, got " << range_resolution;
+  } else if (!(dropout_probability >= 0 && dropout_probability <= 1)) {
+    msg << "dropout_probability must be in [0, 1], got " << dropout_probability;
   } else {
     return;
   }
@@ -45,9 +51,41 @@ double classifyRange(double range, const EncoderConfig& config) {
   return range;
 }
 
-ScanEncoder::ScanEncoder(const EncoderConfig& config)
-    : config_(config), rng_(config.noise_seed), noise_(0.0, 1.0) {
+double quantizeRange(double range, const EncoderConfig& config) {
+  const double step = config.range_resolution;
+  if (!(step > 0)) return range;
+  return std::clamp(std::round(range / step) * step, config.range_min, config.range_max);
+}
+
+ScanEncoder::ScanEncoder(const EncoderConfig& config) : config_(config), noise_(0.0, 1.0) {
   config_.validate();
+  seed(config_.noise_seed);
+}
+
+void ScanEncoder::setConfig(const EncoderConfig& config) {
+  config.validate();
+  const bool reseed = config.noise_seed != config_.noise_seed;
+  config_ = config;
+  if (reseed) seed(config_.noise_seed);
+}
+
+void ScanEncoder::seed(std::uint64_t seed) {
+  rng_.seed(seed);
+  dropout_rng_.seed(seed ^ kDropoutSeedMix);
+  noise_.reset();  // drop a normal value cached from the old sequence
+}
+
+bool ScanEncoder::degrade(double* range) {
+  double r = *range + config_.range_bias;
+  if (config_.noise_stddev > 0) r += config_.noise_stddev * noise_(rng_);
+  r = std::clamp(r, config_.range_min, config_.range_max);
+  *range = quantizeRange(r, config_);
+  if (config_.dropout_probability > 0) {
+    // u in [0, 1) from the top 53 bits: exact and the same with every standard library.
+    const double u = static_cast<double>(dropout_rng_() >> 11) * 0x1p-53;
+    if (u < config_.dropout_probability) return false;
+  }
+  return true;
 }
 
 void ScanEncoder::encode(const Scene& scene, const ScanResult& result,
@@ -68,9 +106,11 @@ void ScanEncoder::encode(const Scene& scene, const ScanResult& result,
     const int label = body >= 0 ? scene.bodies()[body].label : -1;
     out->labels[i] = label;
     double r = classifyRange(result.range[i], config_);
-    const bool valid = std::isfinite(r);
-    if (valid && config_.noise_stddev > 0) {
-      r = std::clamp(r + config_.noise_stddev * noise_(rng_), config_.range_min, config_.range_max);
+    bool valid = std::isfinite(r);
+    if (valid && !degrade(&r)) {
+      valid = false;
+      r = std::numeric_limits<double>::infinity();  // lost: no return
+      out->labels[i] = -1;
     }
     out->ranges[i] = static_cast<float>(r);  // the one rounding to float
     if (config_.intensity && valid && label >= 0) {

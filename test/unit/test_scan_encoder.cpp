@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "encoder_inputs.h"
 #include "expect_invalid.h"
 #include "laser_raycast/core/scan_encoder.h"
 #include "laser_raycast/core/scan_spec.h"
@@ -21,40 +22,6 @@ using namespace laser_raycast::core;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
-
-EncoderConfig encoderConfig(double range_min, double range_max,
-                            MinRangePolicy policy = MinRangePolicy::kNegInf) {
-  EncoderConfig c;
-  c.range_min = range_min;
-  c.range_max = range_max;
-  c.min_range_policy = policy;
-  return c;
-}
-
-// A scene with three labels and one sphere body per label (label i on body i), plus a fourth body
-// sharing label 1, for hand-made ScanResults.
-Scene labelledScene() {
-  Scene scene;
-  scene.addFrame("world");
-  for (const char* name : {"wall", "table", "robot"}) scene.addLabel(name);
-  for (const int label : {0, 1, 2, 1}) {
-    Body body;
-    body.shape = Sphere{0.1};
-    body.label = label;
-    scene.addBody(body);
-  }
-  return scene;
-}
-
-// A ScanResult of n beams, all hitting body 0 at `range` unless changed, cos_incidence 1.
-ScanResult uniformResult(int n, double range, bool with_incidence = false) {
-  ScanResult r;
-  r.range.assign(n, range);
-  r.body.assign(n, 0);
-  r.triangle.assign(n, -1);
-  if (with_incidence) r.cos_incidence.assign(n, 1.0);
-  return r;
-}
 
 bool sameFloat(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
 

@@ -1,5 +1,6 @@
-// From geometry to what the sensor reports (REP 117): the min-range policy, +-Inf and NaN, Gaussian
-// noise, intensity, and one rounding to float.
+// From geometry to what the sensor reports (REP 117): the min-range policy, +-Inf and NaN, the
+// range realism options (bias, Gaussian noise, quantisation, dropout), intensity, and one rounding
+// to float.
 #pragma once
 
 #include <cstdint>
@@ -35,9 +36,13 @@ struct EncoderConfig {
   double range_max = 30.0;  // m, > range_min
   MinRangePolicy min_range_policy = MinRangePolicy::kNegInf;
   double noise_stddev = 0.0;  // m, >= 0: Gaussian noise added to valid ranges
-  std::uint64_t noise_seed =
-      0;                   // seed of the noise generator: equal seeds give equal noise sequences
+  // Seed of the random draws (noise and dropout): equal seeds give equal sequences.
+  std::uint64_t noise_seed = 0;
   bool intensity = false;  // fill intensities: reflectivity of the link hit x cos(incidence angle)
+  // Range realism, off by default; like the noise, only valid returns get it (see ScanEncoder).
+  double range_bias = 0.0;        // m, finite: added to every valid range (a calibration offset)
+  double range_resolution = 0.0;  // m, >= 0: valid ranges are rounded to a multiple of it; 0: off
+  double dropout_probability = 0.0;  // in [0, 1]: chance that a valid return is lost (+Inf)
 
   // Throws std::invalid_argument naming the field and its value.
   void validate() const;
@@ -49,26 +54,56 @@ struct EncoderConfig {
 // anyway is +Inf.
 double classifyRange(double range, const EncoderConfig& config);
 
+// A valid range rounded to the nearest multiple of range_resolution (halves away from zero), as a
+// driver reporting in fixed units does, then clamped to [range_min, range_max] so that a valid
+// return stays valid (a multiple just outside a limit becomes the limit itself). Returns range
+// unchanged if range_resolution is 0.
+double quantizeRange(double range, const EncoderConfig& config);
+
 struct EncodedScan {
   std::vector<float> ranges;       // REP 117
   std::vector<float> intensities;  // one per beam when EncoderConfig::intensity, else empty
   std::vector<int> labels;         // label index of the body hit (also when too close), -1 for none
 };
 
+// Each beam's range is classified (classifyRange, on the noise-free range, so validity follows the
+// geometry). A valid one then becomes
+//   r = quantizeRange(clamp(range + range_bias + noise_stddev * N(0, 1), range_min, range_max))
+// and is lost with probability dropout_probability; it is rounded once to float. Bias, noise and
+// quantisation never make a valid return invalid; invalid returns (+-Inf, NaN) get none of them.
+// A lost return reports what a real lidar reports for a beam without echo: +Inf (REP 117's "no
+// return"), label -1 and intensity 0.
+//
+// Random draws: two generators, both mt19937_64, one for the noise seeded with noise_seed and one
+// for the dropout seeded with noise_seed ^ kDropoutSeedMix. Beams are visited in index order; each
+// valid beam draws one N(0, 1) from the first if noise_stddev > 0 (even if it is then lost) and
+// one uniform u in [0, 1) from the second if dropout_probability > 0, lost iff u <
+// dropout_probability. So a seed fixes both sequences, and changing the dropout probability does
+// not change the noise of the beams that remain. Both sequences continue across calls.
 class ScanEncoder {
  public:
+  static constexpr std::uint64_t kDropoutSeedMix = 0x9E3779B97F4A7C15ULL;
+
   explicit ScanEncoder(const EncoderConfig& config);  // validates
 
-  // Valid ranges get N(0, noise_stddev) noise, clamped to [range_min, range_max] so that a valid
-  // return stays valid, then are rounded once to float. Noise is drawn afresh on every call.
+  // A new configuration for the next encode() (e.g. from dynamic_reconfigure): validates it, and
+  // restarts both random sequences if noise_seed changed; otherwise they continue.
+  void setConfig(const EncoderConfig& config);
+  const EncoderConfig& config() const { return config_; }
+
   // reflectivity is indexed by label (missing entries count as 1); intensity needs
   // result.cos_incidence.
   void encode(const Scene& scene, const ScanResult& result, const std::vector<double>& reflectivity,
               EncodedScan* out);
 
  private:
+  void seed(std::uint64_t seed);
+  // The realism steps for one valid range (the class comment's formula and draws); false if lost.
+  bool degrade(double* range);
+
   EncoderConfig config_;
-  std::mt19937_64 rng_;
+  std::mt19937_64 rng_;          // noise
+  std::mt19937_64 dropout_rng_;  // dropout
   std::normal_distribution<double> noise_;
 };
 
