@@ -1,0 +1,63 @@
+// Presets of real sensors: the beam pattern, range limits and scan rate of a named lidar, taken
+// from its datasheet (src/core/sensor_model.cpp says where each value comes from; docs/sensors.md
+// lists them). A preset fills a ScanSpec; explicit settings then override single fields of it.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "laser_raycast/core/enum_names.h"
+#include "laser_raycast/core/scan_pattern.h"
+#include "laser_raycast/core/scan_spec.h"
+
+namespace laser_raycast {
+namespace core {
+
+enum class SensorModelId {
+  kVlp16,    // Velodyne VLP-16 (Puck): 16 rings, 360 deg
+  kHdl32e,   // Velodyne HDL-32E: 32 rings, 360 deg
+  kOs1_64,   // Ouster OS1-64, first generation, uniform beam spacing: 64 rings, 360 deg
+  kUtm30lx,  // Hokuyo UTM-30LX: planar, 270 deg
+  kTim571,   // SICK TiM571: planar, 270 deg
+  kLds01,    // ROBOTIS LDS-01 (Hitachi-LG HLS-LFCD2), the TurtleBot3's: planar, 360 deg
+};
+// The names the sensor_model parameter takes: the makers' spellings.
+inline const EnumNames<SensorModelId, 6> kSensorModelNames{{{
+    {SensorModelId::kVlp16, "VLP-16"},
+    {SensorModelId::kHdl32e, "HDL-32E"},
+    {SensorModelId::kOs1_64, "OS1-64"},
+    {SensorModelId::kUtm30lx, "UTM-30LX"},
+    {SensorModelId::kTim571, "TiM571"},
+    {SensorModelId::kLds01, "LDS-01"},
+}}};
+inline const char* toString(SensorModelId id) { return kSensorModelNames.name(id); }
+
+struct SensorModel {
+  SensorModelId id;
+  // rad, ascending (ring r is the r-th lowest); {0} for a planar scanner.
+  std::vector<double> elevations;
+  // Azimuths as angle_min, angle_max and angle_increment (samples 0). A full turn runs from -pi
+  // to pi - angle_increment, so that no azimuth is cast twice.
+  FanSpec fan;
+  double range_min = 0;  // m
+  double range_max = 0;  // m
+  double rate = 0;       // Hz: scans (head turns) per second
+
+  const char* name() const { return toString(id); }
+
+  // Sets spec->fan, spec->elevations, spec->output.range_min and range_max, and *rate; leaves
+  // everything else in spec (min-range policy, noise, intensity, method) as it was. Explicit
+  // settings are applied afterwards by the caller; one that sets samples must clear
+  // fan.angle_increment (and vice versa), since a FanSpec takes exactly one of them.
+  void apply(ScanSpec* spec, double* rate) const;
+};
+
+// The preset of that sensor.
+SensorModel sensorModel(SensorModelId id);
+// The preset named `name` (exactly one of kSensorModelNames); nullopt for anything else. The
+// error message for an unknown name: kSensorModelNames.notOneOf(name) lists the known ones.
+std::optional<SensorModel> findSensorModel(const std::string& name);
+
+}  // namespace core
+}  // namespace laser_raycast
