@@ -1,0 +1,228 @@
+// buildPointCloud: the field layout, both layouts against hand-computed points (read back with
+// sensor_msgs' PointCloud2ConstIterator, as consumers read them), times, intensities, and a cloud
+// from a real cast whose points lie on the wall that was cast against.
+#include <gtest/gtest.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/scan_spec.h"
+#include "laser_raycast/node/point_cloud.h"
+
+namespace laser_raycast_test {
+namespace {
+
+using laser_raycast::buildPointCloud;
+using laser_raycast::CloudOptions;
+using laser_raycast::rotatingColumnTimes;
+using namespace laser_raycast::core;
+using sensor_msgs::PointField;
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+
+// Two rings (given high first: ring 0 is the lower, -0.3 rad) of three azimuths -pi/2, 0, pi/2.
+ScanPattern twoRings() {
+  ScanSpec spec;
+  spec.fan.angle_min = -M_PI / 2;
+  spec.fan.angle_max = M_PI / 2;
+  spec.fan.samples = 3;
+  spec.elevations = {0.2, -0.3};
+  return spec.pattern();
+}
+
+// Ring-major: ring 0 = {2, no return, 1.5}, ring 1 = {too close, 3, NaN}.
+EncodedScan sixBeams() {
+  EncodedScan scan;
+  scan.ranges = {2.0f, kInf, 1.5f, -kInf, 3.0f, kNan};
+  scan.intensities = {0.5f, 0.0f, 0.25f, 0.0f, 0.75f, 0.0f};
+  scan.labels = {0, -1, 0, 0, 0, -1};
+  return scan;
+}
+
+std_msgs::Header header() {
+  std_msgs::Header h;
+  h.stamp = ros::Time(12, 345);
+  h.frame_id = "velodyne";
+  h.seq = 3;
+  return h;
+}
+
+struct ReadPoint {
+  float x, y, z, intensity;
+  std::uint16_t ring;
+  float time;
+};
+
+// Every point, read by field name.
+std::vector<ReadPoint> readAll(const sensor_msgs::PointCloud2& cloud) {
+  std::vector<ReadPoint> points;
+  sensor_msgs::PointCloud2ConstIterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z"),
+      intensity(cloud, "intensity"), time(cloud, "time");
+  sensor_msgs::PointCloud2ConstIterator<std::uint16_t> ring(cloud, "ring");
+  for (; x != x.end(); ++x, ++y, ++z, ++intensity, ++ring, ++time) {
+    points.push_back({*x, *y, *z, *intensity, *ring, *time});
+  }
+  return points;
+}
+
+// The point at range r, elevation el, azimuth az, by hand.
+void expectPoint(const ReadPoint& p, double r, double el, double az) {
+  EXPECT_NEAR(p.x, r * std::cos(el) * std::cos(az), 1e-6);
+  EXPECT_NEAR(p.y, r * std::cos(el) * std::sin(az), 1e-6);
+  EXPECT_NEAR(p.z, r * std::sin(el), 1e-6);
+}
+
+TEST(PointCloud, FieldsAsVelodynePointcloudNamesThem) {
+  sensor_msgs::PointCloud2 cloud;
+  buildPointCloud(twoRings(), sixBeams(), {}, header(), CloudOptions{}, &cloud);
+  ASSERT_EQ(cloud.fields.size(), 6u);
+  const std::vector<std::string> names = {"x", "y", "z", "intensity", "ring", "time"};
+  const std::vector<std::uint32_t> offsets = {0, 4, 8, 12, 16, 20};
+  for (int f = 0; f < 6; ++f) {
+    EXPECT_EQ(cloud.fields[f].name, names[f]);
+    EXPECT_EQ(cloud.fields[f].offset, offsets[f]) << names[f];
+    EXPECT_EQ(cloud.fields[f].datatype,
+              names[f] == "ring" ? PointField::UINT16 : PointField::FLOAT32)
+        << names[f];
+    EXPECT_EQ(cloud.fields[f].count, 1u) << names[f];
+  }
+  EXPECT_EQ(cloud.point_step, 24u);
+  EXPECT_FALSE(cloud.is_bigendian);  // the test machines are little-endian
+  EXPECT_EQ(cloud.header.frame_id, "velodyne");
+  EXPECT_EQ(cloud.header.stamp, ros::Time(12, 345));
+  EXPECT_EQ(cloud.header.seq, 3u);
+}
+
+// Only the three valid returns, in beam order, one row.
+TEST(PointCloud, DenseHoldsTheValidReturns) {
+  sensor_msgs::PointCloud2 cloud;
+  buildPointCloud(twoRings(), sixBeams(), {0.0, 0.01, 0.02}, header(), CloudOptions{}, &cloud);
+  EXPECT_EQ(cloud.height, 1u);
+  EXPECT_EQ(cloud.width, 3u);
+  EXPECT_EQ(cloud.row_step, 72u);
+  EXPECT_EQ(cloud.data.size(), 72u);
+  EXPECT_TRUE(cloud.is_dense);
+  const auto p = readAll(cloud);
+  ASSERT_EQ(p.size(), 3u);
+  // Ring 0 (-0.3 rad), azimuth -pi/2 at 2 m: (0, -2 cos 0.3, -2 sin 0.3).
+  expectPoint(p[0], 2.0, -0.3, -M_PI / 2);
+  EXPECT_NEAR(p[0].y, -2 * std::cos(0.3), 1e-6);
+  EXPECT_EQ(p[0].ring, 0);
+  EXPECT_EQ(p[0].time, 0.0f);
+  EXPECT_EQ(p[0].intensity, 0.5f);
+  // Ring 0, azimuth pi/2 at 1.5 m, taken 0.02 s after the stamp.
+  expectPoint(p[1], 1.5, -0.3, M_PI / 2);
+  EXPECT_EQ(p[1].ring, 0);
+  EXPECT_EQ(p[1].time, 0.02f);
+  EXPECT_EQ(p[1].intensity, 0.25f);
+  // Ring 1 (0.2 rad), azimuth 0 at 3 m: (3 cos 0.2, 0, 3 sin 0.2).
+  expectPoint(p[2], 3.0, 0.2, 0.0);
+  EXPECT_NEAR(p[2].x, 3 * std::cos(0.2), 1e-6);
+  EXPECT_EQ(p[2].ring, 1);
+  EXPECT_EQ(p[2].time, 0.01f);
+  EXPECT_EQ(p[2].intensity, 0.75f);
+}
+
+// Every beam: rows are rings, columns azimuths; no return is a NaN point that keeps ring and time.
+TEST(PointCloud, OrganizedHoldsEveryBeam) {
+  sensor_msgs::PointCloud2 cloud;
+  CloudOptions organized;
+  organized.organized = true;
+  buildPointCloud(twoRings(), sixBeams(), rotatingColumnTimes(3, 0.005), header(), organized,
+                  &cloud);
+  EXPECT_EQ(cloud.height, 2u);
+  EXPECT_EQ(cloud.width, 3u);
+  EXPECT_EQ(cloud.row_step, 72u);
+  EXPECT_EQ(cloud.data.size(), 144u);
+  EXPECT_FALSE(cloud.is_dense);
+  const auto p = readAll(cloud);
+  ASSERT_EQ(p.size(), 6u);
+  const double el[2] = {-0.3, 0.2}, az[3] = {-M_PI / 2, 0, M_PI / 2};
+  const float range[6] = {2.0f, kNan, 1.5f, kNan, 3.0f, kNan};
+  for (int b = 0; b < 6; ++b) {
+    const int ring = b / 3, column = b % 3;
+    EXPECT_EQ(p[b].ring, ring) << b;
+    EXPECT_EQ(p[b].time, static_cast<float>(column * 0.005)) << b;
+    if (std::isnan(range[b])) {
+      EXPECT_TRUE(std::isnan(p[b].x) && std::isnan(p[b].y) && std::isnan(p[b].z)) << b;
+      EXPECT_TRUE(std::isnan(p[b].intensity)) << b;
+    } else {
+      expectPoint(p[b], range[b], el[ring], az[column]);
+    }
+  }
+  // With a return on every beam, an organized cloud is dense.
+  EncodedScan all = sixBeams();
+  all.ranges = {1, 2, 3, 4, 5, 6};
+  buildPointCloud(twoRings(), all, {}, header(), organized, &cloud);
+  EXPECT_TRUE(cloud.is_dense);
+  EXPECT_EQ(readAll(cloud)[5].time, 0.0f);  // instantaneous: every point at the stamp
+}
+
+TEST(PointCloud, NoIntensitiesGiveZero) {
+  EncodedScan scan = sixBeams();
+  scan.intensities.clear();
+  sensor_msgs::PointCloud2 cloud;
+  buildPointCloud(twoRings(), scan, {}, header(), CloudOptions{}, &cloud);
+  for (const ReadPoint& p : readAll(cloud)) EXPECT_EQ(p.intensity, 0.0f);
+}
+
+TEST(PointCloud, MismatchedSizesThrow) {
+  sensor_msgs::PointCloud2 cloud;
+  EncodedScan scan = sixBeams();
+  scan.ranges.pop_back();
+  EXPECT_THROW(buildPointCloud(twoRings(), scan, {}, header(), CloudOptions{}, &cloud),
+               std::invalid_argument);
+  scan = sixBeams();
+  scan.intensities.resize(4);
+  EXPECT_THROW(buildPointCloud(twoRings(), scan, {}, header(), CloudOptions{}, &cloud),
+               std::invalid_argument);
+  try {
+    buildPointCloud(twoRings(), sixBeams(), {0.0, 0.1}, header(), CloudOptions{}, &cloud);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("2 column times"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("2 rings x 3 azimuths"), std::string::npos) << e.what();
+  }
+}
+
+// End to end with the caster: a wall 4 m ahead (a box whose near face is x = 4) seen by 5 rings of
+// 21 azimuths over +-0.5 rad: every point lies on x = 4, at range 4 / (cos el cos az).
+TEST(PointCloud, PointsOfACastLieOnTheWall) {
+  Scene scene;
+  scene.addFrame("world");
+  scene.addLabel("wall");
+  Body wall;
+  wall.shape = Box{Eigen::Vector3d(0.2, 20, 20)};
+  wall.frame_from_body = Eigen::Translation3d(4.1, 0, 0);
+  scene.addBody(wall);
+  ScanSpec spec;
+  spec.fan.angle_min = -0.5;
+  spec.fan.angle_max = 0.5;
+  spec.fan.samples = 21;
+  spec.elevations = {-0.2, -0.1, 0, 0.1, 0.2};
+  const ScanPattern pattern = spec.pattern();
+  Caster caster;
+  const ScanResult& result = caster.cast(scene, FramePoses::identity(scene),
+                                         Eigen::Isometry3d::Identity(), pattern, spec.castConfig());
+  ScanEncoder encoder(spec.output);
+  EncodedScan scan;
+  encoder.encode(scene, result, {}, &scan);
+  sensor_msgs::PointCloud2 cloud;
+  buildPointCloud(pattern, scan, {}, header(), CloudOptions{}, &cloud);
+  const auto points = readAll(cloud);
+  ASSERT_EQ(points.size(), 105u);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double el = spec.elevations[points[i].ring], az = -0.5 + 0.05 * (i % 21);
+    EXPECT_NEAR(points[i].x, 4.0, 2e-6) << i;
+    expectPoint(points[i], 4.0 / (std::cos(el) * std::cos(az)), el, az);
+  }
+}
+
+}  // namespace
+}  // namespace laser_raycast_test
