@@ -37,12 +37,13 @@ const char* const kSynopsis =
     "                 [--angle-min RAD] [--angle-max RAD] [--samples N | --angle-increment RAD]\n"
     "                 [--range-min M] [--range-max M] [--geometry visual|collision]\n"
     "                 [--method seed_plane|seed_uv|cramer|moller_trumbore|watertight]\n"
-    "                 [--joint NAME=VALUE ...] [--repeat N]\n";
+    "                 [--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n";
 const char* const kNotes =
-    "Prints CSV 'index,angle,range,link' (REP 117: inf, -inf, nan). Defaults: angles -pi..pi, 360 "
-    "samples,\n"
-    "ranges 0..30 m, geometry visual, method watertight. Poses in metres and radians (URDF rpy).\n"
-    "Exit status: 0 ok, 2 bad arguments, 3 bad scene input.\n";
+    "Prints CSV 'index,angle,range,link' (REP 117: inf, -inf, nan); with --elevations\n"
+    "'index,ring,elevation,angle,range,link' (ring 0 the lowest).\n"
+    "Defaults: angles -pi..pi, 360 samples, ranges 0..30 m, geometry visual, method watertight.\n"
+    "Poses in metres and radians (URDF rpy). Exit status: 0 ok, 2 bad arguments, 3 bad scene\n"
+    "input.\n";
 
 struct Model {
   std::string path;
@@ -56,6 +57,7 @@ struct Args {
   GeometrySource geometry = GeometrySource::kVisual;
   std::map<std::string, double> joints;
   int repeat = 0;
+  bool rings = false;  // --elevations given: one fan per elevation, and the ring columns
 };
 
 double parseNumber(const std::string& flag, const std::string& text) {
@@ -108,6 +110,18 @@ Model parseModel(const std::string& spec) {
 void parseSensor(const std::string& spec, Eigen::Isometry3d* pose) {
   if (!parsePose(spec, pose)) {
     throw ArgError("--sensor: '" + spec + "' is not x,y,z,roll,pitch,yaw (6 finite numbers)");
+  }
+}
+
+// "E1,E2,...": radians, any order, at least one.
+std::vector<double> parseElevations(const std::string& text) {
+  std::vector<double> elevations;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    elevations.push_back(parseNumber("--elevations", text.substr(start, comma - start)));
+    if (comma == std::string::npos) return elevations;
+    start = comma + 1;
   }
 }
 
@@ -187,6 +201,13 @@ po::options_description flags(Args* args) {
   add("method",
       single("NAME", [args](const std::string& v) { args->scan.method = parseMethod(v); }),
       "the triangle test");
+  add("elevations",
+      single("RAD,RAD,...",
+             [args](const std::string& v) {
+               args->scan.elevations = parseElevations(v);
+               args->rings = true;
+             }),
+      "one fan of azimuths per elevation (rad, up positive, any order); ring r is the r-th lowest");
   add("joint",
       repeated("NAME=VALUE ...", [args](const std::string& v) { parseJoint(v, &args->joints); })
           ->multitoken(),
@@ -227,6 +248,98 @@ std::string formatNumber(double value) {
   return buffer;
 }
 
+// The models, loaded and placed, with their joints at the given values.
+struct LoadedScene {
+  core::Scene scene;
+  core::FramePoses poses;
+  bool prefixed = false;  // each model's link names carry a private prefix (not printed)
+};
+
+// Every joint value must name a movable joint of some model. Throws ArgError.
+void checkJoints(const std::map<std::string, double>& joints,
+                 const std::vector<laser_raycast::LoadedModel>& models) {
+  using Type = laser_raycast::ModelJoint::Type;
+  for (const auto& [name, value] : joints) {
+    bool found = false;
+    for (const auto& model : models) {
+      for (const auto& joint : model.joints) {
+        if (joint.name != name) continue;
+        found = true;
+        if (joint.type != Type::kRevolute && joint.type != Type::kContinuous &&
+            joint.type != Type::kPrismatic) {
+          throw ArgError("--joint " + name + "=" + formatNumber(value) +
+                         ": the joint is not revolute, continuous or prismatic");
+        }
+      }
+    }
+    if (!found) throw ArgError("--joint " + name + ": no model has a joint of that name");
+  }
+}
+
+// Loads every model; with several, gives each a private prefix so that equal link names stay
+// apart. Throws SceneLoadError (bad scene input) or ArgError (a bad joint).
+LoadedScene loadScene(const Args& args) {
+  laser_raycast::SceneLoader loader(laser_raycast::rosPackagePath);
+  LoadedScene out;
+  std::vector<laser_raycast::LoadedModel> loaded;
+  out.prefixed = args.models.size() > 1;
+  for (std::size_t m = 0; m < args.models.size(); ++m) {
+    laser_raycast::LoaderOptions options;
+    options.geometry = args.geometry;
+    if (out.prefixed) options.tf_prefix = "m" + std::to_string(m) + "/";
+    loaded.push_back(loader.addUrdfFile(args.models[m].path, options, &out.scene));
+  }
+  checkJoints(args.joints, loaded);
+  std::map<std::string, Eigen::Isometry3d> link_poses;
+  for (std::size_t m = 0; m < loaded.size(); ++m) {
+    const auto poses =
+        laser_raycast::forwardKinematics(loaded[m], args.models[m].pose, args.joints);
+    link_poses.insert(poses.begin(), poses.end());
+  }
+  out.poses = laser_raycast::framePosesFromLinks(out.scene, link_poses);
+  return out;
+}
+
+// Casts the scan `repeat` more times, each from scratch, and prints the median time to stderr.
+void reportMedianCastTime(const Args& args, const LoadedScene& loaded,
+                          const core::ScanPattern& pattern, const core::CastConfig& config,
+                          core::Caster& caster) {
+  std::vector<long long> ns;
+  ns.reserve(args.repeat);
+  for (int k = 0; k < args.repeat; ++k) {
+    caster.forget();  // time the cast itself, not the reuse of an unchanged scan
+    const auto t0 = std::chrono::steady_clock::now();
+    caster.cast(loaded.scene, loaded.poses, args.sensor, pattern, config);
+    const auto t1 = std::chrono::steady_clock::now();
+    ns.push_back(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());
+  }
+  std::nth_element(ns.begin(), ns.begin() + ns.size() / 2, ns.end());
+  std::cerr << "cast_ns_per_scan_median=" << ns[ns.size() / 2] << "\n";
+}
+
+// One CSV row per beam, in beam order (ring-major).
+std::string formatCsv(const Args& args, const LoadedScene& loaded, const core::ScanPattern& pattern,
+                      const core::ScanResult& result) {
+  std::string out =
+      args.rings ? "index,ring,elevation,angle,range,link\n" : "index,angle,range,link\n";
+  const int azimuths = pattern.azimuthCount();
+  for (int i = 0; i < pattern.size(); ++i) {
+    const int ring = i / azimuths;
+    out += std::to_string(i) + ",";
+    if (args.rings) {
+      out += std::to_string(ring) + "," + formatNumber(pattern.elevations()[ring]) + ",";
+    }
+    out += formatNumber(pattern.azimuth(i % azimuths)) + "," +
+           formatNumber(core::classifyRange(result.range[i], args.scan.output)) + ",";
+    if (result.body[i] >= 0) {
+      const std::string& label = loaded.scene.labels()[loaded.scene.bodies()[result.body[i]].label];
+      out += loaded.prefixed ? label.substr(label.find('/') + 1) : label;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -243,83 +356,23 @@ int main(int argc, char** argv) {
     std::cout << kSynopsis << "\n" << flags(&unused) << "\n" << kNotes;
     return 0;
   }
-
-  // Load every model; with several, give each a private prefix so that equal link names stay apart
-  // (the prefix is not printed).
-  laser_raycast::SceneLoader loader(laser_raycast::rosPackagePath);
-  core::Scene scene;
-  std::vector<laser_raycast::LoadedModel> loaded;
-  const bool prefixed = args.models.size() > 1;
-  for (std::size_t m = 0; m < args.models.size(); ++m) {
-    laser_raycast::LoaderOptions options;
-    options.geometry = args.geometry;
-    if (prefixed) options.tf_prefix = "m" + std::to_string(m) + "/";
-    try {
-      loaded.push_back(loader.addUrdfFile(args.models[m].path, options, &scene));
-    } catch (const laser_raycast::SceneLoadError& e) {
-      std::cerr << "cast_scan: " << e.what() << "\n";
-      return kExitBadScene;
-    }
+  LoadedScene loaded;
+  try {
+    loaded = loadScene(args);
+  } catch (const laser_raycast::SceneLoadError& e) {
+    std::cerr << "cast_scan: " << e.what() << "\n";
+    return kExitBadScene;
+  } catch (const ArgError& e) {
+    std::cerr << "cast_scan: " << e.what() << "\n";
+    return kExitBadArguments;
   }
-
-  // Joint values: every name must be a movable joint of some model.
-  for (const auto& [name, value] : args.joints) {
-    bool found = false;
-    for (const auto& model : loaded) {
-      for (const auto& joint : model.joints) {
-        if (joint.name != name) continue;
-        found = true;
-        using Type = laser_raycast::ModelJoint::Type;
-        if (joint.type != Type::kRevolute && joint.type != Type::kContinuous &&
-            joint.type != Type::kPrismatic) {
-          std::cerr << "cast_scan: --joint " << name << "=" << value
-                    << ": the joint is not revolute, continuous or prismatic\n";
-          return kExitBadArguments;
-        }
-      }
-    }
-    if (!found) {
-      std::cerr << "cast_scan: --joint " << name << ": no model has a joint of that name\n";
-      return kExitBadArguments;
-    }
-  }
-  std::map<std::string, Eigen::Isometry3d> link_poses;
-  for (std::size_t m = 0; m < loaded.size(); ++m) {
-    const auto poses =
-        laser_raycast::forwardKinematics(loaded[m], args.models[m].pose, args.joints);
-    link_poses.insert(poses.begin(), poses.end());
-  }
-  const core::FramePoses frame_poses = laser_raycast::framePosesFromLinks(scene, link_poses);
-
   const core::ScanPattern pattern = args.scan.pattern();
   const core::CastConfig config = args.scan.castConfig();
   core::Caster caster;
-  const core::ScanResult& result = caster.cast(scene, frame_poses, args.sensor, pattern, config);
-
-  if (args.repeat > 0) {
-    std::vector<long long> ns;
-    ns.reserve(args.repeat);
-    for (int k = 0; k < args.repeat; ++k) {
-      caster.forget();  // time the cast itself, not the reuse of an unchanged scan
-      const auto t0 = std::chrono::steady_clock::now();
-      caster.cast(scene, frame_poses, args.sensor, pattern, config);
-      const auto t1 = std::chrono::steady_clock::now();
-      ns.push_back(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());
-    }
-    std::nth_element(ns.begin(), ns.begin() + ns.size() / 2, ns.end());
-    std::cerr << "cast_ns_per_scan_median=" << ns[ns.size() / 2] << "\n";
-  }
-
-  std::string out = "index,angle,range,link\n";
-  for (int i = 0; i < pattern.size(); ++i) {
-    out += std::to_string(i) + "," + formatNumber(pattern.azimuth(i)) + "," +
-           formatNumber(core::classifyRange(result.range[i], args.scan.output)) + ",";
-    if (result.body[i] >= 0) {
-      const std::string& label = scene.labels()[scene.bodies()[result.body[i]].label];
-      out += prefixed ? label.substr(label.find('/') + 1) : label;
-    }
-    out += "\n";
-  }
-  std::fwrite(out.data(), 1, out.size(), stdout);
+  const core::ScanResult& result =
+      caster.cast(loaded.scene, loaded.poses, args.sensor, pattern, config);
+  if (args.repeat > 0) reportMedianCastTime(args, loaded, pattern, config, caster);
+  const std::string csv = formatCsv(args, loaded, pattern, result);
+  std::fwrite(csv.data(), 1, csv.size(), stdout);
   return 0;
 }

@@ -1,7 +1,9 @@
 // The offline CLI cast_scan, run as a user would: each flag, the CSV format, and each exit status.
-// Expected ranges are worked out by hand in test/data/cli_joints.urdf and node_scene.urdf.
+// Expected ranges are worked out by hand in test/data/cli_joints.urdf, node_scene.urdf and
+// cli_rings.urdf.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -71,6 +73,37 @@ std::vector<Row> parse(const std::string& csv) {
 }
 
 double value(const Row& row) { return std::stod(row.range); }
+
+struct RingRow {
+  int index, ring;
+  double elevation, angle;
+  std::string range, link;
+};
+
+// Parses the CSV of a scan with --elevations, checking the header and the shape of every row.
+std::vector<RingRow> parseRings(const std::string& csv) {
+  std::istringstream in(csv);
+  std::string line;
+  std::vector<RingRow> rows;
+  if (!std::getline(in, line) || line != "index,ring,elevation,angle,range,link") {
+    ADD_FAILURE() << "bad header: '" << line << "'";
+    return rows;
+  }
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ls(line);
+    std::string item;
+    while (std::getline(ls, item, ',')) f.push_back(item);
+    if (!line.empty() && line.back() == ',') f.push_back("");
+    if (f.size() != 6) {
+      ADD_FAILURE() << "bad row: '" << line << "'";
+      continue;
+    }
+    rows.push_back(
+        RingRow{std::stoi(f[0]), std::stoi(f[1]), std::stod(f[2]), std::stod(f[3]), f[4], f[5]});
+  }
+  return rows;
+}
 
 TEST(CastScan, FourBeamsAtHandComputedRanges) {
   const CliRun run = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0" + kFour);
@@ -262,6 +295,61 @@ TEST(CastScan, RepeatReportsTheMedianCastTime) {
   EXPECT_EQ(parse(run.out).size(), 360u);
 }
 
+// Three rings given out of order (ring 0 is the lowest) of three azimuths against a wall at x = 2
+// and a floor at z = -1: the wall at 2 / (cos el cos az), the floor at 1 / sin(-el) where nearer.
+TEST(CastScan, RingsAtHandComputedRanges) {
+  const CliRun run = runCli("--urdf " + kData +
+                            "cli_rings.urdf --sensor 0,0,0,0,0,0 --angle-min -0.4 --angle-max 0.4 "
+                            "--samples 3 --elevations 0.3,-0.6,0");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parseRings(run.out);
+  ASSERT_EQ(rows.size(), 9u);
+  const double elevations[3] = {-0.6, 0.0, 0.3};
+  for (int i = 0; i < 9; ++i) {
+    const int ring = i / 3;
+    const double el = elevations[ring], az = -0.4 + 0.4 * (i % 3);
+    EXPECT_EQ(rows[i].index, i);
+    EXPECT_EQ(rows[i].ring, ring);
+    EXPECT_NEAR(rows[i].elevation, el, 1e-9);
+    EXPECT_NEAR(rows[i].angle, az, 1e-9);
+    const double wall = 2 / (std::cos(el) * std::cos(az));
+    const double floor = el < 0 ? 1 / std::sin(-el) : HUGE_VAL;
+    EXPECT_NEAR(std::stod(rows[i].range), std::min(wall, floor), 1e-8) << i;
+    EXPECT_EQ(rows[i].link, floor < wall ? "floor" : "wall") << i;
+  }
+  EXPECT_NEAR(std::stod(rows[0].range), 1.77103220, 1e-8);  // 1 / sin 0.6
+  EXPECT_NEAR(std::stod(rows[4].range), 2.0, 1e-8);
+  EXPECT_NEAR(std::stod(rows[8].range), 2.27292570, 1e-8);  // 2 / (cos 0.3 cos 0.4)
+}
+
+// One ring at elevation 0 is the planar scan, with the ring columns.
+TEST(CastScan, OneRingAtZeroIsThePlanarScan) {
+  const std::string base = "--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0" + kFour;
+  const CliRun planar = runCli(base);
+  const CliRun ring = runCli(base + " --elevations 0");
+  ASSERT_EQ(ring.status, 0) << ring.err;
+  const auto p = parse(planar.out);
+  const auto r = parseRings(ring.out);
+  ASSERT_EQ(r.size(), 4u);
+  ASSERT_EQ(p.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(r[i].ring, 0);
+    EXPECT_EQ(r[i].elevation, 0.0);
+    EXPECT_EQ(r[i].range, p[i].range) << i;
+    EXPECT_EQ(r[i].link, p[i].link) << i;
+  }
+}
+
+TEST(CastScan, RepeatWithRings) {
+  const CliRun run = runCli("--urdf " + kData +
+                            "cli_rings.urdf --sensor 0,0,0,0,0,0 --samples 8 --elevations "
+                            "-0.2,0.2 --repeat 3");
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_TRUE(std::regex_search(run.err, std::regex("(^|\n)cast_ns_per_scan_median=[0-9]+\n")))
+      << run.err;
+  EXPECT_EQ(parseRings(run.out).size(), 16u);
+}
+
 TEST(CastScan, HelpExitsZero) {
   const CliRun run = runCli("--help");
   EXPECT_EQ(run.status, 0);
@@ -273,7 +361,7 @@ TEST(CastScan, HelpListsEveryFlag) {
   ASSERT_EQ(run.status, 0);
   for (const char* flag : {"--urdf", "--sensor", "--angle-min", "--angle-max", "--samples",
                            "--angle-increment", "--range-min", "--range-max", "--geometry",
-                           "--method", "--joint", "--repeat", "Exit status"}) {
+                           "--method", "--elevations", "--joint", "--repeat", "Exit status"}) {
     EXPECT_NE(run.out.find(flag), std::string::npos) << flag << "\n" << run.out;
   }
 }
@@ -316,6 +404,13 @@ TEST(CastScan, BadArgumentsExitTwo) {
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint plate_fix=1", "plate_fix");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint swing", "NAME=VALUE");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --repeat", "--repeat");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations ''", "--elevations");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,nan", "--elevations: 'nan'");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,,0.2", "--elevations: ''");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,", "--elevations: ''");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,0.1", "distinct");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0,2", "elevations[1]");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0 --elevations 1", "--elevations");
 }
 
 TEST(CastScan, FlagsAreNotAbbreviatedAndStrayWordsAreErrors) {
