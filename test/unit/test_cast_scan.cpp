@@ -48,12 +48,14 @@ struct Row {
   std::string link;
 };
 
-// Parses the CSV, checking the header and the shape of every row.
-std::vector<Row> parse(const std::string& csv) {
+// The rows of a CSV with this header, each split into as many fields as the header has (a trailing
+// empty field kept); a bad header or row is a test failure.
+std::vector<std::vector<std::string>> csvRows(const std::string& csv, const std::string& header) {
+  const std::size_t columns = std::count(header.begin(), header.end(), ',') + 1;
   std::istringstream in(csv);
   std::string line;
-  std::vector<Row> rows;
-  if (!std::getline(in, line) || line != "index,angle,range,link") {
+  std::vector<std::vector<std::string>> rows;
+  if (!std::getline(in, line) || line != header) {
     ADD_FAILURE() << "bad header: '" << line << "'";
     return rows;
   }
@@ -63,11 +65,19 @@ std::vector<Row> parse(const std::string& csv) {
     std::string f;
     while (std::getline(ls, f, ',')) fields.push_back(f);
     if (!line.empty() && line.back() == ',') fields.push_back("");
-    if (fields.size() != 4) {
+    if (fields.size() != columns) {
       ADD_FAILURE() << "bad row: '" << line << "'";
       continue;
     }
-    rows.push_back(Row{std::stoi(fields[0]), std::stod(fields[1]), fields[2], fields[3]});
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
+std::vector<Row> parse(const std::string& csv) {
+  std::vector<Row> rows;
+  for (const auto& f : csvRows(csv, "index,angle,range,link")) {
+    rows.push_back(Row{std::stoi(f[0]), std::stod(f[1]), f[2], f[3]});
   }
   return rows;
 }
@@ -80,25 +90,10 @@ struct RingRow {
   std::string range, link;
 };
 
-// Parses the CSV of a scan with --elevations, checking the header and the shape of every row.
+// The CSV of a scan with --elevations.
 std::vector<RingRow> parseRings(const std::string& csv) {
-  std::istringstream in(csv);
-  std::string line;
   std::vector<RingRow> rows;
-  if (!std::getline(in, line) || line != "index,ring,elevation,angle,range,link") {
-    ADD_FAILURE() << "bad header: '" << line << "'";
-    return rows;
-  }
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream ls(line);
-    std::string item;
-    while (std::getline(ls, item, ',')) f.push_back(item);
-    if (!line.empty() && line.back() == ',') f.push_back("");
-    if (f.size() != 6) {
-      ADD_FAILURE() << "bad row: '" << line << "'";
-      continue;
-    }
+  for (const auto& f : csvRows(csv, "index,ring,elevation,angle,range,link")) {
     rows.push_back(
         RingRow{std::stoi(f[0]), std::stoi(f[1]), std::stod(f[2]), std::stod(f[3]), f[4], f[5]});
   }
