@@ -35,11 +35,23 @@ struct Bin {
 
 // Binned SAH (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies", 2007): for
 // each axis, centroids are binned and the split plane between bins with the lowest cost is chosen.
+// With groups (e.g. a mesh's connected components), a group is never split between subtrees while
+// the node holds more than one group: the groups are partitioned first (SAH over their centroids),
+// then each group's triangles. So every subtree below some node holds exactly one group, and every
+// leaf does.
 class Builder {
  public:
-  Builder(const std::vector<BuildTriangle>& tris, const BvhConfig& config)
-      : tris_(tris), config_(config), order_(tris.size()) {
+  Builder(const std::vector<BuildTriangle>& tris, const BvhConfig& config,
+          const std::vector<std::uint32_t>& groups)
+      : tris_(tris), config_(config), groups_(groups), order_(tris.size()) {
     std::iota(order_.begin(), order_.end(), 0u);
+    if (groups_.empty()) return;
+    std::uint32_t count = 0;
+    for (const std::uint32_t g : groups_) count = std::max(count, g + 1);
+    group_centroid_.assign(count, Eigen::Vector3d::Zero());
+    std::vector<Aabb> group_bounds(count);
+    for (std::size_t i = 0; i < tris_.size(); ++i) group_bounds[groups_[i]].grow(tris_[i].bounds);
+    for (std::uint32_t g = 0; g < count; ++g) group_centroid_[g] = group_bounds[g].center();
   }
 
   void run() {
@@ -78,10 +90,32 @@ class Builder {
   int depth() const { return depth_; }
 
  private:
+  // The centroid a triangle is binned by: its own, or its group's while groups are split apart.
+  const Eigen::Vector3d& binCentroid(std::uint32_t tri, bool by_group) const {
+    return by_group ? group_centroid_[groups_[tri]] : tris_[tri].centroid;
+  }
+
+  bool holdsSeveralGroups(const Task& task) const {
+    if (groups_.empty()) return false;
+    const std::uint32_t first = groups_[order_[task.begin]];
+    for (std::uint32_t i = task.begin + 1; i < task.end; ++i) {
+      if (groups_[order_[i]] != first) return true;
+    }
+    return false;
+  }
+
   // Partitions [begin, end) and returns the split point; begin or end means "make a leaf".
-  std::uint32_t split(const Task& task, const Aabb& bounds, const Aabb& centroids) {
+  std::uint32_t split(const Task& task, const Aabb& bounds, const Aabb& triangle_centroids) {
     const std::uint32_t count = task.end - task.begin;
     if (count <= 1 || task.depth >= config_.max_depth) return task.begin;
+    const bool by_group = holdsSeveralGroups(task);
+    Aabb centroids = triangle_centroids;
+    if (by_group) {
+      centroids = Aabb{};
+      for (std::uint32_t i = task.begin; i < task.end; ++i) {
+        centroids.grow(binCentroid(order_[i], true));
+      }
+    }
     const int nbins = config_.bins;
     const double leaf_cost = count;
     double best_cost = std::numeric_limits<double>::infinity();
@@ -96,7 +130,8 @@ class Builder {
       std::fill(bins.begin(), bins.end(), Bin{});
       for (std::uint32_t i = task.begin; i < task.end; ++i) {
         const BuildTriangle& t = tris_[order_[i]];
-        Bin& bin = bins[binIndex(t.centroid[axis], centroids.lo[axis], scale)];
+        Bin& bin =
+            bins[binIndex(binCentroid(order_[i], by_group)[axis], centroids.lo[axis], scale)];
         bin.bounds.grow(t.bounds);
         ++bin.count;
       }
@@ -127,20 +162,33 @@ class Builder {
     const double split_cost = area > 0 ? config_.traversal_cost + best_cost / area
                                        : std::numeric_limits<double>::infinity();
     if (best_axis < 0) {
+      if (by_group) return splitGroupsByIndex(task);
       // All centroids coincide: no plane separates them. Halve by count if the leaf would be too
       // big.
       if (count <= static_cast<std::uint32_t>(config_.max_leaf_size)) return task.begin;
       return task.begin + count / 2;
     }
-    if (split_cost >= leaf_cost && count <= static_cast<std::uint32_t>(config_.max_leaf_size)) {
-      return task.begin;
-    }
+    const bool leaf_is_cheaper =
+        split_cost >= leaf_cost && count <= static_cast<std::uint32_t>(config_.max_leaf_size);
+    if (leaf_is_cheaper && !by_group) return task.begin;
     const double scale = nbins / extent[best_axis];
     const double lo = centroids.lo[best_axis];
     const auto it = std::partition(
         order_.begin() + task.begin, order_.begin() + task.end, [&](std::uint32_t i) {
-          return binIndex(tris_[i].centroid[best_axis], lo, scale) <= best_bin;
+          return binIndex(binCentroid(i, by_group)[best_axis], lo, scale) <= best_bin;
         });
+    return static_cast<std::uint32_t>(it - order_.begin());
+  }
+
+  // Several groups whose centroids coincide: the lower half of their indices goes left.
+  std::uint32_t splitGroupsByIndex(const Task& task) {
+    std::vector<std::uint32_t> present;
+    for (std::uint32_t i = task.begin; i < task.end; ++i) present.push_back(groups_[order_[i]]);
+    std::sort(present.begin(), present.end());
+    present.erase(std::unique(present.begin(), present.end()), present.end());
+    const std::uint32_t pivot = present[present.size() / 2];
+    const auto it = std::partition(order_.begin() + task.begin, order_.begin() + task.end,
+                                   [&](std::uint32_t i) { return groups_[i] < pivot; });
     return static_cast<std::uint32_t>(it - order_.begin());
   }
 
@@ -151,6 +199,8 @@ class Builder {
 
   const std::vector<BuildTriangle>& tris_;
   const BvhConfig& config_;
+  const std::vector<std::uint32_t>& groups_;  // per build triangle, or empty
+  std::vector<Eigen::Vector3d> group_centroid_;
   std::vector<std::uint32_t> order_;
   std::vector<BuildNode> nodes_;
   int depth_ = 0;
@@ -197,8 +247,13 @@ void BvhConfig::validate() const {
 
 template <typename T>
 BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
-                       const std::vector<TriangleIndices>& triangles, const BvhConfig& config) {
+                       const std::vector<TriangleIndices>& triangles, const BvhConfig& config,
+                       const std::vector<std::uint32_t>& groups) {
   config.validate();
+  if (!groups.empty() && groups.size() != triangles.size()) {
+    throw std::invalid_argument("BVH build: " + std::to_string(groups.size()) + " groups for " +
+                                std::to_string(triangles.size()) + " triangles");
+  }
   std::vector<BuildTriangle> build_tris;
   std::vector<std::uint32_t> kept;  // original index of each build triangle
   build_tris.reserve(triangles.size());
@@ -218,7 +273,12 @@ BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
   BvhT<T> bvh;
   if (build_tris.empty()) return bvh;
 
-  Builder builder(build_tris, config);
+  std::vector<std::uint32_t> build_groups;
+  if (!groups.empty()) {
+    build_groups.reserve(kept.size());
+    for (const std::uint32_t i : kept) build_groups.push_back(groups[i]);
+  }
+  Builder builder(build_tris, config, build_groups);
   builder.run();
   bvh.depth_ = builder.depth();
   const std::vector<BuildNode>& tree = builder.nodes();

@@ -27,7 +27,8 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
       }
     }
   }
-  bvh_ = Bvh::build(vertices_, triangles_, bvh_config);
+  labelComponents();
+  bvh_ = Bvh::build(vertices_, triangles_, bvh_config, component_);
   if (bvh_.empty()) {
     std::ostringstream msg;
     msg << "mesh has " << triangles_.size() << " triangles but all of them have zero area";
@@ -46,6 +47,35 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
   // Rounding of the squared norm and sqrt could put the farthest vertex just outside; widen by a
   // few ulps.
   sphere_radius_ = std::sqrt(r2) * (1 + 4 * std::numeric_limits<double>::epsilon());
+  std::vector<std::uint32_t> slot_component;
+  slot_component.reserve(bvh_.triangleIds().size());
+  for (const std::uint32_t id : bvh_.triangleIds()) slot_component.push_back(component_[id]);
+  wide_ = WideBvh(bvh_, slot_component);
+}
+
+// Union-find over vertex indices: triangles sharing a vertex index are in one component. Only
+// shared indices count (not equal positions): they are what makes a shared edge watertight.
+void Mesh::labelComponents() {
+  std::vector<std::uint32_t> parent(vertices_.size());
+  for (std::uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
+  auto find = [&](std::uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const TriangleIndices& tri : triangles_) {
+    for (int k = 1; k < 3; ++k) {
+      const std::uint32_t a = find(tri[0]), b = find(tri[k]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<std::uint32_t> number(vertices_.size(), std::numeric_limits<std::uint32_t>::max());
+  component_.resize(triangles_.size());
+  component_count_ = 0;
+  for (std::size_t t = 0; t < triangles_.size(); ++t) {
+    std::uint32_t& n = number[find(triangles_[t][0])];
+    if (n == std::numeric_limits<std::uint32_t>::max()) n = component_count_++;
+    component_[t] = n;
+  }
 }
 
 Eigen::Vector3d Mesh::normal(std::uint32_t triangle) const {

@@ -34,6 +34,7 @@ struct MeshHitT {
   T u, v;                  // barycentric weights of the triangle's second and third vertex
   std::uint32_t triangle;  // index into the mesh's triangle list
 };
+using MeshHit = MeshHitT<double>;
 
 template <typename T>
 class BvhT {
@@ -68,9 +69,12 @@ class BvhT {
 
   // Builds over the non-degenerate triangles (degenerate ones can never be hit and are left out).
   // The vertices are double; a float BVH stores them rounded to float. Indices must be in range
-  // (Mesh checks).
+  // (Mesh checks). With groups (one id per triangle, e.g. its connected component), each group
+  // fills whole subtrees: a node holding several groups never splits one of them, so every leaf
+  // holds one group (unless max_depth stops the split first).
   static BvhT build(const std::vector<Eigen::Vector3d>& vertices,
-                    const std::vector<TriangleIndices>& triangles, const BvhConfig& config = {});
+                    const std::vector<TriangleIndices>& triangles, const BvhConfig& config = {},
+                    const std::vector<std::uint32_t>& groups = {});
 
   // The inner nodes, depth first (a parent before its children); the tree starts at root().
   const std::vector<Node>& nodes() const { return nodes_; }

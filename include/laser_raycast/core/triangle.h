@@ -29,6 +29,14 @@
 #include "laser_raycast/core/enum_names.h"
 #include "laser_raycast/core/ray.h"
 
+// Triangle tests sit in the innermost loops of the BVH walks; GCC and Clang would otherwise keep
+// the larger ones out of line there.
+#if defined(__GNUC__)
+#define LASER_RAYCAST_HOT_INLINE __attribute__((always_inline)) inline
+#else
+#define LASER_RAYCAST_HOT_INLINE inline
+#endif
+
 namespace laser_raycast {
 namespace core {
 
@@ -124,8 +132,10 @@ class PreparedRay<T, TriangleMethod::kSeedPlane> {
  public:
   PreparedRay(const RayT<T>& ray, bool cull_backfaces) : ray_(ray), cull_(cull_backfaces) {}
 
-  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
-                                           T tmax) const {
+  LASER_RAYCAST_HOT_INLINE std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a,
+                                                                    const Vec3<T>& b,
+                                                                    const Vec3<T>& c,
+                                                                    T tmax) const {
     const Vec3<T> n = (b - a).cross(c - b);
     const T h_w = -n.dot(a);
     const T denom = n.dot(ray_.dir);  // H.[W,0]
@@ -156,8 +166,10 @@ class PreparedRay<T, TriangleMethod::kSeedUv> {
  public:
   PreparedRay(const RayT<T>& ray, bool cull_backfaces) : ray_(ray), cull_(cull_backfaces) {}
 
-  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
-                                           T tmax) const {
+  LASER_RAYCAST_HOT_INLINE std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a,
+                                                                    const Vec3<T>& b,
+                                                                    const Vec3<T>& c,
+                                                                    T tmax) const {
     const Vec3<T> ab = b - a;
     const Vec3<T> ac = c - a;
     Vec3<T> n = ac.cross(ab);
@@ -198,8 +210,10 @@ class PreparedRay<T, TriangleMethod::kCramer> {
  public:
   PreparedRay(const RayT<T>& ray, bool cull_backfaces) : ray_(ray), cull_(cull_backfaces) {}
 
-  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
-                                           T tmax) const {
+  LASER_RAYCAST_HOT_INLINE std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a,
+                                                                    const Vec3<T>& b,
+                                                                    const Vec3<T>& c,
+                                                                    T tmax) const {
     const Vec3<T> e1 = a - b;
     const Vec3<T> e2 = a - c;
     const Vec3<T> r = a - ray_.origin;
@@ -227,8 +241,10 @@ class PreparedRay<T, TriangleMethod::kMollerTrumbore> {
  public:
   PreparedRay(const RayT<T>& ray, bool cull_backfaces) : ray_(ray), cull_(cull_backfaces) {}
 
-  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
-                                           T tmax) const {
+  LASER_RAYCAST_HOT_INLINE std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a,
+                                                                    const Vec3<T>& b,
+                                                                    const Vec3<T>& c,
+                                                                    T tmax) const {
     const Vec3<T> e1 = b - a;
     const Vec3<T> e2 = c - a;
     const Vec3<T> p = ray_.dir.cross(e2);
@@ -283,8 +299,10 @@ class PreparedRay<T, TriangleMethod::kWatertight> {
     sz_ = T(1) / ray.dir[kz_];
   }
 
-  std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
-                                           T tmax) const {
+  LASER_RAYCAST_HOT_INLINE std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a,
+                                                                    const Vec3<T>& b,
+                                                                    const Vec3<T>& c,
+                                                                    T tmax) const {
     // Translate to the ray origin, then shear x and y (z is scaled only once the hit is known).
     const Vec3<T> pa = a - origin_;
     const Vec3<T> pb = b - origin_;

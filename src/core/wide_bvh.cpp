@@ -1,0 +1,283 @@
+#include "laser_raycast/core/wide_bvh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+// A binary subtree with its (float, outward-rounded) box, while a wide node gathers its children.
+struct Gathered {
+  Bvh::Child child;
+  float lo[3], hi[3];
+  float halfArea() const {
+    const float x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
+    return x * y + y * z + z * x;
+  }
+};
+
+}  // namespace
+
+WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) : bvh_(&bvh) {
+  if (bvh.empty()) return;
+  const auto& binary = bvh.nodes();
+  // The group and triangle count of a binary subtree, and its collapsed wide reference.
+  struct Summary {
+    Ref ref;
+    std::int32_t group;
+    std::uint32_t triangles;
+  };
+  auto leafGroup = [&](const Bvh::Child& leaf) -> std::int32_t {
+    if (slot_group.empty()) return -1;
+    const std::uint32_t g = slot_group[leaf.index];
+    bool mixed = false;
+    for (std::uint32_t s = leaf.index + 1; s < leaf.index + leaf.count; ++s) {
+      mixed |= slot_group[s] != g;
+    }
+    if (!mixed) return static_cast<std::int32_t>(g);
+    for (std::uint32_t s = leaf.index; s < leaf.index + leaf.count; ++s) {
+      if (slot_group[s] >= group_in_mixed_leaf_.size()) {
+        group_in_mixed_leaf_.resize(slot_group[s] + 1, 0);
+      }
+      group_in_mixed_leaf_[slot_group[s]] = 1;
+    }
+    return -1;
+  };
+  // Each binary inner node's slot range (a subtree's slots are contiguous: the builder partitions
+  // in place) and whether it holds a single group; children come after their parent.
+  struct Span {
+    std::uint32_t first, count;
+    bool one_group;
+  };
+  std::vector<Span> span(binary.size());
+  for (std::size_t n = binary.size(); n-- > 0;) {
+    Span out{std::numeric_limits<std::uint32_t>::max(), 0, true};
+    for (int k = 0; k < 2; ++k) {
+      const Bvh::Child c = binary[n].child[k];
+      const Span sub = c.isLeaf() ? Span{c.index, c.count, true} : span[c.index];
+      out.first = std::min(out.first, sub.first);
+      out.count += sub.count;
+      out.one_group = out.one_group && sub.one_group;
+    }
+    out.one_group =
+        out.one_group &&
+        (slot_group.empty() ||
+         std::all_of(slot_group.begin() + out.first, slot_group.begin() + out.first + out.count,
+                     [&](std::uint32_t g) { return g == slot_group[out.first]; }));
+    span[n] = out;
+  }
+  // A small subtree of one group becomes one leaf: a few more triangle tests cost less than the
+  // node visits they replace.
+  auto asLeaf = [&](const Bvh::Child& c) -> std::optional<Bvh::Child> {
+    if (c.isLeaf()) return c;
+    const Span& sub = span[c.index];
+    if (sub.count <= kMaxLeafTriangles && sub.one_group) return Bvh::Child{sub.first, sub.count};
+    return std::nullopt;
+  };
+  // Depth-first; the binary tree's depth is bounded (BvhConfig::max_depth), so recursion is too.
+  auto collapse = [&](auto&& self, const Bvh::Child& child) -> Summary {
+    if (const auto leaf = asLeaf(child)) {
+      return Summary{Ref{leaf->index, leaf->count}, leafGroup(*leaf), leaf->count};
+    }
+    // Open the largest inner child until there are kWidth children or only leaves.
+    std::vector<Gathered> gathered;
+    auto open = [&](const Bvh::Child& inner) {
+      const auto& node = binary[inner.index];
+      for (int k = 0; k < 2; ++k) {
+        Gathered g;
+        g.child = node.child[k];
+        for (int a = 0; a < 3; ++a) {
+          g.lo[a] = node.lo[k][a];
+          g.hi[a] = node.hi[k][a];
+        }
+        gathered.push_back(g);
+      }
+    };
+    open(child);
+    while (static_cast<int>(gathered.size()) < kWidth) {
+      int best = -1;
+      for (int k = 0; k < static_cast<int>(gathered.size()); ++k) {
+        if (asLeaf(gathered[k].child)) continue;
+        if (best < 0 || gathered[k].halfArea() > gathered[best].halfArea()) best = k;
+      }
+      if (best < 0) break;
+      const Bvh::Child inner = gathered[best].child;
+      gathered.erase(gathered.begin() + best);
+      open(inner);
+    }
+    const auto index = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.emplace_back();
+    child_group_.resize(nodes_.size() * kWidth, -1);
+    child_triangles_.resize(nodes_.size() * kWidth, 0);
+    Summary out{Ref{index, 0}, -2, 0};  // -2: no child seen yet
+    for (int k = 0; k < kWidth; ++k) {
+      Node& node = nodes_[index];
+      if (k >= static_cast<int>(gathered.size())) {
+        for (int a = 0; a < 3; ++a) {
+          node.lo[a][k] = std::numeric_limits<float>::infinity();
+          node.hi[a][k] = -std::numeric_limits<float>::infinity();
+        }
+        node.index[k] = kEmpty;
+        node.count[k] = 0;
+        continue;
+      }
+      const Summary sub = self(self, gathered[k].child);  // may grow nodes_
+      Node& filled = nodes_[index];
+      for (int a = 0; a < 3; ++a) {
+        filled.lo[a][k] = gathered[k].lo[a];
+        filled.hi[a][k] = gathered[k].hi[a];
+      }
+      filled.index[k] = sub.ref.index;
+      filled.count[k] = sub.ref.count;
+      child_group_[index * kWidth + k] = sub.group;
+      child_triangles_[index * kWidth + k] = sub.triangles;
+      out.group = out.group == -2 || out.group == sub.group ? sub.group : -1;
+      out.triangles += sub.triangles;
+    }
+    return out;
+  };
+  const Summary root = collapse(collapse, bvh.root());
+  root_ = root.ref;
+  root_group_ = root.group;
+  root_triangles_ = root.triangles;
+}
+
+template <TriangleMethod M>
+WideRay<M>::WideRay(const Ray& ray, bool cull_backfaces, const Aabb& bounds)
+    : prepared_(ray, cull_backfaces),
+      tmin_(ray.tmin),
+      reach_((bounds.lo - ray.origin)
+                 .cwiseAbs()
+                 .cwiseMax((bounds.hi - ray.origin).cwiseAbs())
+                 .maxCoeff() /
+             ray.dir.cwiseAbs().maxCoeff()) {
+  constexpr std::uint32_t kLo = offsetof(WideBvh::Node, lo), kHi = offsetof(WideBvh::Node, hi);
+  for (int k = 0; k < 3; ++k) {
+    // Adding +0 turns -0 into +0, so a zero component gives +inf and counts as positive (see
+    // SlabRay): a ray lying in a slab plane then gives NaN there, which never narrows the interval.
+    const double d = ray.dir[k] + 0.0;
+    const bool positive = !(d < 0);
+    const auto axis = static_cast<std::uint32_t>(k * WideBvh::kWidth * sizeof(float));
+    near_offset_[k] = (positive ? kLo : kHi) + axis;
+    far_offset_[k] = (positive ? kHi : kLo) + axis;
+    // The near plane minus the origin must not come out larger than exact, nor the far one smaller:
+    // for a positive direction that is the origin rounded up for the near plane (lo) and down for
+    // the far plane (hi); for a negative one the other way round.
+    const float up = floatAbove(ray.origin[k]), down = floatBelow(ray.origin[k]);
+    origin_near_[k] = positive ? up : down;
+    origin_far_[k] = positive ? down : up;
+    inv_dir_[k] = static_cast<float>(1.0 / d);
+  }
+}
+
+template <TriangleMethod M>
+bool WideRay<M>::closestHit(const WideBvh& bvh, WideBvh::Ref start, const float* start_lo,
+                            const float* start_hi, double* tmax,
+                            std::optional<MeshHit>* best) const {
+  if (start.isEmpty()) return false;
+  const Bvh& binary = bvh.binary();
+  const auto& slots = binary.triangleVertices();
+  const auto& ids = binary.triangleIds();
+  // Boxes are culled against [tmin, tmax] widened as BvhT::traverse does (see there): a hit's t and
+  // its box's entry and exit round differently.
+  constexpr double kWiden = 64 * std::numeric_limits<double>::epsilon();
+  const float tnear0 = floatBelow(tmin_ - (std::abs(tmin_) + reach_) * kWiden);
+  float cull = floatAbove(*tmax + (std::abs(*tmax) + reach_) * kWiden);
+  constexpr float kWidenExit = 1 + 2 * roundingGamma<float>(3);
+  constexpr std::uint32_t kLo = offsetof(WideBvh::Node, lo);
+
+  // The start box, scalar, with the same arithmetic as the four-wide test below.
+  {
+    float tnear = tnear0, tfar = std::numeric_limits<float>::infinity();
+    for (int k = 0; k < 3; ++k) {
+      const bool positive = near_offset_[k] == kLo + k * WideBvh::kWidth * sizeof(float);
+      const float t0 = ((positive ? start_lo : start_hi)[k] - origin_near_[k]) * inv_dir_[k];
+      const float t1 = ((positive ? start_hi : start_lo)[k] - origin_far_[k]) * inv_dir_[k];
+      tnear = t0 > tnear ? t0 : tnear;  // NaN never replaces tnear
+      tfar = t1 < tfar ? t1 : tfar;     // nor tfar
+    }
+    tfar *= kWidenExit;
+    if (!(tnear <= (tfar < cull ? tfar : cull))) return false;
+  }
+
+  const __m128 tnear0_ps = _mm_set1_ps(tnear0), widen = _mm_set1_ps(kWidenExit);
+  __m128 origin_near[3], origin_far[3], inv_dir[3];
+  for (int k = 0; k < 3; ++k) {
+    origin_near[k] = _mm_set1_ps(origin_near_[k]);
+    origin_far[k] = _mm_set1_ps(origin_far_[k]);
+    inv_dir[k] = _mm_set1_ps(inv_dir_[k]);
+  }
+  struct Entry {
+    WideBvh::Ref ref;
+    float t_entry;
+  };
+  Entry stack[64 * (WideBvh::kWidth - 1) + 1];
+  int top = 0;
+  stack[top++] = Entry{start, tnear0};
+  bool improved = false;
+  const WideBvh::Node* nodes = bvh.nodes().data();
+  while (top > 0) {
+    const Entry entry = stack[--top];
+    if (entry.t_entry > cull) continue;
+    if (entry.ref.isLeaf()) {
+      const std::uint32_t end = entry.ref.index + entry.ref.count;
+      for (std::uint32_t slot = entry.ref.index; slot < end; ++slot) {
+        const auto& tri = slots[slot];
+        const auto hit = prepared_.intersect(tri[0], tri[1], tri[2], *tmax);
+        if (!hit) continue;
+        const std::uint32_t id = ids[slot];
+        if (*best && !(hit->t < (*best)->t || ((*best)->t == hit->t && id < (*best)->triangle))) {
+          continue;
+        }
+        *best = MeshHit{hit->t, hit->u, hit->v, id};
+        improved = true;
+        *tmax = hit->t;
+        cull = floatAbove(*tmax + (std::abs(*tmax) + reach_) * kWiden);
+      }
+      continue;
+    }
+    // The four children at once: entry through the near planes, exit through the far ones.
+    const WideBvh::Node& node = nodes[entry.ref.index];
+    const char* base = reinterpret_cast<const char*>(&node);
+    __m128 tnear = tnear0_ps;
+    __m128 tfar = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    for (int k = 0; k < 3; ++k) {
+      const __m128 near_plane = _mm_load_ps(reinterpret_cast<const float*>(base + near_offset_[k]));
+      const __m128 far_plane = _mm_load_ps(reinterpret_cast<const float*>(base + far_offset_[k]));
+      // maxps/minps return their second operand when either is NaN (a ray lying in a slab plane):
+      // it never narrows the interval, as in slabTest.
+      tnear = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near_plane, origin_near[k]), inv_dir[k]), tnear);
+      tfar = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far_plane, origin_far[k]), inv_dir[k]), tfar);
+    }
+    tfar = _mm_min_ps(_mm_mul_ps(tfar, widen), _mm_set1_ps(cull));
+    int mask = _mm_movemask_ps(_mm_cmple_ps(tnear, tfar));
+    if (!mask) continue;
+    alignas(16) float t_entry[4];
+    _mm_store_ps(t_entry, tnear);
+    // Push the children met, farthest first, so that the nearest is visited next.
+    int order[4], n = 0;
+    while (mask) {
+      const int k = __builtin_ctz(static_cast<unsigned>(mask));
+      mask &= mask - 1;
+      int j = n++;
+      for (; j > 0 && t_entry[order[j - 1]] < t_entry[k]; --j) order[j] = order[j - 1];
+      order[j] = k;
+    }
+    for (int j = 0; j < n; ++j) {
+      const int k = order[j];
+      stack[top++] = Entry{WideBvh::Ref{node.index[k], node.count[k]}, t_entry[k]};
+    }
+  }
+  return improved;
+}
+
+template class WideRay<TriangleMethod::kSeedPlane>;
+template class WideRay<TriangleMethod::kSeedUv>;
+template class WideRay<TriangleMethod::kCramer>;
+template class WideRay<TriangleMethod::kMollerTrumbore>;
+template class WideRay<TriangleMethod::kWatertight>;
+
+}  // namespace core
+}  // namespace laser_raycast

@@ -1,0 +1,232 @@
+// WideBvh and WideRay: the 4-wide BVH's structure (every triangle slot in exactly one leaf, boxes
+// that contain their subtrees, groups in whole subtrees) and its traversal against brute force, for
+// every triangle method, with rays aimed at box faces and edges where rounding decides.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "laser_raycast/core/mesh.h"
+#include "laser_raycast/core/wide_bvh.h"
+#include "mesh_builder.h"
+#include "random.h"
+#include "test_geometry.h"
+#include "triangle_soup.h"
+
+namespace laser_raycast_test {
+namespace {
+
+using core::Bvh;
+using core::MeshHit;
+using core::TriangleMethod;
+using core::WideBvh;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Walks the tree from the root with each subtree's box; fn(slot, box) for every slot.
+template <class Fn>
+void forEachSlot(const WideBvh& w, Fn&& fn) {
+  struct Item {
+    WideBvh::Ref ref;
+    Eigen::Vector3d lo, hi;
+  };
+  const core::Aabb& b = w.binary().bounds();
+  std::vector<Item> todo{{w.root(), b.lo, b.hi}};
+  while (!todo.empty()) {
+    const Item item = todo.back();
+    todo.pop_back();
+    if (item.ref.isLeaf()) {
+      for (std::uint32_t s = item.ref.index; s < item.ref.index + item.ref.count; ++s) {
+        fn(s, item.lo, item.hi);
+      }
+      continue;
+    }
+    const WideBvh::Node& node = w.nodes()[item.ref.index];
+    for (int k = 0; k < WideBvh::kWidth; ++k) {
+      if (node.index[k] == WideBvh::kEmpty) continue;
+      const Eigen::Vector3d lo(node.lo[0][k], node.lo[1][k], node.lo[2][k]);
+      const Eigen::Vector3d hi(node.hi[0][k], node.hi[1][k], node.hi[2][k]);
+      // A child's box lies within its parent's (both rounded outward from exact bounds).
+      EXPECT_TRUE((lo.array() >= item.lo.array() - 1e-6 * (1 + item.lo.array().abs())).all());
+      todo.push_back({node.child(k), lo, hi});
+    }
+  }
+}
+
+TEST(WideBvh, EverySlotOnceInsideItsBoxes) {
+  Rng rng(11);
+  for (const int n : {1, 2, 7, 300, 5000}) {
+    const Soup s = n % 2 ? spreadSoup(rng, n) : clusteredSoup(rng, n);
+    const core::Mesh mesh(s.vertices, s.triangles);
+    const WideBvh& w = mesh.wideBvh();
+    std::vector<int> seen(mesh.bvh().triangleIds().size(), 0);
+    forEachSlot(w, [&](std::uint32_t slot, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+      ++seen[slot];
+      for (const auto& v : mesh.bvh().triangleVertices()[slot]) {
+        EXPECT_TRUE((v.array() >= lo.array()).all() && (v.array() <= hi.array()).all())
+            << "slot " << slot << " vertex " << v.transpose();
+      }
+    });
+    for (std::size_t slot = 0; slot < seen.size(); ++slot) EXPECT_EQ(seen[slot], 1) << slot;
+    if (n > 100) EXPECT_LT(w.nodes().size(), seen.size());  // four-wide: fewer nodes than slots
+  }
+}
+
+// Prisms that do not touch: one component each. Every subtree below a node with one group holds
+// only that group's triangles, and the group tags say so.
+TEST(WideBvh, ComponentsFillWholeSubtrees) {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<core::TriangleIndices> triangles;
+  Rng rng(5);
+  for (int k = 0; k < 40; ++k) {
+    const auto prism = makePrism(circle(12, uniform(rng, 0.1, 0.4)), {-1.0, 0.0, 1.0, 2.0});
+    const Eigen::Vector3d at(uniform(rng, -20, 20), uniform(rng, -20, 20), 0);
+    const auto base = static_cast<std::uint32_t>(vertices.size());
+    for (const auto& v : prism.vertices) vertices.push_back(v + at);
+    for (auto t : prism.triangles) triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  const core::Mesh mesh(vertices, triangles);
+  ASSERT_EQ(mesh.componentCount(), 40u);
+  const WideBvh& w = mesh.wideBvh();
+  const auto& ids = mesh.bvh().triangleIds();
+  int tagged = 0;
+  for (std::uint32_t n = 0; n < w.nodes().size(); ++n) {
+    for (int k = 0; k < WideBvh::kWidth; ++k) {
+      const std::int32_t group = w.childGroup(n, k);
+      if (group < 0 || w.nodes()[n].index[k] == WideBvh::kEmpty) continue;
+      ++tagged;
+      // Every slot below carries that group.
+      std::vector<WideBvh::Ref> todo{w.nodes()[n].child(k)};
+      std::uint32_t count = 0;
+      while (!todo.empty()) {
+        const WideBvh::Ref r = todo.back();
+        todo.pop_back();
+        if (r.isLeaf()) {
+          for (std::uint32_t s = r.index; s < r.index + r.count; ++s, ++count) {
+            EXPECT_EQ(mesh.components()[ids[s]], static_cast<std::uint32_t>(group));
+          }
+          continue;
+        }
+        for (int j = 0; j < WideBvh::kWidth; ++j) {
+          if (w.nodes()[r.index].index[j] != WideBvh::kEmpty) {
+            todo.push_back(w.nodes()[r.index].child(j));
+          }
+        }
+      }
+      EXPECT_EQ(count, w.childTriangles(n, k));
+    }
+  }
+  EXPECT_GT(tagged, 40);
+  for (std::int32_t g = 0; g < 40; ++g) EXPECT_FALSE(w.groupInMixedLeaf(g));
+}
+
+template <TriangleMethod M>
+std::optional<MeshHit> wideHit(const core::Mesh& mesh, const core::Ray& ray) {
+  const WideBvh& w = mesh.wideBvh();
+  const core::WideRay<M> wide(ray, false, mesh.bvh().bounds());
+  const core::Aabb& b = mesh.bvh().bounds();
+  float lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = core::floatBelow(b.lo[a]);
+    hi[a] = core::floatAbove(b.hi[a]);
+  }
+  double tmax = ray.tmax;
+  std::optional<MeshHit> best;
+  wide.closestHit(w, w.root(), lo, hi, &tmax, &best);
+  return best;
+}
+
+// The same nearest distance as brute force (which triangle, where two are as near, may differ:
+// the wide walk keeps the lower index, brute force the last one it tried).
+template <TriangleMethod M>
+void expectLikeBruteForce(const core::Mesh& mesh, const core::Ray& ray) {
+  const auto wide = wideHit<M>(mesh, ray);
+  const auto brute = core::bruteForceClosestHit(M, mesh.vertices(), mesh.triangles(), ray, false);
+  ASSERT_EQ(wide.has_value(), brute.has_value())
+      << core::toString(M) << " origin " << ray.origin.transpose() << " dir "
+      << ray.dir.transpose();
+  if (wide) {
+    EXPECT_EQ(wide->t, brute->t) << core::toString(M);
+    const auto& t = mesh.triangles()[wide->triangle];
+    const auto again = core::intersectTriangle<M>(ray, mesh.vertices()[t[0]], mesh.vertices()[t[1]],
+                                                  mesh.vertices()[t[2]]);
+    ASSERT_TRUE(again.has_value());
+    EXPECT_EQ(again->t, wide->t);
+  }
+}
+
+TEST(WideRay, NearestHitEqualsBruteForceForEveryMethod) {
+  Rng rng(17);
+  int hits = 0;
+  for (int scene = 0; scene < 6; ++scene) {
+    const Soup s = scene % 2 ? spreadSoup(rng, 800) : clusteredSoup(rng, 800);
+    const core::Mesh mesh(s.vertices, s.triangles);
+    for (int i = 0; i < 300; ++i) {
+      core::Ray ray;
+      ray.origin = uniformInCube(rng, 14);
+      // Aim at a vertex or a point of a triangle half of the time: hits, edges and corners.
+      const auto& tri = s.triangles[static_cast<std::size_t>(i) % s.triangles.size()];
+      const Eigen::Vector2d uv = randomBarycentrics(rng);
+      const Eigen::Vector3d target = i % 3 == 0 ? s.vertices[tri[0]]
+                                                : (1 - uv.x() - uv.y()) * s.vertices[tri[0]] +
+                                                      uv.x() * s.vertices[tri[1]] +
+                                                      uv.y() * s.vertices[tri[2]];
+      ray.dir = i % 2 ? (target - ray.origin).normalized() : randomUnitVector(rng);
+      ray.tmin = i % 5 == 0 ? uniform(rng, 0, 3) : 0.0;
+      ray.tmax = i % 4 == 0 ? uniform(rng, 1, 40) : kInf;
+      expectLikeBruteForce<TriangleMethod::kWatertight>(mesh, ray);
+      expectLikeBruteForce<TriangleMethod::kMollerTrumbore>(mesh, ray);
+      expectLikeBruteForce<TriangleMethod::kCramer>(mesh, ray);
+      expectLikeBruteForce<TriangleMethod::kSeedPlane>(mesh, ray);
+      expectLikeBruteForce<TriangleMethod::kSeedUv>(mesh, ray);
+      hits += wideHit<TriangleMethod::kWatertight>(mesh, ray).has_value();
+      if (HasFailure()) return;
+    }
+  }
+  EXPECT_GT(hits, 600);
+}
+
+// Axis-aligned rays and rays lying exactly in box faces (the float boxes are rounded outward, and
+// a ray in a slab plane gives NaN there): a grid of axis-aligned squares, rays along the grid
+// lines.
+TEST(WideRay, AxisAlignedRaysInBoxFacesFindTheirHits) {
+  const auto grid = gridBox(steps(-2, 2, 9), steps(-2, 2, 9), steps(-1, 1, 5), false);
+  int hits = 0;
+  for (const double y : steps(-2, 2, 9)) {
+    for (const double z : steps(-1, 1, 5)) {
+      for (const double sign : {1.0, -1.0}) {
+        core::Ray ray;
+        ray.origin = Eigen::Vector3d(0, y, z);
+        ray.dir = Eigen::Vector3d(sign, 0, 0);
+        expectLikeBruteForce<TriangleMethod::kWatertight>(*grid, ray);
+        ray.origin = Eigen::Vector3d(y, 0.5 * z, 0);
+        ray.dir = Eigen::Vector3d(0, 0, sign);
+        expectLikeBruteForce<TriangleMethod::kWatertight>(*grid, ray);
+        hits += wideHit<TriangleMethod::kWatertight>(*grid, ray).has_value();
+      }
+    }
+  }
+  EXPECT_GT(hits, 50);
+}
+
+TEST(FloatRounding, BelowAndAboveBracketTheDouble) {
+  Rng rng(3);
+  for (int i = 0; i < 100000; ++i) {
+    const double x = (i % 2 ? 1 : -1) * std::pow(10.0, uniform(rng, -40, 38));
+    const float lo = core::floatBelow(x), hi = core::floatAbove(x);
+    EXPECT_LE(double(lo), x);
+    EXPECT_GE(double(hi), x);
+    EXPECT_LE(std::nextafter(lo, std::numeric_limits<float>::infinity()), hi);
+  }
+  EXPECT_EQ(core::floatBelow(0.0), 0.0f);
+  EXPECT_EQ(core::floatBelow(1.0), 1.0f);
+  EXPECT_LT(core::floatBelow(0.1), 0.1);
+  EXPECT_GT(core::floatAbove(0.1), 0.1);
+  EXPECT_TRUE(std::isnan(core::floatBelow(std::numeric_limits<double>::quiet_NaN())));
+}
+
+}  // namespace
+}  // namespace laser_raycast_test
