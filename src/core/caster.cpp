@@ -4,60 +4,33 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
+#include "laser_raycast/core/beam_set.h"
 #include "laser_raycast/core/beam_window.h"
-#include "laser_raycast/core/fan_slicer.h"
+#include "laser_raycast/core/body_traversal.h"
 #include "laser_raycast/core/pose.h"
+#include "laser_raycast/core/thread_pool.h"
 
 namespace laser_raycast {
 namespace core {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// More threads than this is a mistake, not a machine.
+constexpr int kMaxThreads = 1024;
 
-// What tracing one beam through a mesh costs, in units of placing one slice segment (see
-// castBodies): on the benchmark's scenes a traversal takes about 150-300 ns and a segment 60-100
-// ns. Only speed depends on it.
-constexpr double kBeamCostInSegments = 2.0;
+// A cast is split between threads only if each gets at least this many beams: a 2D fan of a few
+// thousand beams is cast in tens of microseconds, about what handing work to another thread costs.
+constexpr int kMinBeamsPerThread = 4096;
 
-// One beam's nearest hit on one body: distance, triangle (-1 for a primitive), and the surface
-// normal in the body's frame (a mesh triangle's front normal, a primitive's outward normal).
-struct BodyHit {
-  double t;
-  int triangle;
-  Eigen::Vector3d normal;
-};
-
-// One beam (unit direction in the sensor frame) against one body, with t in [tmin, tmax].
-template <TriangleMethod M>
-std::optional<BodyHit> intersectBody(const Body& body, const Caster::ActiveBody& active,
-                                     const Eigen::Vector3d& dir, double tmin, double tmax,
-                                     bool cull_backfaces) {
-  Ray ray;
-  ray.origin = active.sensor_in_body;
-  ray.dir = active.body_from_sensor_rot * dir;
-  ray.tmin = tmin;
-  ray.tmax = tmax;
-  std::optional<PrimitiveHit> primitive;
-  switch (body.shape.index()) {
-    case 0:
-      primitive = intersect(ray, std::get<Box>(body.shape));
-      break;
-    case 1:
-      primitive = intersect(ray, std::get<Cylinder>(body.shape));
-      break;
-    case 2:
-      primitive = intersect(ray, std::get<Sphere>(body.shape));
-      break;
-    default: {
-      const auto& mesh = std::get<std::shared_ptr<const Mesh>>(body.shape);
-      const auto hit = mesh->bvh().closestHit<M>(ray, cull_backfaces);
-      if (!hit) return std::nullopt;
-      return BodyHit{hit->t, static_cast<int>(hit->triangle), mesh->normal(hit->triangle)};
-    }
-  }
-  if (!primitive) return std::nullopt;
-  return BodyHit{primitive->t, -1, primitive->normal};
+// Columns per piece of work when a cast is split between threads: whole coarse occlusion tiles, so
+// that no tile is written by two threads, and several pieces per thread to even out the load.
+int chunkColumns(int columns, int threads) {
+  const int unit = OcclusionTiles::kCoarseWidth;
+  const int pieces = threads * 4;
+  const int width = (columns + pieces - 1) / pieces;
+  return std::max(unit, (width + unit - 1) / unit * unit);
 }
 
 }  // namespace
@@ -68,6 +41,8 @@ void CastConfig::validate() const {
     msg << "tmin must be finite and >= 0, got " << tmin;
   } else if (!(tmax > tmin)) {
     msg << "tmax (" << tmax << " m) must be greater than tmin (" << tmin << " m)";
+  } else if (threads < 0 || threads > kMaxThreads) {
+    msg << "threads must be in [0, " << kMaxThreads << "] (0: every core), got " << threads;
   } else {
     return;
   }
@@ -77,8 +52,14 @@ void CastConfig::validate() const {
 bool CastConfig::operator==(const CastConfig& o) const {
   return method == o.method && cull_backfaces == o.cull_backfaces && tmin == o.tmin &&
          tmax == o.tmax && planar_fast_path == o.planar_fast_path &&
+         raster_fast_path == o.raster_fast_path && occlusion_culling == o.occlusion_culling &&
          compute_incidence == o.compute_incidence;
 }
+
+Caster::Caster() : beams_(std::make_unique<BeamSet>()) {}
+Caster::~Caster() = default;
+Caster::Caster(Caster&&) noexcept = default;
+Caster& Caster::operator=(Caster&&) noexcept = default;
 
 bool Caster::ReuseKey::operator==(const ReuseKey& o) const {
   if (scene_version != o.scene_version || !(config == o.config) || angle_min != o.angle_min ||
@@ -161,8 +142,9 @@ void Caster::resetResult(int beams, int bodies, bool sensor_ok, bool with_normal
   result_.stats.bodies = bodies;
 }
 
-// Each body's pose relative to the sensor, then culled by bounding sphere against the search
-// interval, the scan plane (planar fans) and the fan's azimuths; the rest sorted nearest first.
+// Each body's pose relative to the sensor, then culled by its bounding sphere against the search
+// interval and by its box's view against the scan plane (planar fans) and the pattern's beams; the
+// rest sorted nearest first.
 void Caster::prepareBodies(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,
                            const CastConfig& config) {
   const bool planar = pattern.planar();
@@ -174,110 +156,76 @@ void Caster::prepareBodies(const Scene& scene, const ReuseKey& key, const ScanPa
       ++result_.stats.bodies_skipped;
       continue;
     }
-    ActiveBody a;
-    a.index = static_cast<int>(b);
-    a.sensor_from_body = key.sensor_from_frame[body.frame] * body.frame_from_body;
-    a.body_from_sensor_rot = a.sensor_from_body.linear().transpose();
-    a.sensor_in_body = -(a.body_from_sensor_rot * a.sensor_from_body.translation());
-    a.center = a.sensor_from_body * scene.sphereCenter(static_cast<int>(b));
-    a.radius = scene.sphereRadius(static_cast<int>(b));
-    const double dist = a.center.norm();
-    const double slack = kWindowSlack * (dist + a.radius + config.tmax);
-    a.near = std::max(0.0, dist - a.radius - slack);
-    bool culled = dist - a.radius > config.tmax + slack || dist + a.radius < config.tmin - slack;
-    if (planar && std::abs(a.center.z()) > a.radius + kWindowSlack * (dist + a.radius)) {
-      culled = true;
+    const int index = static_cast<int>(b);
+    const Eigen::Isometry3d sensor_from_body =
+        key.sensor_from_frame[body.frame] * body.frame_from_body;
+    // The sphere first: a cheap answer for bodies out of range.
+    const Eigen::Vector3d center = sensor_from_body * scene.sphereCenter(index);
+    const double radius = scene.sphereRadius(index);
+    const double dist = center.norm();
+    const double slack = kWindowSlack * (dist + radius + config.tmax);
+    if (dist - radius > config.tmax + slack || dist + radius < config.tmin - slack) {
+      ++result_.stats.bodies_culled;
+      continue;
     }
-    a.azimuth_limited =
-        azimuthWindow(a.center, a.radius, pattern.angleMin(), &a.azimuth_start, &a.azimuth_width);
-    if (!culled && a.azimuth_limited) {
+    const Eigen::Matrix3d& rot = sensor_from_body.linear();
+    const View view = boxView(scene.boxCenter(index), scene.boxHalf(index), rot, rot.cwiseAbs(),
+                              sensor_from_body.translation(), pattern.angleMin(), !planar);
+    bool culled = !(view.near <= config.tmax) || (planar && !view.crosses);
+    if (!culled && view.azimuth_limited) {
       bool any = false;
-      forEachBeamRange(pattern, a.azimuth_start, a.azimuth_width, [&](int, int) { any = true; });
+      forEachBeamRange(pattern, view.azimuth_start, view.azimuth_width,
+                       [&](int, int) { any = true; });
       culled = !any;
     }
-    elevationWindow(a.center, a.radius, &a.elevation_lo, &a.elevation_hi);
     if (culled) {
       ++result_.stats.bodies_culled;
       continue;
     }
+    ActiveBody a;
+    a.index = index;
+    a.sensor_from_body = sensor_from_body;
+    a.body_from_sensor_rot = rot.transpose();
+    a.sensor_in_body = -(a.body_from_sensor_rot * sensor_from_body.translation());
+    a.center = center;
+    a.radius = radius;
+    a.view = view;
     active_.push_back(a);
   }
   // Nearest first: a beam that has already hit something nearer than a body can be skips it, so
   // bodies hidden behind nearer ones cost a comparison per beam of their window.
   std::sort(active_.begin(), active_.end(),
-            [](const ActiveBody& x, const ActiveBody& y) { return x.near < y.near; });
+            [](const ActiveBody& x, const ActiveBody& y) { return x.view.near < y.view.near; });
 }
 
-// Every active body against the beams of its window that have not hit anything nearer than it: a
-// mesh under a planar fan is sliced or traced, whichever does less work; everything else is traced
-// beam by beam.
+// Every active body, nearest first, against the open beams of its window (body_traversal.h); with
+// threads, each thread takes pieces of the pattern's columns (all rows) in turn.
 void Caster::castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config) {
-  const auto& bodies = scene.bodies();
-  const auto& dirs = pattern.directions();
-  const bool with_normals = config.compute_incidence;
-  const bool slice_meshes = pattern.planar() && config.planar_fast_path;
-
-  // The beams of a body's window (azimuths, then the rings whose elevation it spans) that have not
-  // hit anything nearer than the body's nearest point.
-  auto forEachBeamOf = [&](const ActiveBody& a, auto&& f) {
-    const int azimuths = pattern.azimuthCount();
-    for (int ring = 0; ring < pattern.ringCount(); ++ring) {
-      const double elevation = pattern.elevations()[ring];
-      if (elevation < a.elevation_lo || elevation > a.elevation_hi) continue;
-      const int offset = ring * azimuths;
-      auto run = [&](int first, int last) {
-        for (int i = offset + first; i <= offset + last; ++i) {
-          if (result_.range[i] > a.near) f(i);
-        }
-      };
-      if (a.azimuth_limited) {
-        forEachBeamRange(pattern, a.azimuth_start, a.azimuth_width, run);
-      } else {
-        run(0, azimuths - 1);
-      }
-    }
-  };
-
-  dispatchTriangleMethod(config.method, [&](auto method) {
-    constexpr TriangleMethod M = decltype(method)::value;
+  beams_->reset(pattern, config, &result_);
+  auto castWithin = [&](const BeamRect& within) {
     for (const ActiveBody& a : active_) {
-      const Body& body = bodies[a.index];
-      const auto* mesh = std::get_if<std::shared_ptr<const Mesh>>(&body.shape);
-      if (mesh && slice_meshes) {
-        // A plane cuts about 2 sqrt(n) of a compact closed mesh's n triangles, each a segment to
-        // place; a beam costs one BVH traversal, about kBeamCostInSegments segments. Walls and
-        // rooms cover many beams and are sliced; a detailed object far away covers a few and is
-        // traced. Both are watertight and agree, but where a surface only touches the scan plane
-        // (see fan_slicer.h).
-        int open_beams = 0;
-        forEachBeamOf(a, [&](int) { ++open_beams; });
-        if (open_beams == 0) continue;  // hidden behind nearer bodies
-        const double segments = 2 * std::sqrt(double((*mesh)->bvh().triangleIds().size()));
-        if (kBeamCostInSegments * open_beams >= segments) {
-          sliceMesh(**mesh, a.sensor_from_body, pattern, config.tmin, config.tmax,
-                    config.cull_backfaces, a.index,
-                    DepthBuffer{&result_.range, &result_.body, &result_.triangle, nullptr,
-                                with_normals ? &result_.normal : nullptr});
-          continue;
-        }
-      }
-      // Traced beam by beam, skipping beams that pass beside the bounding sphere.
-      const double slack_base = kWindowSlack * (a.center.squaredNorm() + a.radius * a.radius);
-      forEachBeamOf(a, [&](int i) {
-        const Eigen::Vector3d& d = dirs[i];
-        const double along = d.dot(a.center);
-        const double miss2 = (a.center - along * d).squaredNorm() - a.radius * a.radius;
-        if (miss2 > slack_base) return;
-        const auto hit =
-            intersectBody<M>(body, a, d, config.tmin, std::min(config.tmax, result_.range[i]),
-                             config.cull_backfaces);
-        if (!hit || !(hit->t < result_.range[i])) return;
-        result_.range[i] = hit->t;
-        result_.body[i] = a.index;
-        result_.triangle[i] = hit->triangle;
-        if (with_normals) result_.normal[i] = a.sensor_from_body.linear() * hit->normal;
+      beams_->forEachRect(a.view, within, [&](const BeamRect& rect) {
+        if (beams_->anyOpen(rect, a.view.near)) castBody(*beams_, scene, a, config, rect);
       });
     }
+  };
+  int threads = config.threads;
+  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // Waking threads costs more than a small scan does: each gets at least kMinBeamsPerThread.
+  threads = std::max(1, std::min(threads, pattern.size() / kMinBeamsPerThread));
+  if (threads == 1) {
+    castWithin(beams_->all());
+    return;
+  }
+  if (!pool_ || pool_->threads() != threads) pool_ = std::make_unique<ThreadPool>(threads);
+  const int columns = pattern.azimuthCount();
+  const int width = chunkColumns(columns, threads);
+  const int pieces = (columns + width - 1) / width;
+  pool_->run(pieces, [&](int i) {
+    BeamRect piece = beams_->all();
+    piece.col_lo = i * width;
+    piece.col_hi = std::min(columns - 1, piece.col_lo + width - 1);
+    castWithin(piece);
   });
 }
 

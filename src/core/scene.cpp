@@ -41,6 +41,23 @@ void boundingSphere(const Shape& shape, Eigen::Vector3d* center, double* radius)
   *radius *= 1 + 4 * std::numeric_limits<double>::epsilon();  // the norm's rounding
 }
 
+// A box containing the shape, in the shape's frame: centre and half extents, rounded up a few ulps.
+void boundingBox(const Shape& shape, Eigen::Vector3d* center, Eigen::Vector3d* half) {
+  *center = Eigen::Vector3d::Zero();
+  if (const auto* mesh = std::get_if<std::shared_ptr<const Mesh>>(&shape)) {
+    *center = (*mesh)->bounds().center();
+    *half = (*mesh)->bounds().extent() * 0.5;
+  } else if (const auto* box = std::get_if<Box>(&shape)) {
+    *half = box->size * 0.5;
+  } else if (const auto* cylinder = std::get_if<Cylinder>(&shape)) {
+    *half = Eigen::Vector3d(cylinder->radius, cylinder->radius, cylinder->length * 0.5);
+  } else {
+    *half = Eigen::Vector3d::Constant(std::get<Sphere>(shape).radius);
+  }
+  *half *= 1 + 4 * std::numeric_limits<double>::epsilon();  // the halving's and centre's rounding
+  *half += 4 * std::numeric_limits<double>::epsilon() * center->cwiseAbs();
+}
+
 }  // namespace
 
 Scene::Scene() : version_(nextVersion()) {}
@@ -77,6 +94,10 @@ int Scene::addBody(Body body) {
   boundingSphere(body.shape, &center, &radius);
   sphere_centers_.push_back(center);
   sphere_radii_.push_back(radius);
+  Eigen::Vector3d box_center, box_half;
+  boundingBox(body.shape, &box_center, &box_half);
+  box_centers_.push_back(box_center);
+  box_halves_.push_back(box_half);
   bodies_.push_back(std::move(body));
   version_ = nextVersion();
   return static_cast<int>(bodies_.size()) - 1;

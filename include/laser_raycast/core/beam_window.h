@@ -4,7 +4,7 @@
 // functions only decide how much work is done, never a range.
 #pragma once
 
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -19,23 +19,40 @@ namespace core {
 inline constexpr double kWindowSlack = 8 * std::numeric_limits<double>::epsilon();
 
 // Beam index ranges of a fan that may see the angular interval [start, start + width] (rad, start
-// measured from angle_min, width in [0, 2 pi]). Padded by one beam each side, which absorbs the
-// rounding of the index arithmetic. Calls f(first, last) for each index range (more than one when
-// the fan spans more than a turn); the ranges are increasing and disjoint, so no beam is visited
-// twice even when the padding of a coarse fan makes consecutive turns' windows overlap.
+// measured from angle_min, width in [0, 2 pi]): every beam whose azimuth lies in the interval, and
+// those within the rounding of the index arithmetic of its ends (a few ulps of the angles
+// involved). The interval itself must already hold every error of how it was found. Calls
+// f(first, last) for each index range (more than one when the fan spans more than a turn); the
+// ranges are increasing and disjoint, so no beam is visited twice.
+// floor(x) and ceil(x) for |x| < 2^31, without a call into libm (SSE2 has no rounding
+// instruction).
+inline int floorToInt(double x) {
+  const int i = static_cast<int>(x);  // truncates towards zero
+  return i - (x < i);
+}
+inline int ceilToInt(double x) {
+  const int i = static_cast<int>(x);
+  return i + (x > i);
+}
+
 template <class F>
 void forEachBeamRange(const ScanPattern& fan, double start, double width, F&& f) {
   const double inc = fan.angleIncrement();
   const int n = fan.azimuthCount();
   const double span = (n - 1) * inc;
+  const double pad = 64 * std::numeric_limits<double>::epsilon() * (span + width + 4 * M_PI);
+  // Window positions in units of beams, clamped far beyond the fan so that the conversions to int
+  // cannot overflow (a window never needs more than the fan's own index range).
+  const double limit = n + 2.0;
+  auto index = [&](double angle) { return std::max(-limit, std::min(limit, angle / inc)); };
   int next = 0;  // the first beam not yet visited
   for (int turn = -1;; ++turn) {
-    const double lo = start + turn * 2 * M_PI;
-    const double hi = lo + width;
-    if (lo > span + inc) break;
-    if (hi < -inc) continue;
-    const int first = std::max(next, static_cast<int>(std::ceil(lo / inc)) - 1);
-    const int last = std::min(n - 1, static_cast<int>(std::floor(hi / inc)) + 1);
+    const double lo = start + turn * 2 * M_PI - pad;
+    const double hi = lo + width + 2 * pad;
+    if (lo > span) break;
+    if (hi < 0) continue;
+    const int first = std::max(next, ceilToInt(index(lo)));
+    const int last = std::min(n - 1, floorToInt(index(hi)));
     if (first <= last) {
       f(first, last);
       next = last + 1;
@@ -64,7 +81,9 @@ inline double approxAtan2(double y, double x) {
 
 // angle wrapped into [0, 2 pi).
 inline double wrapToTurn(double angle) {
-  double a = angle - 2 * M_PI * std::floor(angle / (2 * M_PI));
+  const double turns = angle / (2 * M_PI);
+  const double whole = std::abs(turns) < 1e9 ? floorToInt(turns) : std::floor(turns);
+  const double a = angle - 2 * M_PI * whole;
   return a < 2 * M_PI ? a : 0.0;
 }
 
@@ -102,6 +121,23 @@ inline void elevationWindow(const Eigen::Vector3d& center, double radius, double
   *lo = middle - half - kWindowSlack;
   *hi = middle + half + kWindowSlack;
 }
+
+// How a sphere or a box looks from the sensor (sensor frame), conservatively.
+struct View {
+  double near;                          // no point of it is nearer to the sensor than this
+  bool crosses;                         // it may meet the scan plane (sensor z = 0)
+  bool azimuth_limited;                 // else it may be seen at any azimuth
+  double azimuth_start, azimuth_width;  // as forEachBeamRange takes them
+  double elevation_lo, elevation_hi;    // rad
+};
+
+// The view of a sphere; of a box given by its centre and half extents in a frame whose pose in the
+// sensor frame is (rot, trans) (abs_rot: rot with its entries' magnitudes). The box view bounds the
+// box by its sensor-frame bounding box.
+View sphereView(const Eigen::Vector3d& center, double radius, double angle_min);
+View boxView(const Eigen::Vector3d& center, const Eigen::Vector3d& half, const Eigen::Matrix3d& rot,
+             const Eigen::Matrix3d& abs_rot, const Eigen::Vector3d& trans, double angle_min,
+             bool elevations);
 
 }  // namespace core
 }  // namespace laser_raycast

@@ -5,9 +5,11 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 
+#include "laser_raycast/core/beam_window.h"
 #include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scene.h"
@@ -23,7 +25,14 @@ struct CastConfig {
   double tmax = 30.0;  // m, farthest accepted hit (> tmin); bodies wholly beyond are skipped
   bool planar_fast_path =
       true;  // planar fans: slice meshes in the scan plane instead of tracing beams
+  bool raster_fast_path = true;  // other patterns: rasterise nearby meshes instead of tracing beams
   bool compute_incidence = false;  // fill ScanResult::cos_incidence
+  // Threads a cast uses (the calling one included); 0: every core. The beams are split between
+  // them; the result is the same, bit for bit, for any number.
+  int threads = 1;
+  // Skip bodies and BVH nodes that every beam able to reach them has already passed (a nearer
+  // hit). Never changes the result; off only to test that.
+  bool occlusion_culling = true;
 
   // Throws std::invalid_argument naming the field and its value.
   void validate() const;
@@ -48,8 +57,16 @@ struct ScanResult {
   CastStats stats;
 };
 
+class BeamSet;
+class ThreadPool;
+
 class Caster {
  public:
+  Caster();
+  ~Caster();
+  Caster(Caster&&) noexcept;
+  Caster& operator=(Caster&&) noexcept;
+
   // Casts pattern from world_from_sensor (both it and poses in the same common frame). Bodies whose
   // frame is invalid are skipped. If world_from_sensor is not a finite rigid transform, every beam
   // is NaN. If scene, pattern, config and every frame's pose relative to the sensor are unchanged
@@ -77,12 +94,7 @@ class Caster {
     Eigen::Vector3d sensor_in_body;        // the sensor origin in the body frame
     Eigen::Vector3d center;                // bounding sphere centre, sensor frame
     double radius;
-    double near;  // no point of the body is nearer to the sensor than this (m)
-    // The directions the bounding sphere covers: an azimuth interval (from angle_min, as
-    // forEachBeamRange takes it) unless it surrounds the z axis, and an elevation interval.
-    bool azimuth_limited;
-    double azimuth_start, azimuth_width;
-    double elevation_lo, elevation_hi;
+    View view;  // how the body's box looks from the sensor: nearest distance, windows
   };
 
  private:
@@ -110,6 +122,8 @@ class Caster {
 
   ScanResult result_;
   std::vector<ActiveBody> active_;
+  std::unique_ptr<BeamSet> beams_;    // the walk's per-scan state, kept to reuse its memory
+  std::unique_ptr<ThreadPool> pool_;  // for CastConfig::threads > 1, kept between casts
   std::optional<ReuseKey> previous_;  // the inputs of result_, if it is complete
 };
 

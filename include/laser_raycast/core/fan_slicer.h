@@ -4,6 +4,10 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
 #include <vector>
 
 #include "laser_raycast/core/beam_window.h"
@@ -25,17 +29,128 @@ struct DepthBuffer {
   std::vector<Eigen::Vector3d>* normal = nullptr;
 };
 
-// Slices one mesh body by the fan's plane (the sensor's z = 0) and keeps, per beam, the nearest hit
-// with t in [tmin, tmax]. Watertight: each crossing point is computed from its edge's two vertices
-// in a fixed (lexicographic) order, so neighbouring triangles share bitwise-identical segment
-// endpoints, and a beam is tested against a segment by the signs of two cross products with those
-// endpoints. A beam exactly through a shared endpoint counts for one of the two segments (half-open
-// segments), and a vertex exactly on the plane counts as just below it, so that an edge lying in
-// the plane is cut once: a beam crosses a closed outline exactly once. A surface that only touches
-// the plane from below (the top of a box at exactly the sensor's height) is therefore not seen;
-// triangles lying in the plane are skipped, as the 3D tests skip a ray in a triangle's plane.
+// Slices a mesh by the fan's plane (the sensor's z = 0): each triangle that crosses it becomes a
+// segment in the plane, tested against the beams. Watertight: each crossing point is computed from
+// its edge's two vertices in a fixed (lexicographic) order, so neighbouring triangles share
+// bitwise-identical segment endpoints, and a beam is tested against a segment by the signs of two
+// cross products with those endpoints. A beam exactly through a shared endpoint counts for one of
+// the two segments (half-open segments), and a vertex exactly on the plane counts as just below it,
+// so that an edge lying in the plane is cut once: a beam crosses a closed outline exactly once. A
+// surface that only touches the plane from below (the top of a box at exactly the sensor's height)
+// is therefore not seen; triangles lying in the plane are skipped, as the 3D tests skip a ray in a
+// triangle's plane.
+class PlaneSlicer {
+ public:
+  PlaneSlicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
+              double tmin, double tmax, bool cull_backfaces);
+
+  // False if the box (mesh frame) certainly neither crosses the plane nor comes within tmax.
+  bool mayCross(const Aabb& box) const;
+
+  // Slices the triangle in BVH slot `slot` and calls hit(beam, t) for every beam with index in
+  // [first, last] that crosses its segment with t in [tmin, tmax]. open(beam, near) may say that a
+  // beam needs no test: it has hit something nearer than `near`, the segment's nearest distance.
+  template <class Hit>
+  void sliceSlot(std::uint32_t slot, int first, int last, Hit&& hit) const {
+    sliceSlot(slot, first, last, std::forward<Hit>(hit), [](int, double) { return true; });
+  }
+  template <class Hit, class Open>
+  void sliceSlot(std::uint32_t slot, int first, int last, Hit&& hit, Open&& open) const;
+
+  // The hit triangle's front normal in the sensor frame.
+  Eigen::Vector3d sensorNormal(std::uint32_t slot) const {
+    return rot_ * mesh_.normal(mesh_.bvh().triangleIds()[slot]);
+  }
+
+ private:
+  // Below this many beams in the window, every one is tested without computing bearings.
+  static constexpr int kDirectBeams = 8;
+
+  // Where the slot's triangle crosses the plane, as two points (sensor x, y); false if it does not.
+  bool segment(std::uint32_t slot, Eigen::Vector2d* p, Eigen::Vector2d* q) const;
+
+  const Mesh& mesh_;
+  const ScanPattern& fan_;
+  Eigen::Matrix3d rot_;
+  Eigen::Vector3d trans_;
+  Eigen::Vector3d normal_, abs_normal_, sensor_in_mesh_;  // the plane and the sensor, mesh frame
+  double offset_;
+  double tmin_, tmax_, tmax2_, gamma_;
+  bool cull_backfaces_;
+};
+
+// Slices one mesh body and keeps, per beam, the nearest hit with t in [tmin, tmax] in buffer.
 void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
                double tmin, double tmax, bool cull_backfaces, int body_index, DepthBuffer buffer);
+
+template <class Hit, class Open>
+void PlaneSlicer::sliceSlot(std::uint32_t slot, int first, int last, Hit&& hit, Open&& open) const {
+  Eigen::Vector2d p, q;
+  if (!segment(slot, &p, &q)) return;
+  if (p == q) return;  // touches the plane at a vertex: no beam crosses it
+  // No point of the segment is nearer to the sensor than this (the distance to its line where the
+  // foot of the perpendicular falls inside it, else to the nearer end), lowered for rounding: a
+  // beam that has already hit something nearer needs no test.
+  const Eigen::Vector2d pq = q - p;
+  const double along = -p.dot(pq), length2 = pq.squaredNorm();
+  const double near =
+      (along > 0 && along < length2 ? std::abs(p.x() * pq.y() - p.y() * pq.x()) / std::sqrt(length2)
+                                    : std::sqrt(std::min(p.squaredNorm(), q.squaredNorm()))) *
+          (1 - 16 * std::numeric_limits<double>::epsilon()) -
+      16 * std::numeric_limits<double>::epsilon() * (p.norm() + q.norm());
+  Eigen::Vector3d front = Eigen::Vector3d::Zero();
+  if (cull_backfaces_) {
+    const auto& v = mesh_.bvh().triangleVertices()[slot];
+    front = rot_ * (v[1] - v[0]).cross(v[2] - v[0]);
+  }
+  const auto& dirs = fan_.directions();
+  auto test = [&](int lo, int hi) {
+    for (int i = std::max(lo, first); i <= std::min(hi, last); ++i) {
+      if (!open(i, near)) continue;
+      const double dx = dirs[i].x(), dy = dirs[i].y();
+      // Which side of the beam's line each endpoint is on; a shared endpoint gives the same value
+      // to both of its segments.
+      const double side_p = dx * p.y() - dy * p.x();
+      const double side_q = dx * q.y() - dy * q.x();
+      if (!((side_p <= 0 && side_q >= 0) || (side_p >= 0 && side_q <= 0))) continue;
+      // Both on the line: the beam runs along the triangle's plane.
+      if (side_p == side_q) continue;
+      // Exactly through an endpoint: the beam counts for the segment whose other end lies on its
+      // left (as if nudged to the right), so for exactly one of the two segments sharing a point
+      // where the outline crosses the beam.
+      if (side_p == 0 ? !(side_q > 0) : (side_q == 0 && !(side_p > 0))) continue;
+      const double along_p = dx * p.x() + dy * p.y();
+      const double along_q = dx * q.x() + dy * q.y();
+      const double t = along_p + (side_p / (side_p - side_q)) * (along_q - along_p);
+      if (!(t >= tmin_ && t <= tmax_)) continue;
+      if (cull_backfaces_ && dx * front.x() + dy * front.y() > 0) continue;
+      hit(i, t);
+    }
+  };
+  // A few beams are tested directly; for more, only those the segment's bearings can reach.
+  if (last - first < kDirectBeams) {
+    test(first, last);
+    return;
+  }
+  // The shorter arc between the endpoints' bearings, widened by one bearing error each side. Each
+  // true bearing lies within kBearingError of its approximation, so the arc from the lower
+  // approximation minus the error to the higher plus the error holds the true arc, also when the
+  // approximation flipped the sign of a tiny sweep (the window spans both approximations either
+  // way). The shorter arc is the true one unless the sweep is within two errors of half a turn (a
+  // segment passing beside the sensor): then every beam is tried.
+  const double bearing_p = approxAtan2(p.y(), p.x());
+  const double bearing_q = approxAtan2(q.y(), q.x());
+  double sweep = bearing_q - bearing_p;
+  if (sweep > M_PI) sweep -= 2 * M_PI;
+  if (sweep < -M_PI) sweep += 2 * M_PI;
+  const double pad = kBearingError;
+  if (std::abs(sweep) > M_PI - 2 * pad) {
+    test(first, last);
+    return;
+  }
+  const double start = wrapToTurn((sweep >= 0 ? bearing_p : bearing_q) - pad - fan_.angleMin());
+  forEachBeamRange(fan_, start, std::abs(sweep) + 2 * pad, test);
+}
 
 }  // namespace core
 }  // namespace laser_raycast

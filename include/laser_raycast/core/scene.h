@@ -46,6 +46,10 @@ class Scene {
   // A sphere containing the body, in the body's frame.
   const Eigen::Vector3d& sphereCenter(int body) const { return sphere_centers_[body]; }
   double sphereRadius(int body) const { return sphere_radii_[body]; }
+  // A box containing the body, in the body's frame: centre and half extents (a mesh's bounds, a
+  // primitive's own box).
+  const Eigen::Vector3d& boxCenter(int body) const { return box_centers_[body]; }
+  const Eigen::Vector3d& boxHalf(int body) const { return box_halves_[body]; }
   std::size_t triangleCount() const;
   // Changes on every modification and is unique across scenes, so a cached result can tell whether
   // it was computed from this scene as it is now.
@@ -58,6 +62,7 @@ class Scene {
   std::vector<Body> bodies_;
   std::vector<Eigen::Vector3d> sphere_centers_;
   std::vector<double> sphere_radii_;
+  std::vector<Eigen::Vector3d> box_centers_, box_halves_;
 };
 
 // Where each frame of a scene is this scan, in one common (fixed) frame.

@@ -1,0 +1,160 @@
+#include "laser_raycast/core/node_views.h"
+
+#include <cmath>
+#include <limits>
+
+#include "laser_raycast/core/beam_window.h"
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+// Relative slack for the float arithmetic below: every quantity is a few roundings (at 2^-24 each)
+// away from its exact value, so widening by 32 of them keeps each window and distance on the safe
+// side with room to spare.
+constexpr float kViewSlack = 32.0f / (1 << 24);
+
+inline __m128 absPs(__m128 x) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), x); }
+inline __m128 selectPs(__m128 mask, __m128 a, __m128 b) {
+  return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+
+// approxAtan2 (beam_window.h) for four angles: the same polynomial, in float. The float rounding
+// adds at most a few 1e-7 rad to the polynomial's 1e-5, within kBearingError.
+inline __m128 atan2Ps(__m128 y, __m128 x) {
+  const __m128 ax = absPs(x), ay = absPs(y);
+  const __m128 big = _mm_max_ps(ax, ay), small = _mm_min_ps(ax, ay);
+  const __m128 nonzero = _mm_cmpgt_ps(big, _mm_setzero_ps());
+  const __m128 a = _mm_and_ps(nonzero, _mm_div_ps(small, selectPs(nonzero, big, _mm_set1_ps(1))));
+  const __m128 z = _mm_mul_ps(a, a);
+  __m128 p = _mm_set1_ps(0.0208351f);
+  p = _mm_add_ps(_mm_mul_ps(p, z), _mm_set1_ps(-0.0851330f));
+  p = _mm_add_ps(_mm_mul_ps(p, z), _mm_set1_ps(0.1801410f));
+  p = _mm_add_ps(_mm_mul_ps(p, z), _mm_set1_ps(-0.3302995f));
+  p = _mm_add_ps(_mm_mul_ps(p, z), _mm_set1_ps(0.9998660f));
+  __m128 r = _mm_mul_ps(a, p);
+  r = selectPs(_mm_cmpgt_ps(ay, ax), _mm_sub_ps(_mm_set1_ps(static_cast<float>(M_PI / 2)), r), r);
+  r = selectPs(_mm_cmplt_ps(x, _mm_setzero_ps()),
+               _mm_sub_ps(_mm_set1_ps(static_cast<float>(M_PI)), r), r);
+  // The sign of y (also for -0, as atan2 does).
+  return _mm_or_ps(r, _mm_and_ps(y, _mm_set1_ps(-0.0f)));
+}
+
+// The children that exist (an empty slot's box, at +inf, gives NaNs that some of the min/max
+// operations above would turn into zeros).
+inline int presentMask(const WideBvh::Node& node) {
+  int mask = 0;
+  for (int k = 0; k < WideBvh::kWidth; ++k) mask |= (node.index[k] != WideBvh::kEmpty) << k;
+  return mask;
+}
+
+}  // namespace
+
+ViewFrame::ViewFrame(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax)
+    : planar_(planar) {
+  const Eigen::Matrix3d& r = sensor_from_body.linear();
+  const Eigen::Vector3d& t = sensor_from_body.translation();
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      rot_[i][k] = _mm_set1_ps(static_cast<float>(r(i, k)));
+      abs_rot_[i][k] = _mm_set1_ps(static_cast<float>(std::abs(r(i, k))));
+    }
+    trans_[i] = _mm_set1_ps(static_cast<float>(t[i]));
+    abs_trans_[i] = _mm_set1_ps(static_cast<float>(std::abs(t[i])));
+  }
+  tmax_ = _mm_set1_ps(floatAbove(tmax));
+}
+
+void NodeViews::compute(const WideBvh::Node& node, const ViewFrame& f) {
+  const __m128 half_ps = _mm_set1_ps(0.5f);
+  const __m128 slack = _mm_set1_ps(kViewSlack);
+  __m128 cb[3], eb[3];
+  for (int k = 0; k < 3; ++k) {
+    const __m128 lo = _mm_load_ps(node.lo[k]), hi = _mm_load_ps(node.hi[k]);
+    cb[k] = _mm_mul_ps(_mm_add_ps(lo, hi), half_ps);
+    eb[k] = _mm_mul_ps(_mm_sub_ps(hi, lo), half_ps);
+  }
+  // The sensor-frame centre c and half extents e of the child boxes, e widened by the rounding.
+  __m128 c[3], e[3];
+  for (int i = 0; i < 3; ++i) {
+    __m128 ci = f.trans_[i], ei = _mm_setzero_ps(), mag = f.abs_trans_[i];
+    for (int k = 0; k < 3; ++k) {
+      ci = _mm_add_ps(ci, _mm_mul_ps(f.rot_[i][k], cb[k]));
+      ei = _mm_add_ps(ei, _mm_mul_ps(f.abs_rot_[i][k], eb[k]));
+      mag = _mm_add_ps(mag, _mm_mul_ps(f.abs_rot_[i][k], _mm_add_ps(absPs(cb[k]), eb[k])));
+    }
+    c[i] = ci;
+    e[i] = _mm_add_ps(ei, _mm_mul_ps(slack, _mm_add_ps(mag, ei)));
+  }
+  // Nearest distance: the norm of the gap between the sensor and the box, lowered by the slack.
+  // If the squares overflow, the largest gap is still a lower bound.
+  __m128 sum = _mm_setzero_ps(), biggest = _mm_setzero_ps(), magnitude = _mm_setzero_ps();
+  for (int i = 0; i < 3; ++i) {
+    const __m128 gap = _mm_max_ps(_mm_sub_ps(absPs(c[i]), e[i]), _mm_setzero_ps());
+    sum = _mm_add_ps(sum, _mm_mul_ps(gap, gap));
+    biggest = _mm_max_ps(biggest, gap);
+    magnitude = _mm_add_ps(magnitude, _mm_add_ps(absPs(c[i]), e[i]));
+  }
+  const __m128 finite = _mm_cmplt_ps(sum, _mm_set1_ps(std::numeric_limits<float>::infinity()));
+  __m128 near = selectPs(finite, _mm_sqrt_ps(sum), biggest);
+  near = _mm_max_ps(_mm_sub_ps(near, _mm_mul_ps(slack, _mm_add_ps(near, magnitude))),
+                    _mm_setzero_ps());
+  _mm_store_ps(this->near, near);
+
+  // Present, within tmax, and (planar) meeting the plane.
+  __m128 ok = _mm_cmple_ps(near, f.tmax_);
+  if (f.planar_) ok = _mm_and_ps(ok, _mm_cmple_ps(absPs(c[2]), e[2]));
+  mask = _mm_movemask_ps(ok) & presentMask(node);
+  if (!mask) return;
+
+  // Azimuths: the box's xy extent lies in a disc of radius r around (cx, cy); seen from the
+  // sensor the disc spans half-angle asin(r / rho) <= r / sqrt(rho^2 - r^2), unless it holds the
+  // z axis (or nearly: then every azimuth).
+  const __m128 rho2 = _mm_add_ps(_mm_mul_ps(c[0], c[0]), _mm_mul_ps(c[1], c[1]));
+  const __m128 r2 = _mm_add_ps(_mm_mul_ps(e[0], e[0]), _mm_mul_ps(e[1], e[1]));
+  const __m128 limited = _mm_cmpgt_ps(rho2, _mm_mul_ps(r2, _mm_set1_ps(1 + 8 * kViewSlack)));
+  const __m128 denom = _mm_sqrt_ps(_mm_max_ps(_mm_sub_ps(rho2, r2), _mm_set1_ps(1e-30f)));
+  __m128 half = _mm_mul_ps(_mm_div_ps(_mm_sqrt_ps(r2), denom), _mm_set1_ps(1 + 8 * kViewSlack));
+  half = _mm_add_ps(half, _mm_set1_ps(static_cast<float>(2 * kBearingError)));
+  const __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
+  _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
+  _mm_store_ps(az_center, atan2Ps(c[1], c[0]));
+  if (f.planar_) return;
+
+  // Elevations: a point of the box has height in [z_lo, z_hi] and horizontal distance in
+  // [rho_min, rho_max]; its elevation atan2(z, rho) is largest at the top and the nearest distance
+  // (the farthest if the top is below the sensor), smallest likewise.
+  const __m128 one_minus = _mm_set1_ps(1 - 8 * kViewSlack),
+               one_plus = _mm_set1_ps(1 + 8 * kViewSlack);
+  const __m128 rho = _mm_sqrt_ps(rho2), r = _mm_sqrt_ps(r2);
+  const __m128 rho_min = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(rho, r), one_minus), _mm_setzero_ps());
+  const __m128 rho_max = _mm_mul_ps(_mm_add_ps(rho, r), one_plus);
+  const __m128 z_slack = _mm_mul_ps(slack, _mm_add_ps(absPs(c[2]), e[2]));
+  const __m128 z_lo = _mm_sub_ps(_mm_sub_ps(c[2], e[2]), z_slack);
+  const __m128 z_hi = _mm_add_ps(_mm_add_ps(c[2], e[2]), z_slack);
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 pad = _mm_set1_ps(static_cast<float>(kBearingError));
+  const __m128 hi_angle = atan2Ps(z_hi, selectPs(_mm_cmpgt_ps(z_hi, zero), rho_min, rho_max));
+  const __m128 lo_angle = atan2Ps(z_lo, selectPs(_mm_cmplt_ps(z_lo, zero), rho_min, rho_max));
+  _mm_store_ps(el_hi, _mm_add_ps(hi_angle, pad));
+  _mm_store_ps(el_lo, _mm_sub_ps(lo_angle, pad));
+}
+
+int planeMask(const WideBvh::Node& node, const ViewFrame& f) {
+  const __m128 half_ps = _mm_set1_ps(0.5f);
+  const __m128 slack = _mm_set1_ps(kViewSlack);
+  __m128 cz = f.trans_[2], ez = _mm_setzero_ps(), mag = f.abs_trans_[2];
+  for (int k = 0; k < 3; ++k) {
+    const __m128 lo = _mm_load_ps(node.lo[k]), hi = _mm_load_ps(node.hi[k]);
+    const __m128 cb = _mm_mul_ps(_mm_add_ps(lo, hi), half_ps);
+    const __m128 eb = _mm_mul_ps(_mm_sub_ps(hi, lo), half_ps);
+    cz = _mm_add_ps(cz, _mm_mul_ps(f.rot_[2][k], cb));
+    ez = _mm_add_ps(ez, _mm_mul_ps(f.abs_rot_[2][k], eb));
+    mag = _mm_add_ps(mag, _mm_mul_ps(f.abs_rot_[2][k], _mm_add_ps(absPs(cb), eb)));
+  }
+  ez = _mm_add_ps(ez, _mm_mul_ps(slack, _mm_add_ps(mag, ez)));
+  return _mm_movemask_ps(_mm_cmple_ps(absPs(cz), ez)) & presentMask(node);
+}
+
+}  // namespace core
+}  // namespace laser_raycast

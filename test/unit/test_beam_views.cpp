@@ -1,0 +1,233 @@
+// The conservative pieces of the caster's walk, each against its exact counterpart: a box's view
+// (float, four children at once, and double) holds every beam whose exact ray enters the box, and
+// no point of the box is nearer than its near distance; the edge filter lets through every beam
+// the exact triangle test hits; the occlusion tiles never call a window closed that has an open
+// beam.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <set>
+#include <vector>
+
+#include "fan_specs.h"
+#include "laser_raycast/core/aabb.h"
+#include "laser_raycast/core/beam_set.h"
+#include "laser_raycast/core/edge_filter.h"
+#include "laser_raycast/core/mesh.h"
+#include "laser_raycast/core/node_views.h"
+#include "laser_raycast/core/scan_spec.h"
+#include "random.h"
+#include "triangle_soup.h"
+
+namespace laser_raycast_test {
+namespace {
+
+namespace core = laser_raycast::core;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Where the exact ray (sensor frame, from the origin along d) enters the box (body frame, posed by
+// sensor_from_body) within [0, tmax], or nothing: the slab test in long double on the box's
+// corners moved into the sensor frame... simpler and exact enough: in the body frame, with the
+// origin and direction moved there in long double.
+std::optional<long double> entry(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                 const Eigen::Isometry3d& sensor_from_body,
+                                 const Eigen::Vector3d& d, double tmax) {
+  using L = long double;
+  const Eigen::Matrix<L, 3, 3> r = sensor_from_body.linear().cast<L>().transpose();
+  const Eigen::Matrix<L, 3, 1> o = -(r * sensor_from_body.translation().cast<L>());
+  const Eigen::Matrix<L, 3, 1> dir = r * d.cast<L>();
+  L t0 = 0, t1 = tmax;
+  for (int k = 0; k < 3; ++k) {
+    if (dir[k] == 0) {
+      if (o[k] < lo[k] || o[k] > hi[k]) return std::nullopt;
+      continue;
+    }
+    L a = (lo[k] - o[k]) / dir[k], b = (hi[k] - o[k]) / dir[k];
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+  }
+  if (t0 > t1) return std::nullopt;
+  return t0;
+}
+
+// A few beam patterns: fans and rings.
+std::vector<core::ScanPattern> patterns() {
+  std::vector<core::ScanPattern> out;
+  out.emplace_back(fanBySamples(-M_PI, M_PI, 181));
+  out.emplace_back(fanBySamples(-2.3, 2.3, 271));
+  out.emplace_back(fanBySamples(-M_PI, M_PI, 90), std::vector<double>{-0.4, -0.1, 0.0, 0.2, 0.5});
+  return out;
+}
+
+TEST(NodeViews, EveryBeamThatEntersAChildBoxIsInItsWindow) {
+  Rng rng(21);
+  long long checked = 0, inside = 0;
+  for (const core::ScanPattern& pattern : patterns()) {
+    core::ScanResult result;
+    result.range.assign(pattern.size(), kInf);
+    result.body.assign(pattern.size(), -1);
+    result.triangle.assign(pattern.size(), -1);
+    core::BeamSet beams;
+    beams.reset(pattern, core::CastConfig{}, &result);
+    for (int scene = 0; scene < 8; ++scene) {
+      const Soup s = scene % 2 ? clusteredSoup(rng, 400) : spreadSoup(rng, 400);
+      const core::Mesh mesh(s.vertices, s.triangles);
+      const core::WideBvh& w = mesh.wideBvh();
+      const Eigen::Isometry3d pose = randomPose(rng, 6);
+      const core::ViewFrame frame(pose, pattern.planar(), 30.0);
+      for (const core::WideBvh::Node& node : w.nodes()) {
+        core::NodeViews views;
+        views.compute(node, frame);
+        for (int k = 0; k < core::WideBvh::kWidth; ++k) {
+          if (node.index[k] == core::WideBvh::kEmpty) continue;
+          const Eigen::Vector3d lo(node.lo[0][k], node.lo[1][k], node.lo[2][k]);
+          const Eigen::Vector3d hi(node.hi[0][k], node.hi[1][k], node.hi[2][k]);
+          std::set<int> reached;
+          if (views.mask & (1 << k)) {
+            beams.forEachChildRect(views, k, beams.all(), [&](const core::BeamRect& r) {
+              for (int row = r.row_lo; row <= r.row_hi; ++row) {
+                for (int col = r.col_lo; col <= r.col_hi; ++col)
+                  reached.insert(beams.beam(row, col));
+              }
+            });
+          }
+          for (int row = 0; row < beams.rows(); ++row) {
+            for (int col = 0; col < beams.cols(); ++col) {
+              const auto t = entry(lo, hi, pose, beams.direction(row, col), 30.0);
+              ++checked;
+              if (!t) continue;
+              ++inside;
+              EXPECT_TRUE(reached.count(beams.beam(row, col)))
+                  << "row " << row << " col " << col << " enters child " << k << " at "
+                  << double(*t);
+              EXPECT_LE(views.near[k], double(*t) * (1 + 1e-12));
+            }
+          }
+          if (HasFailure()) return;
+        }
+      }
+    }
+  }
+  EXPECT_GT(inside, 5000);
+  EXPECT_GT(checked, 1000000);
+}
+
+TEST(BoxView, EveryBeamThatEntersTheBoxIsInItsWindow) {
+  Rng rng(23);
+  long long inside = 0;
+  for (const core::ScanPattern& pattern : patterns()) {
+    core::ScanResult result;
+    result.range.assign(pattern.size(), kInf);
+    core::BeamSet beams;
+    beams.reset(pattern, core::CastConfig{}, &result);
+    for (int i = 0; i < 400; ++i) {
+      const Eigen::Vector3d center = uniformInCube(rng, 8);
+      const Eigen::Vector3d half(uniform(rng, 0.01, 3), uniform(rng, 0.01, 3),
+                                 uniform(rng, 0.01, 3));
+      const Eigen::Isometry3d pose = randomPose(rng, 5);
+      const Eigen::Matrix3d& r = pose.linear();
+      const core::View view = core::boxView(center, half, r, r.cwiseAbs(), pose.translation(),
+                                            pattern.angleMin(), !pattern.planar());
+      std::set<int> reached;
+      if (!pattern.planar() || view.crosses) {
+        beams.forEachRect(view, beams.all(), [&](const core::BeamRect& rect) {
+          for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
+            for (int col = rect.col_lo; col <= rect.col_hi; ++col)
+              reached.insert(beams.beam(row, col));
+          }
+        });
+      }
+      for (int row = 0; row < beams.rows(); ++row) {
+        for (int col = 0; col < beams.cols(); ++col) {
+          const auto t = entry(center - half, center + half, pose, beams.direction(row, col), kInf);
+          if (!t) continue;
+          ++inside;
+          EXPECT_TRUE(reached.count(beams.beam(row, col))) << "box " << i;
+          EXPECT_LE(view.near, double(*t) * (1 + 1e-12));
+        }
+      }
+      if (HasFailure()) return;
+    }
+  }
+  EXPECT_GT(inside, 10000);
+}
+
+TEST(EdgeFilter, LetsThroughEveryBeamTheExactTestHits) {
+  Rng rng(29);
+  const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 360),
+                                  std::vector<double>{-0.5, -0.2, 0.0, 0.1, 0.4});
+  core::ScanResult result;
+  result.range.assign(pattern.size(), kInf);
+  core::BeamSet beams;
+  core::CastConfig config;
+  beams.reset(pattern, config, &result);
+  long long hits = 0, passed = 0, tested = 0;
+  for (int i = 0; i < 3000; ++i) {
+    // Triangles near the sensor and far, large and tiny, some through the sensor's axis.
+    const double scale = std::pow(10.0, uniform(rng, -1, 1.5));
+    const Eigen::Vector3d c = scale * randomUnitVector(rng);
+    const double size = scale * uniform(rng, 0.001, 1.5);
+    const Eigen::Vector3d a = c + size * randomUnitVector(rng),
+                          b = c + size * randomUnitVector(rng),
+                          d = c + size * randomUnitVector(rng);
+    const core::EdgeFilter filter(a, b, d);
+    for (int row = 0; row < beams.rows(); ++row) {
+      std::vector<char> candidate(beams.cols(), 0);
+      filter.forEachCandidate(beams, row, 0, beams.cols() - 1,
+                              [&](int col) { candidate[col] = 1; });
+      for (int col = 0; col < beams.cols(); ++col) {
+        ++tested;
+        passed += candidate[col];
+        core::Ray ray;
+        ray.dir = beams.direction(row, col);
+        if (!core::intersectTriangle<core::TriangleMethod::kWatertight>(ray, a, b, d)) continue;
+        ++hits;
+        EXPECT_TRUE(candidate[col]) << "triangle " << i << " row " << row << " col " << col;
+      }
+    }
+    if (HasFailure()) return;
+  }
+  EXPECT_GT(hits, 2000);
+  EXPECT_LT(passed, tested / 4);  // and it does filter
+}
+
+TEST(OcclusionTiles, AWindowWithAnOpenBeamIsNeverClosed) {
+  Rng rng(31);
+  for (const int rows : {1, 5, 17}) {
+    const int cols = 300;
+    std::vector<double> range(rows * cols);
+    std::vector<int> beam_of_row(rows);
+    for (int r = 0; r < rows; ++r) beam_of_row[r] = rows - 1 - r;  // rows not in ring order
+    core::OcclusionTiles tiles;
+    tiles.reset(&range, &beam_of_row, rows, cols);
+    for (double& x : range) x = uniform(rng, 1, 10);
+    for (int step = 0; step < 20000; ++step) {
+      // Ranges only decrease, as in a cast.
+      const int row = static_cast<int>(uniform(rng, 0, rows)),
+                col = static_cast<int>(uniform(rng, 0, cols));
+      double& x = range[static_cast<std::size_t>(beam_of_row[row]) * cols + col];
+      x = std::min(x, uniform(rng, 0, 10));
+      tiles.touched(row, col);
+      core::BeamRect rect;
+      rect.row_lo = static_cast<int>(uniform(rng, 0, rows));
+      rect.row_hi = std::min(rows - 1, rect.row_lo + static_cast<int>(uniform(rng, 0, rows)));
+      rect.col_lo = static_cast<int>(uniform(rng, 0, cols));
+      rect.col_hi = std::min(cols - 1, rect.col_lo + static_cast<int>(logUniform(rng, 0, 2.5)));
+      const double near = uniform(rng, 0, 10);
+      bool open = false;
+      for (int r = rect.row_lo; r <= rect.row_hi; ++r) {
+        for (int c = rect.col_lo; c <= rect.col_hi; ++c) {
+          open |= !(range[static_cast<std::size_t>(beam_of_row[r]) * cols + c] < near);
+        }
+      }
+      if (open) ASSERT_TRUE(tiles.anyOpen(rect, near)) << "step " << step;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace laser_raycast_test

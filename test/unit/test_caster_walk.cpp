@@ -1,0 +1,181 @@
+// The caster's shortcuts never change what a beam reports, on random scenes (meshes of many
+// components, a lone sphere mesh, a soup of separate triangles, boxes, cylinders and spheres, on a
+// fixed and a moving frame) seen by fans and rings from random poses:
+// - occlusion culling on or off: the same result, bit for bit;
+// - one thread or several: the same result, bit for bit;
+// - slicing and rasterising on or off (every beam traced instead): the same hits, the same ranges
+//   to rounding, the same bodies.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "cast_reference.h"
+#include "fan_specs.h"
+#include "mesh_builder.h"
+#include "random.h"
+#include "test_geometry.h"
+
+namespace laser_raycast_test {
+namespace {
+
+// Many prisms in one mesh: one connected component each.
+std::shared_ptr<const core::Mesh> prismField(Rng& rng, int count, double spread) {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<core::TriangleIndices> triangles;
+  for (int k = 0; k < count; ++k) {
+    const int sides = 3 + static_cast<int>(uniform(rng, 0, 12));
+    const TriMesh p =
+        makePrism(circle(sides, uniform(rng, 0.05, 0.6), uniform(rng, 0, 1)),
+                  {uniform(rng, -2, -0.2), uniform(rng, -0.1, 0.1), uniform(rng, 0.2, 2)});
+    const Eigen::Vector3d at(uniform(rng, -spread, spread), uniform(rng, -spread, spread), 0);
+    const auto base = static_cast<std::uint32_t>(vertices.size());
+    for (const auto& v : p.vertices) vertices.push_back(v + at);
+    for (const auto& t : p.triangles) triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  return std::make_shared<const core::Mesh>(vertices, triangles);
+}
+
+struct RandomScene {
+  core::Scene scene;
+  core::FramePoses poses;
+};
+
+RandomScene randomScene(Rng& rng) {
+  RandomScene out;
+  core::Scene& scene = out.scene;
+  const int world = scene.addFrame("world");
+  const int cart = scene.addFrame("cart");
+  for (const char* label : {"field", "ball", "soup", "box", "can", "bead"}) scene.addLabel(label);
+  addBody(&scene, prismField(rng, 60, 12), world, Eigen::Isometry3d::Identity(), 0);
+  addBody(&scene, uvSphere(uniform(rng, 0.5, 2), 12, 24), cart,
+          pose(Eigen::Vector3d(uniform(rng, -6, 6), uniform(rng, -6, 6), 0)), 1);
+  addBody(&scene, randomSoup(rng, 300, 8, 0.4), world, Eigen::Isometry3d::Identity(), 2);
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Isometry3d at =
+        pose(uniformInBox(rng, Eigen::Vector3d(-10, -10, -1), Eigen::Vector3d(10, 10, 1)),
+             randomRotation(rng).toRotationMatrix());
+    switch (i % 3) {
+      case 0:
+        addBody(&scene,
+                core::Box{Eigen::Vector3d(uniform(rng, 0.1, 3), uniform(rng, 0.1, 3),
+                                          uniform(rng, 0.1, 3))},
+                i % 2 ? cart : world, at, 3);
+        break;
+      case 1:
+        addBody(&scene, core::Cylinder{uniform(rng, 0.1, 1), uniform(rng, 0.2, 3)},
+                i % 2 ? cart : world, at, 4);
+        break;
+      default:
+        addBody(&scene, core::Sphere{uniform(rng, 0.1, 1)}, i % 2 ? cart : world, at, 5);
+    }
+  }
+  out.poses = core::FramePoses::identity(scene);
+  out.poses.pose[cart] =
+      pose(uniformInBox(rng, Eigen::Vector3d(-2, -2, -0.3), Eigen::Vector3d(2, 2, 0.3)),
+           yaw(uniform(rng, -M_PI, M_PI)));
+  return out;
+}
+
+std::vector<core::ScanPattern> patterns() {
+  std::vector<core::ScanPattern> out;
+  out.emplace_back(fanBySamples(-M_PI, M_PI, 720));
+  out.emplace_back(fanBySamples(-2.35, 2.35, 1081));
+  std::vector<double> rings;
+  for (int r = 0; r < 16; ++r) rings.push_back(-0.26 + 0.52 * r / 15);
+  out.emplace_back(fanBySamples(-M_PI, M_PI, 512), rings);
+  return out;
+}
+
+// A pose in the scene, level (so the planar fan cuts the prisms) or tilted.
+Eigen::Isometry3d sensorPose(Rng& rng, int i) {
+  const Eigen::Vector3d at(uniform(rng, -8, 8), uniform(rng, -8, 8), uniform(rng, -0.5, 0.5));
+  return pose(
+      at, i % 3 ? yaw(uniform(rng, -M_PI, M_PI))
+                : rpy(uniform(rng, -0.3, 0.3), uniform(rng, -0.3, 0.3), uniform(rng, -M_PI, M_PI)));
+}
+
+void expectSameBits(const core::ScanResult& a, const core::ScanResult& b, const char* what) {
+  ASSERT_EQ(a.range.size(), b.range.size());
+  for (std::size_t i = 0; i < a.range.size(); ++i) {
+    const bool same =
+        (a.range[i] == b.range[i] || (std::isnan(a.range[i]) && std::isnan(b.range[i])));
+    ASSERT_TRUE(same && a.body[i] == b.body[i] && a.triangle[i] == b.triangle[i])
+        << what << ": beam " << i << " range " << a.range[i] << " vs " << b.range[i] << ", body "
+        << a.body[i] << " vs " << b.body[i] << ", triangle " << a.triangle[i] << " vs "
+        << b.triangle[i];
+  }
+}
+
+TEST(CasterWalk, CullingThreadsAndFastPathsNeverChangeAResult) {
+  Rng rng(37);
+  long long hits = 0, beams = 0;
+  for (int s = 0; s < 6; ++s) {
+    const RandomScene rs = randomScene(rng);
+    for (const core::ScanPattern& pattern : patterns()) {
+      for (int p = 0; p < 3; ++p) {
+        const Eigen::Isometry3d sensor = sensorPose(rng, p);
+        core::CastConfig base = config(true, 25.0);
+        const core::ScanResult reference = cast(rs.scene, rs.poses, sensor, pattern, base);
+        core::CastConfig no_culling = base;
+        no_culling.occlusion_culling = false;
+        expectSameBits(reference, cast(rs.scene, rs.poses, sensor, pattern, no_culling),
+                       "occlusion culling off");
+        for (const int threads : {2, 3, 0}) {
+          core::CastConfig threaded = base;
+          threaded.threads = threads;
+          expectSameBits(reference, cast(rs.scene, rs.poses, sensor, pattern, threaded), "threads");
+        }
+        core::CastConfig traced = base;
+        traced.planar_fast_path = false;
+        traced.raster_fast_path = false;
+        const core::ScanResult slow = cast(rs.scene, rs.poses, sensor, pattern, traced);
+        for (int i = 0; i < pattern.size(); ++i) {
+          ASSERT_EQ(std::isfinite(reference.range[i]), std::isfinite(slow.range[i]))
+              << "scene " << s << " pose " << p << " beam " << i;
+          if (!std::isfinite(slow.range[i])) continue;
+          EXPECT_NEAR(reference.range[i], slow.range[i], 1e-9 * std::max(1.0, slow.range[i]));
+          EXPECT_EQ(reference.body[i], slow.body[i]) << "beam " << i;
+          ++hits;
+        }
+        beams += pattern.size();
+        if (HasFailure()) return;
+      }
+    }
+  }
+  EXPECT_GT(hits, beams / 3);
+}
+
+// The same with a scan that many threads share: every beam's answer is the one thread's.
+TEST(CasterWalk, ManyThreadsOnALargeScan) {
+  Rng rng(41);
+  const RandomScene rs = randomScene(rng);
+  std::vector<double> rings;
+  for (int r = 0; r < 64; ++r) rings.push_back(-0.26 + 0.52 * r / 63);
+  const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 1024), rings);
+  const Eigen::Isometry3d sensor = sensorPose(rng, 1);
+  core::CastConfig one = config(true, 25.0);
+  const core::ScanResult reference = cast(rs.scene, rs.poses, sensor, pattern, one);
+  core::Caster caster;  // the same caster, so that its thread pool is reused
+  for (const int threads : {2, 4, 7, 2}) {
+    core::CastConfig many = one;
+    many.threads = threads;
+    caster.forget();
+    expectSameBits(reference, caster.cast(rs.scene, rs.poses, sensor, pattern, many), "threads");
+  }
+}
+
+TEST(CastConfig, ThreadsOutOfRangeAreRefused) {
+  core::CastConfig c;
+  c.threads = -1;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c.threads = 100000;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c.threads = 0;
+  EXPECT_NO_THROW(c.validate());
+}
+
+}  // namespace
+}  // namespace laser_raycast_test
