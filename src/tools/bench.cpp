@@ -34,7 +34,7 @@ constexpr int kExitBadArguments = 2;
 
 const char* const kSynopsis =
     "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--method NAME ...] [--list-methods]\n"
-    "             [--list-scenes]\n";
+    "             [--threads N] [--list-scenes]\n";
 const char* const kNotes =
     "Times every method on the workloads fan2d and rings3d and measures each beam's error\n"
     "against a long double reference and its agreement with Embree's robust mode. Writes\n"
@@ -43,7 +43,8 @@ const char* const kNotes =
     "million vertex_rows forest warehouse (default all; tb3 needs tb3_world_data:\n"
     "$LASER_RAYCAST_SHARED_DATA, the ROS package, or ../shared/data beside the source).\n"
     "--method: only these rows (default all; --list-methods names them). --quick: fewer poses\n"
-    "and repetitions (under 2 minutes).\n"
+    "and repetitions (under 2 minutes). --threads N: a second pipeline row cast with N threads\n"
+    "(0: every core); every other row is single-threaded.\n"
     "Exit status: 0 ok, 1 the run failed, 2 bad arguments.\n";
 
 struct Options {
@@ -51,6 +52,7 @@ struct Options {
   std::string out_dir = "bench_results";
   std::vector<std::string> scenes;   // empty: all
   std::vector<std::string> methods;  // empty: all
+  int threads = 1;                   // the second pipeline row's; 1: no second row
   bool list_methods = false, list_scenes = false;
 };
 
@@ -113,6 +115,11 @@ po::options_description flags(Options* options) {
       "the scenes to run (default all)");
   add("method", nameList("method", allMethodNames(), &options->methods),
       "the rows to run (default all)");
+  add("threads",
+      po::value<std::string>()->value_name("N")->notifier([options](const std::string& text) {
+        options->threads = laser_raycast::tools::parseThreads("--threads", text);
+      }),
+      "also time the pipeline with N threads (0: every core)");
   add("list-methods", po::bool_switch(&options->list_methods),
       "print the methods this build has and exit");
   add("list-scenes", po::bool_switch(&options->list_scenes), "print the scenes and exit");
@@ -168,7 +175,7 @@ bench::SceneMethods sceneMethods(const Options& options, bench::SceneGeometry* g
     geometry->bvh_f = core::BvhF::build(scene.soup.vertices, scene.soup.triangles);
   }
   bench::SceneMethods methods;
-  methods.rows = bench::coreMethods(*geometry, wanted);
+  methods.rows = bench::coreMethods(*geometry, wanted, options.threads);
   const auto wanted_or_robust = [&](const std::string& name) {
     return wanted(name) || name == "embree_robust";
   };
@@ -223,6 +230,7 @@ std::string commandLine(const Options& options) {
   if (options.quick) command += " --quick";
   if (options.scenes != bench::sceneNames()) command += " --scene " + joined(options.scenes);
   if (!options.methods.empty()) command += " --method " + joined(options.methods);
+  if (options.threads != 1) command += " --threads " + std::to_string(options.threads);
   return command;
 }
 
@@ -238,8 +246,12 @@ std::string runInfo(const Options& options, const bench::Settings& settings,
                     const std::vector<bench::Row>& rows, double seconds) {
   std::ostringstream info;
   info << "# laser_raycast benchmark\n\n";
-  info << "Run: " << runLabel(options) << ", single-threaded, " << std::lround(seconds)
-       << " s wall clock. ";
+  info << "Run: " << runLabel(options) << ", single-threaded";
+  if (options.threads != 1) {
+    info << " except the second pipeline row (threads " << options.threads
+         << (options.threads == 0 ? ": every core" : "") << ")";
+  }
+  info << ", " << std::lround(seconds) << " s wall clock. ";
   info << "Sensor poses per scene: ";
   for (const auto& w : bench::workloads()) {
     info << w.name << " " << (options.quick ? w.quick_poses : w.full_poses) << ", ";

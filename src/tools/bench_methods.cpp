@@ -68,22 +68,24 @@ Pass brutePass(const core::BvhT<T>& bvh) {
 }
 
 // The pipeline as the node runs it: one Caster::cast per sensor pose over the whole pattern.
-// forget() first, so that an unchanged pose does not return the previous result.
-Pass pipelinePass(const BenchScene& scene) {
+// forget() first, so that an unchanged pose does not return the previous result. The caster keeps
+// its thread pool between casts, as the node's does.
+Pass pipelinePass(const BenchScene& scene, int threads) {
   auto caster = std::make_shared<core::Caster>();
-  return
-      [caster, &scene](const WorkloadRays& w, const std::vector<int>&, std::vector<double>* out) {
-        core::CastConfig config;
-        config.tmin = 0;
-        config.tmax = w.tmax;
-        const std::size_t beams = static_cast<std::size_t>(w.pattern->size());
-        for (std::size_t p = 0; p < w.sensors.size(); ++p) {
-          caster->forget();
-          const core::ScanResult& result =
-              caster->cast(scene.scene, scene.frame_poses, w.sensors[p], *w.pattern, config);
-          std::copy(result.range.begin(), result.range.end(), out->begin() + p * beams);
-        }
-      };
+  return [caster, &scene, threads](const WorkloadRays& w, const std::vector<int>&,
+                                   std::vector<double>* out) {
+    core::CastConfig config;
+    config.tmin = 0;
+    config.tmax = w.tmax;
+    config.threads = threads;
+    const std::size_t beams = static_cast<std::size_t>(w.pattern->size());
+    for (std::size_t p = 0; p < w.sensors.size(); ++p) {
+      caster->forget();
+      const core::ScanResult& result =
+          caster->cast(scene.scene, scene.frame_poses, w.sensors[p], *w.pattern, config);
+      std::copy(result.range.begin(), result.range.end(), out->begin() + p * beams);
+    }
+  };
 }
 
 template <typename T>
@@ -164,7 +166,7 @@ WorkloadRays makeRays(const BenchScene& scene, const Workload& workload, int pos
   return w;
 }
 
-std::vector<Method> coreMethods(const SceneGeometry& g, const MethodFilter& wanted) {
+std::vector<Method> coreMethods(const SceneGeometry& g, const MethodFilter& wanted, int threads) {
   std::vector<Method> methods;
   for (const core::TriangleMethod m : core::kAllTriangleMethods) {
     core::dispatchTriangleMethod(m, [&](auto method) {
@@ -174,8 +176,12 @@ std::vector<Method> coreMethods(const SceneGeometry& g, const MethodFilter& want
     });
   }
   if (wanted("pipeline")) {
-    methods.push_back(Method{"pipeline", false, true, g.scene->scene.triangleCount(),
-                             pipelinePass(*g.scene), true});
+    const std::size_t triangles = g.scene->scene.triangleCount();
+    methods.push_back(Method{"pipeline", false, true, triangles, pipelinePass(*g.scene, 1), true});
+    if (threads != 1) {
+      methods.push_back(Method{"pipeline", false, true, triangles, pipelinePass(*g.scene, threads),
+                               true, threads});
+    }
   }
   return methods;
 }

@@ -55,6 +55,7 @@ struct Method {
   std::size_t triangles = 0;  // triangles in the geometry it is given
   Pass pass;
   bool paired = false;  // timed in alternating rounds with the other paired rows (speed ratios)
+  int threads = 1;      // threads the method casts with (the pipeline's CastConfig::threads)
 };
 
 // Which methods to build (--method); a method not wanted costs nothing.
@@ -69,8 +70,10 @@ struct SceneGeometry {
 
 // The core's methods: every intersector in double and float, brute force and BVH, then the
 // pipeline (Caster::cast, with Caster::forget() before every cast so nothing is reused); those
-// wanted. The float rows need geometry.bvh_f.
-std::vector<Method> coreMethods(const SceneGeometry& geometry, const MethodFilter& wanted);
+// wanted. With threads != 1 the pipeline has a second row cast with that many threads (0: every
+// core). The float rows need geometry.bvh_f.
+std::vector<Method> coreMethods(const SceneGeometry& geometry, const MethodFilter& wanted,
+                                int threads);
 // Their names, in the same order, for --list-methods.
 std::vector<std::string> coreMethodNames();
 

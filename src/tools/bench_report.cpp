@@ -46,7 +46,8 @@ std::ofstream openForWriting(const std::string& path) {
 }  // namespace
 
 const char* const kCsvHeader =
-    "workload,scene,method,triangles,rays,ns_per_ray,mrays_per_s,max_abs_err_m,p99_abs_err_m,"
+    "workload,scene,method,threads,triangles,rays,ns_per_ray,mrays_per_s,max_abs_err_m,p99_abs_err_"
+    "m,"
     "max_ulp,leaks,false_hits,agree_robust,disagree_robust";
 
 ErrorStats compareWithReference(const std::vector<double>& dist, const std::vector<Real>& reference,
@@ -102,11 +103,11 @@ void writeCsv(const std::string& path, const std::vector<Row>& rows) {
   std::ofstream out = openForWriting(path);
   out << kCsvHeader << "\n";
   for (const Row& r : rows) {
-    out << r.workload << "," << r.scene << "," << r.method << "," << r.triangles << "," << r.rays
-        << "," << format("%.6g", r.ns_per_ray) << "," << format("%.6g", 1000.0 / r.ns_per_ray)
-        << "," << format("%.6g", r.errors.max_abs_err_m) << ","
-        << format("%.6g", r.errors.p99_abs_err_m) << "," << format("%.6g", r.errors.max_ulp) << ","
-        << r.errors.leaks << "," << r.errors.false_hits << ",";
+    out << r.workload << "," << r.scene << "," << r.method << "," << r.threads << "," << r.triangles
+        << "," << r.rays << "," << format("%.6g", r.ns_per_ray) << ","
+        << format("%.6g", 1000.0 / r.ns_per_ray) << "," << format("%.6g", r.errors.max_abs_err_m)
+        << "," << format("%.6g", r.errors.p99_abs_err_m) << "," << format("%.6g", r.errors.max_ulp)
+        << "," << r.errors.leaks << "," << r.errors.false_hits << ",";
     if (r.agree_robust.available()) {
       out << fractionDown(r.agree_robust.fraction, 8) << "," << r.agree_robust.disagree;
     } else {
@@ -125,17 +126,18 @@ void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
   }
   std::ofstream out = openForWriting(path);
   out << run_info << "\n";
-  out << "| workload | scene | method | triangles | rays | ns_per_ray | mrays_per_s | "
+  out << "| workload | scene | method | threads | triangles | rays | ns_per_ray | mrays_per_s | "
          "max_abs_err_m | p99_abs_err_m | max_ulp | leaks | false_hits | vs_embree | agree_robust "
          "| "
          "disagree_robust |\n";
   out << "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: "
+         "| ---: "
          "| ---: | ---: |\n";
   for (const Row& r : rows) {
     const auto it = embree.find({r.workload, r.scene});
     const std::string vs = it == embree.end() ? "n/a" : format("%.3g", it->second / r.ns_per_ray);
-    out << "| " << r.workload << " | " << r.scene << " | " << r.method << " | " << r.triangles
-        << " | " << r.rays << " | " << format("%.4g", r.ns_per_ray) << " | "
+    out << "| " << r.workload << " | " << r.scene << " | " << r.method << " | " << r.threads
+        << " | " << r.triangles << " | " << r.rays << " | " << format("%.4g", r.ns_per_ray) << " | "
         << format("%.4g", 1000.0 / r.ns_per_ray) << " | " << format("%.3g", r.errors.max_abs_err_m)
         << " | " << format("%.3g", r.errors.p99_abs_err_m) << " | "
         << format("%.3g", r.errors.max_ulp) << " | " << r.errors.leaks << " | "

@@ -46,6 +46,7 @@ Agreement compareWithPeer(const std::vector<double>& dist, const std::vector<dou
 
 struct Row {
   std::string workload, scene, method;
+  int threads = 1;  // threads the method cast with (0: every core)
   std::size_t triangles = 0, rays = 0;
   double ns_per_ray = 0;
   ErrorStats errors;

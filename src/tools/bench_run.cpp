@@ -144,6 +144,7 @@ Row measureRow(const Method& method, const std::vector<double>& dist, const std:
                const References& refs, const std::vector<double>& robust, std::string* log) {
   Row row;
   row.method = method.name;
+  row.threads = method.threads;
   row.triangles = method.triangles;
   row.rays = used.size();
   row.errors = compareWithReference(dist, method.pipeline ? refs.pipeline : refs.soup, used);
@@ -222,7 +223,9 @@ void runWorkload(const Settings& settings, int poses, const BenchScene& scene,
     row.range_max = scene.range_max;
     const double ns = 1e9 / static_cast<double>(row.rays);
     row.ns_per_ray = median(measured[k].seconds) * ns;
-    std::cerr << "    " << row.method << ": " << row.ns_per_ray << " ns/ray";
+    std::cerr << "    " << row.method
+              << (row.threads == 1 ? "" : " (threads " + std::to_string(row.threads) + ")") << ": "
+              << row.ns_per_ray << " ns/ray";
     if (measured[k].method->paired) {
       std::cerr << " (rounds:";
       for (const double s : measured[k].seconds) std::cerr << " " << s * ns;

@@ -37,11 +37,13 @@ const char* const kSynopsis =
     "                 [--angle-min RAD] [--angle-max RAD] [--samples N | --angle-increment RAD]\n"
     "                 [--range-min M] [--range-max M] [--geometry visual|collision]\n"
     "                 [--method seed_plane|seed_uv|cramer|moller_trumbore|watertight]\n"
-    "                 [--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n";
+    "                 [--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n"
+    "                 [--threads N]\n";
 const char* const kNotes =
     "Prints CSV 'index,angle,range,link' (REP 117: inf, -inf, nan); with --elevations\n"
     "'index,ring,elevation,angle,range,link' (ring 0 the lowest).\n"
-    "Defaults: angles -pi..pi, 360 samples, ranges 0..30 m, geometry visual, method watertight.\n"
+    "Defaults: angles -pi..pi, 360 samples, ranges 0..30 m, geometry visual, method watertight,\n"
+    "1 thread.\n"
     "Poses in metres and radians (URDF rpy). Exit status: 0 ok, 2 bad arguments, 3 bad scene\n"
     "input.\n";
 
@@ -57,6 +59,7 @@ struct Args {
   GeometrySource geometry = GeometrySource::kVisual;
   std::map<std::string, double> joints;
   int repeat = 0;
+  int threads = 1;     // CastConfig::threads: 0 every core
   bool rings = false;  // --elevations given: one fan per elevation, and the ring columns
 };
 
@@ -214,6 +217,12 @@ po::options_description flags(Args* args) {
       "joint values (rad or m; 0 if not given): several after one --joint, or one each");
   add("repeat", count("--repeat", &args->repeat),
       "cast N more times after loading and print the median cast time to stderr");
+  add("threads",
+      single("N",
+             [args](const std::string& v) {
+               args->threads = laser_raycast::tools::parseThreads("--threads", v);
+             }),
+      "threads a cast uses (default 1; 0: every core); the ranges are the same for any number");
   add("help,h", "print this help");
   return options;
 }
@@ -367,7 +376,8 @@ int main(int argc, char** argv) {
     return kExitBadArguments;
   }
   const core::ScanPattern pattern = args.scan.pattern();
-  const core::CastConfig config = args.scan.castConfig();
+  core::CastConfig config = args.scan.castConfig();
+  config.threads = args.threads;
   core::Caster caster;
   const core::ScanResult& result =
       caster.cast(loaded.scene, loaded.poses, args.sensor, pattern, config);

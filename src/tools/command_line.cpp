@@ -1,7 +1,11 @@
 #include "command_line.h"
 
+#include <algorithm>
+#include <cstdlib>
 #include <string>
 #include <vector>
+
+#include "laser_raycast/core/caster.h"
 
 namespace laser_raycast {
 namespace tools {
@@ -34,6 +38,20 @@ bool parseCommandLine(int argc, char** argv, const po::options_description& opti
     throw ArgError(e.what());
   }
   return true;
+}
+
+int parseThreads(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const long value = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0') throw ArgError(flag + ": '" + text + "' is not an integer");
+  core::CastConfig config;  // its validate() holds the bounds
+  config.threads = static_cast<int>(std::clamp<long>(value, -1, 1L << 20));
+  try {
+    config.validate();
+  } catch (const std::invalid_argument& e) {
+    throw ArgError(flag + ": '" + text + "': " + e.what());
+  }
+  return config.threads;
 }
 
 }  // namespace tools

@@ -4,6 +4,7 @@
 
 #include <boost/program_options.hpp>
 #include <stdexcept>
+#include <string>
 
 namespace laser_raycast {
 namespace tools {
@@ -21,6 +22,10 @@ class ArgError : public std::runtime_error {
 bool parseCommandLine(int argc, char** argv,
                       const boost::program_options::options_description& options,
                       boost::program_options::variables_map* values);
+
+// A thread count as core::CastConfig::threads takes it (0: every core). Throws ArgError naming
+// the flag and the text.
+int parseThreads(const std::string& flag, const std::string& text);
 
 }  // namespace tools
 }  // namespace laser_raycast

@@ -26,9 +26,10 @@ namespace {
 
 const std::string kBench = BENCH_PATH;
 const char* const kHeader =
-    "workload,scene,method,triangles,rays,ns_per_ray,mrays_per_s,max_abs_err_m,p99_abs_err_m,"
+    "workload,scene,method,threads,triangles,rays,ns_per_ray,mrays_per_s,max_abs_err_m,p99_abs_err_"
+    "m,"
     "max_ulp,leaks,false_hits,agree_robust,disagree_robust";
-constexpr std::size_t kFields = 14;
+constexpr std::size_t kFields = 15;
 
 std::vector<std::string> splitLines(const std::string& text) {
   std::vector<std::string> lines;
@@ -96,7 +97,7 @@ TEST(BenchSmoke, ListsTheScenes) {
 TEST(BenchSmoke, HelpListsEveryFlag) {
   const auto result = runCommand(kBench + " --help");
   ASSERT_EQ(result.status, 0);
-  for (const char* flag : {"--quick", "--out", "--scene", "--method", "--list-methods",
+  for (const char* flag : {"--quick", "--out", "--scene", "--method", "--threads", "--list-methods",
                            "--list-scenes", "Exit status"}) {
     EXPECT_NE(result.output.find(flag), std::string::npos) << flag << "\n" << result.output;
   }
@@ -219,6 +220,36 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
   }
   EXPECT_EQ(rows, (std::multiset<std::string>{"fan2d watertight_bvh", "fan2d pipeline",
                                               "rings3d watertight_bvh", "rings3d pipeline"}));
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(log);
+}
+
+// --threads adds a second pipeline row; the ranges do not depend on the thread count, so its
+// errors against the reference are the first row's, field for field.
+TEST(BenchSmoke, ThreadsAddsAPipelineRowWithTheSameRanges) {
+  const std::string dir = tempDir("bench_threads");
+  const std::string log = dir + ".log";
+  const auto run = runCommand("timeout 300 " + kBench +
+                              " --quick --scene box_room --method pipeline --threads 2 --out " +
+                              dir + " 2>" + log);
+  ASSERT_EQ(run.status, 0) << readFile(log);
+  const auto lines = splitLines(readFile(dir + "/results.csv"));
+  ASSERT_EQ(lines.size(), 5u) << readFile(dir + "/results.csv");  // header, 2 workloads x 2 rows
+  for (std::size_t i = 1; i + 1 < lines.size(); i += 2) {
+    const auto one = splitFields(lines[i]), two = splitFields(lines[i + 1]);
+    ASSERT_EQ(one.size(), kFields) << lines[i];
+    ASSERT_EQ(two.size(), kFields) << lines[i + 1];
+    EXPECT_EQ(one[2], "pipeline");
+    EXPECT_EQ(one[3], "1");
+    EXPECT_EQ(two[2], "pipeline");
+    EXPECT_EQ(two[3], "2");
+    for (const std::size_t k : {8, 9, 10, 11, 12, 13, 14}) {  // errors and agreement
+      EXPECT_EQ(one[k], two[k]) << "field " << k << ": " << lines[i] << " / " << lines[i + 1];
+    }
+  }
+  EXPECT_NE(readFile(dir + "/results.md").find("| pipeline | 2 |"), std::string::npos);
+  EXPECT_EQ(runCommand(kBench + " --threads 5000 2>/dev/null").status, 2);
+  EXPECT_EQ(runCommand(kBench + " --threads two 2>/dev/null").status, 2);
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
 }

@@ -345,6 +345,20 @@ TEST(CastScan, RepeatWithRings) {
   EXPECT_EQ(parseRings(run.out).size(), 16u);
 }
 
+// Enough beams (8 rings x 2048) for the cast to be split; the CSV must not change.
+TEST(CastScan, ThreadsGiveTheSameScan) {
+  const std::string base = "--urdf " + kData + "node_scene.urdf --sensor 0.5,0,0,0,0,0.1 " +
+                           "--samples 2048 --elevations -0.3,-0.2,-0.1,-0.05,0,0.05,0.1,0.2";
+  const CliRun one = runCli(base);
+  ASSERT_EQ(one.status, 0) << one.err;
+  ASSERT_EQ(parseRings(one.out).size(), 8u * 2048u);
+  for (const char* threads : {"2", "3", "0"}) {
+    const CliRun run = runCli(base + " --threads " + threads);
+    EXPECT_EQ(run.status, 0) << threads << ": " << run.err;
+    EXPECT_EQ(run.out, one.out) << "--threads " << threads;
+  }
+}
+
 TEST(CastScan, HelpExitsZero) {
   const CliRun run = runCli("--help");
   EXPECT_EQ(run.status, 0);
@@ -354,9 +368,10 @@ TEST(CastScan, HelpExitsZero) {
 TEST(CastScan, HelpListsEveryFlag) {
   const CliRun run = runCli("-h");
   ASSERT_EQ(run.status, 0);
-  for (const char* flag : {"--urdf", "--sensor", "--angle-min", "--angle-max", "--samples",
-                           "--angle-increment", "--range-min", "--range-max", "--geometry",
-                           "--method", "--elevations", "--joint", "--repeat", "Exit status"}) {
+  for (const char* flag :
+       {"--urdf", "--sensor", "--angle-min", "--angle-max", "--samples", "--angle-increment",
+        "--range-min", "--range-max", "--geometry", "--method", "--elevations", "--joint",
+        "--repeat", "--threads", "Exit status"}) {
     EXPECT_NE(run.out.find(flag), std::string::npos) << flag << "\n" << run.out;
   }
 }
@@ -398,6 +413,9 @@ TEST(CastScan, BadArgumentsExitTwo) {
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint elbow=1", "elbow");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint plate_fix=1", "plate_fix");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint swing", "NAME=VALUE");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --threads -1", "--threads: '-1'");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --threads 5000", "--threads: '5000'");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --threads 2x", "--threads: '2x'");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --repeat", "--repeat");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations ''", "--elevations");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,nan", "--elevations: 'nan'");
