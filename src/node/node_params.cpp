@@ -9,56 +9,11 @@
 #include <stdexcept>
 
 #include "param_reader.h"
+#include "sensor_params.h"
 
-// The parameters are read in groups. The sensor's own groups (frames, fan, output, timing, pose
-// source) take a reader over one struct, so that a list of sensors could later be read entry by
-// entry with the same functions.
+// The parameters are read in groups: the node's own here, each sensor's in sensor_params.cpp.
 namespace laser_raycast {
 namespace {
-
-// tf2 frame ids have no leading '/' (tf1 had one); an empty one names no frame.
-void checkFrame(ParamReader* r, const std::string& name, const std::string& frame, bool optional) {
-  if (frame.empty() && !optional) r->fail(name, "must not be empty");
-  if (!frame.empty() && frame[0] == '/') {
-    r->fail(name, "'" + frame + "': tf2 frame ids must not start with '/'");
-  }
-}
-
-void readFrames(ParamReader* r, NodeParams* p) {
-  p->frame_id = r->text("frame_id", p->frame_id);
-  checkFrame(r, "frame_id", p->frame_id, false);
-  p->fixed_frame = r->text("fixed_frame", p->fixed_frame);
-  checkFrame(r, "fixed_frame", p->fixed_frame, false);
-}
-
-// The beam count comes from exactly one of ~angle_increment and ~samples (neither:
-// kDefaultSamples); the core checks the angles and the beam count.
-void readFan(ParamReader* r, core::FanSpec* fan) {
-  fan->angle_min = r->number("angle_min", fan->angle_min, "rad");
-  fan->angle_max = r->number("angle_max", fan->angle_max, "rad");
-  const bool has_increment = r->has("angle_increment"), has_samples = r->has("samples");
-  if (has_increment) {
-    fan->angle_increment = r->number("angle_increment", 0.0, "rad");
-    if (!(std::isfinite(fan->angle_increment) && fan->angle_increment > 0)) {
-      r->fail("angle_increment",
-              "must be finite and > 0 rad, got " + formatNumber(fan->angle_increment));
-    }
-  } else {
-    r->note(r->prefix() + "angle_increment unset (beams from " + r->prefix() + "samples)");
-  }
-  if (has_samples || !has_increment) {
-    fan->samples = r->integer("samples", NodeParams::kDefaultSamples, "beams");
-    if (fan->samples < 2) r->fail("samples", "must be >= 2, got " + std::to_string(fan->samples));
-  } else {
-    r->note(r->prefix() + "samples unset (beams from " + r->prefix() + "angle_increment)");
-  }
-  if (has_increment && has_samples) {
-    r->fail("samples", "set " + r->prefix() + "angle_increment or " + r->prefix() +
-                           "samples, not both (got angle_increment " +
-                           formatNumber(fan->angle_increment) + " and samples " +
-                           std::to_string(fan->samples) + ")");
-  }
-}
 
 // The entries of a reflectivity dict, `link` being the path to it. The parameter server splits
 // names at '/', so a link with a TF prefix ("robot2/wall") arrives as a nested dict ({robot2:
@@ -87,7 +42,7 @@ void readReflectivityEntries(ParamReader* r, const std::string& link, const XmlR
 }
 
 // ~reflectivity: {link: value >= 0}; an empty dict is the same as none.
-void readReflectivity(ParamReader* r, std::map<std::string, double>* reflectivity) {
+void readReflectivityDict(ParamReader* r, std::map<std::string, double>* reflectivity) {
   const XmlRpc::XmlRpcValue* v = r->get("reflectivity");
   if (v && v->getType() != XmlRpc::XmlRpcValue::TypeStruct) {
     r->wrongType("reflectivity", *v, "a dict {link: reflectivity}");
@@ -101,36 +56,17 @@ void readReflectivity(ParamReader* r, std::map<std::string, double>* reflectivit
   r->note(r->prefix() + "reflectivity = {" + shown + "}");
 }
 
-// What the sensor reports: range limits, min-range policy, noise, intensity.
-void readOutput(ParamReader* r, NodeParams* p, std::vector<std::string>* warnings) {
-  core::EncoderConfig& out = p->scan.output;
-  out.range_min = r->number("range_min", out.range_min, "m");
-  out.range_max = r->number("range_max", out.range_max, "m");
-  out.min_range_policy =
-      r->choice("min_range_policy", out.min_range_policy, core::kMinRangePolicyNames);
-  out.noise_stddev = r->number("noise_stddev", out.noise_stddev, "m");
-  const int seed = r->integer("noise_seed", static_cast<int>(out.noise_seed), "");
-  if (seed < 0) r->fail("noise_seed", "must be >= 0, got " + std::to_string(seed));
-  out.noise_seed = static_cast<std::uint64_t>(std::max(seed, 0));
-  out.intensity = r->choice("intensity", out.intensity, kIntensityNames);
-  readReflectivity(r, &p->reflectivity);
+// The geometry's reflectivity, for the sensors whose ~intensity is on.
+void readReflectivity(ParamReader* r, NodeParams* p) {
+  readReflectivityDict(r, &p->reflectivity);
   p->default_reflectivity = r->number("default_reflectivity", p->default_reflectivity, "");
   if (!(std::isfinite(p->default_reflectivity) && p->default_reflectivity >= 0)) {
     r->fail("default_reflectivity",
             "must be finite and >= 0, got " + formatNumber(p->default_reflectivity));
   }
-  if (!out.intensity && !p->reflectivity.empty()) {
-    warnings->push_back(r->prefix() + "reflectivity is set but " + r->prefix() +
-                        "intensity is off: no intensities are published");
-  }
 }
 
-void readTiming(ParamReader* r, NodeParams* p) {
-  p->rate = r->number("rate", p->rate, "Hz");
-  if (!(std::isfinite(p->rate) && p->rate > 0 && p->rate <= NodeParams::kMaxRate)) {
-    r->fail("rate", "must be in (0, " + formatNumber(NodeParams::kMaxRate) + "] Hz, got " +
-                        formatNumber(p->rate));
-  }
+void readTfTimeout(ParamReader* r, NodeParams* p) {
   p->tf_timeout = r->number("tf_timeout", p->tf_timeout, "s");
   if (!(std::isfinite(p->tf_timeout) && p->tf_timeout >= 0 &&
         p->tf_timeout <= NodeParams::kMaxTfTimeout)) {
@@ -197,40 +133,30 @@ void readModels(ParamReader* r, std::vector<ModelSource>* models) {
   }
 }
 
-// Which geometry is cast against, and how.
+// Which geometry is cast against.
 void readScene(ParamReader* r, NodeParams* p) {
   p->geometry = r->choice("geometry", p->geometry, kGeometrySourceNames);
   p->skip_bad_geometry = r->boolean("skip_bad_geometry", p->skip_bad_geometry);
   readModels(r, &p->models);
   p->ignore_links = r->textList("ignore_links");
-  p->scan.method = r->choice("method", p->scan.method, core::kTriangleMethodNames);
-  p->scan.cull_backfaces = r->boolean("cull_backfaces", p->scan.cull_backfaces);
 }
 
-// Where the sensor pose comes from: TF, or a topic giving the pose of pose_frame.
-void readPoseSource(ParamReader* r, NodeParams* p) {
-  p->pose_topic = r->text("pose_topic", p->pose_topic);
-  std::string why;
-  if (!p->pose_topic.empty() && !ros::names::validate(p->pose_topic, why)) {
-    r->fail("pose_topic", "'" + p->pose_topic + "' is not a valid topic name: " + why);
-  }
-  p->pose_frame = r->text("pose_frame", p->pose_frame);
-  checkFrame(r, "pose_frame", p->pose_frame, true);
-  if (!p->pose_frame.empty() && p->pose_topic.empty()) {
-    r->fail("pose_frame", "is set to '" + p->pose_frame + "' but " + r->prefix() +
-                              "pose_topic is not (pose_frame names the frame whose pose the "
-                              "topic gives)");
-  }
-}
-
-// Every group, in the order the log lists them.
+// Every group, in the order the log lists them: the node's own, then the sensor's.
 void readAll(ParamReader* r, NodeParams* p, std::vector<std::string>* warnings) {
-  readFrames(r, p);
-  readFan(r, &p->scan.fan);
-  readOutput(r, p, warnings);
-  readTiming(r, p);
+  p->fixed_frame = r->text("fixed_frame", p->fixed_frame);
+  checkFrame(r, "fixed_frame", p->fixed_frame, false);
+  readTfTimeout(r, p);
   readScene(r, p);
-  readPoseSource(r, p);
+  readReflectivity(r, p);
+  p->sensors.assign(1, SensorParams());
+  readSensor(r, &p->sensors[0]);
+  const bool any_intensity =
+      std::any_of(p->sensors.begin(), p->sensors.end(),
+                  [](const SensorParams& s) { return s.scan.output.intensity; });
+  if (!any_intensity && !p->reflectivity.empty()) {
+    warnings->push_back(r->prefix() + "reflectivity is set but " + r->prefix() +
+                        "intensity is off: no intensities are published");
+  }
 }
 
 }  // namespace
@@ -249,7 +175,7 @@ std::string parseNodeParams(const XmlRpc::XmlRpcValue& values, NodeParams* p, Pa
   // the field (the fields share the parameters' names).
   if (r.error().empty()) {
     try {
-      p->scan.validate();
+      for (const SensorParams& sensor : p->sensors) sensor.scan.validate();
     } catch (const std::invalid_argument& e) {
       r.failWith(std::string("bad parameter: ") + e.what());
     }

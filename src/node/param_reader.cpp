@@ -43,6 +43,13 @@ std::string describeValue(const XmlRpc::XmlRpcValue& value) {
   }
 }
 
+std::string joinFirst(const std::vector<std::string>& names, std::size_t n) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size() && i < n; ++i) out += (i ? ", " : "") + names[i];
+  if (names.size() > n) out += ", ... (" + std::to_string(names.size() - n) + " more)";
+  return out;
+}
+
 const char* typeName(XmlRpc::XmlRpcValue::Type type) {
   switch (type) {
     case XmlRpc::XmlRpcValue::TypeBoolean:

@@ -18,6 +18,8 @@ namespace laser_raycast {
 std::string formatNumber(double value);
 // A parameter value as YAML would write it ('text', 0.5, true, [a, b], {k: v}), for messages.
 std::string describeValue(const XmlRpc::XmlRpcValue& value);
+// The first n names, comma-separated, then "... (N more)" if there are more.
+std::string joinFirst(const std::vector<std::string>& names, std::size_t n);
 // "bool", "int", "double", "string", "list", "dict".
 const char* typeName(XmlRpc::XmlRpcValue::Type type);
 

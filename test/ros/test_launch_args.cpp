@@ -64,16 +64,17 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
   ASSERT_EQ(all.error, "");
   EXPECT_TRUE(all.report.warnings.empty()) << all.report.warnings.front();
   const NodeParams& p = all.params;
-  EXPECT_EQ(p.frame_id, "base_scan");
+  EXPECT_EQ(p.sensors.at(0).frame_id, "base_scan");
   EXPECT_EQ(p.fixed_frame, "odom");
-  EXPECT_EQ(p.scan.fan.angle_min, -1.5);
-  EXPECT_EQ(p.scan.fan.angle_max, 1.5);
-  EXPECT_EQ(p.scan.fan.angle_increment, 0.01);
-  EXPECT_EQ(p.scan.fan.samples, 0);
-  EXPECT_EQ(p.scan.output.range_min, 0.12);
-  EXPECT_EQ(p.scan.output.range_max, 3.5);
-  EXPECT_EQ(p.scan.output.min_range_policy, laser_raycast::core::MinRangePolicy::kPassThrough);
-  EXPECT_EQ(p.rate, 5.0);
+  EXPECT_EQ(p.sensors.at(0).scan.fan.angle_min, -1.5);
+  EXPECT_EQ(p.sensors.at(0).scan.fan.angle_max, 1.5);
+  EXPECT_EQ(p.sensors.at(0).scan.fan.angle_increment, 0.01);
+  EXPECT_EQ(p.sensors.at(0).scan.fan.samples, 0);
+  EXPECT_EQ(p.sensors.at(0).scan.output.range_min, 0.12);
+  EXPECT_EQ(p.sensors.at(0).scan.output.range_max, 3.5);
+  EXPECT_EQ(p.sensors.at(0).scan.output.min_range_policy,
+            laser_raycast::core::MinRangePolicy::kPassThrough);
+  EXPECT_EQ(p.sensors.at(0).rate, 5.0);
   EXPECT_EQ(p.tf_timeout, 0.25);
   ASSERT_EQ(p.models.size(), 2u);
   EXPECT_EQ(p.models[0].param, "scene_description");
@@ -84,20 +85,21 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
   EXPECT_EQ(p.geometry, laser_raycast::GeometrySource::kCollision);
   EXPECT_EQ(p.ignore_links, (std::vector<std::string>{"s/arm", "slider"}));
   EXPECT_TRUE(p.skip_bad_geometry);
-  EXPECT_EQ(p.scan.output.noise_stddev, 0.01);
-  EXPECT_EQ(p.scan.output.noise_seed, 42u);
-  EXPECT_TRUE(p.scan.output.intensity);
+  EXPECT_EQ(p.sensors.at(0).scan.output.noise_stddev, 0.01);
+  EXPECT_EQ(p.sensors.at(0).scan.output.noise_seed, 42u);
+  EXPECT_TRUE(p.sensors.at(0).scan.output.intensity);
   EXPECT_EQ(p.reflectivity, (std::map<std::string, double>{{"s/plate", 0.5}, {"t/plate", 2.0}}));
   EXPECT_EQ(p.default_reflectivity, 0.25);
-  EXPECT_EQ(p.scan.method, laser_raycast::core::TriangleMethod::kCramer);
-  EXPECT_TRUE(p.scan.cull_backfaces);
-  EXPECT_EQ(p.pose_topic, "/all/pose");
-  EXPECT_EQ(p.pose_frame, "base_link");
+  EXPECT_EQ(p.sensors.at(0).scan.method, laser_raycast::core::TriangleMethod::kCramer);
+  EXPECT_TRUE(p.sensors.at(0).scan.cull_backfaces);
+  EXPECT_EQ(p.sensors.at(0).pose_topic, "/all/pose");
+  EXPECT_EQ(p.sensors.at(0).pose_frame, "base_link");
+  EXPECT_EQ(p.sensors.at(0).pose_timeout, 0.2);
 
   const Parsed samples = parseFromMaster("/samples/laser_raycast");
   ASSERT_EQ(samples.error, "");
-  EXPECT_EQ(samples.params.scan.fan.samples, 100);
-  EXPECT_EQ(samples.params.scan.fan.angle_increment, 0.0);
+  EXPECT_EQ(samples.params.sensors.at(0).scan.fan.samples, 100);
+  EXPECT_EQ(samples.params.sensors.at(0).scan.fan.angle_increment, 0.0);
 
   // Between them, the two set every parameter the node reads.
   std::set<std::string> set = keys(all.values);

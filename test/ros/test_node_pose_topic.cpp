@@ -1,6 +1,6 @@
 // rostest node_pose_topic.test: the sensor pose from geometry_msgs/PoseWithCovarianceStamped (of
-// another frame, combined with TF) and from geometry_msgs/PoseStamped; non-finite poses are
-// ignored.
+// another frame, combined with TF) and from geometry_msgs/PoseStamped; a pose older than
+// ~pose_timeout or a non-finite one gives no scan.
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
@@ -8,14 +8,35 @@
 #include <sensor_msgs/LaserScan.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <vector>
 
 namespace laser_raycast_test {
 namespace {
 
 constexpr double kTolerance = 1e-5;  // m
+// ~pose_timeout of node "plain" (node_pose_topic.test).
+constexpr double kPoseTimeout = 0.3;  // s
+
+// The range of `beam`, or NaN (with a failure naming the topic) if the scan has no such beam: a
+// scan that never came fails the test with a message instead of crashing it.
+double rangeOf(const sensor_msgs::LaserScan& scan, std::size_t beam) {
+  if (beam >= scan.ranges.size()) {
+    ADD_FAILURE() << "the scan has " << scan.ranges.size() << " beams, not " << beam + 1;
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  return scan.ranges[beam];
+}
+
+bool anyValid(const sensor_msgs::LaserScan& scan) {
+  for (const float r : scan.ranges) {
+    if (r >= scan.range_min && r <= scan.range_max) return true;
+  }
+  return false;
+}
 
 class PoseTopicTest : public ::testing::Test {
  protected:
@@ -26,8 +47,11 @@ class PoseTopicTest : public ::testing::Test {
         "scan_cov", 10,
         [this](const sensor_msgs::LaserScan::ConstPtr& m) { store(&cov_scan_, m); });
     plain_sub_ = nh_.subscribe<sensor_msgs::LaserScan>(
-        "scan_plain", 10,
-        [this](const sensor_msgs::LaserScan::ConstPtr& m) { store(&plain_scan_, m); });
+        "scan_plain", 100, [this](const sensor_msgs::LaserScan::ConstPtr& m) {
+          store(&plain_scan_, m);
+          std::lock_guard<std::mutex> lock(mutex_);
+          plain_all_.push_back(m);
+        });
     // The laser is mounted 0.5 m ahead of "base".
     geometry_msgs::TransformStamped mount;
     mount.header.stamp = ros::Time::now();
@@ -62,6 +86,26 @@ class PoseTopicTest : public ::testing::Test {
     return sensor_msgs::LaserScan();
   }
 
+  // Calls `publish` every 50 ms for `seconds` (wall time), spinning; returns the scans of node
+  // "plain" that arrived meanwhile.
+  template <class F>
+  std::vector<sensor_msgs::LaserScan::ConstPtr> plainScansWhile(double seconds, F publish) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      plain_all_.clear();
+    }
+    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::ok() && ros::WallTime::now() < end) {
+      publish();
+      for (int i = 0; i < 5; ++i) {
+        ros::spinOnce();
+        ros::WallDuration(0.01).sleep();
+      }
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    return plain_all_;
+  }
+
   void publishCov(double x, double y) {
     geometry_msgs::PoseWithCovarianceStamped m;
     m.header.stamp = ros::Time::now();
@@ -71,7 +115,8 @@ class PoseTopicTest : public ::testing::Test {
     m.pose.pose.orientation.w = 1;
     cov_pub_.publish(m);
   }
-  void publishPlain(double x, double y, double qw) {
+  // Returns the message's stamp.
+  ros::Time publishPlain(double x, double y, double qw) {
     geometry_msgs::PoseStamped m;
     m.header.stamp = ros::Time::now();
     m.header.frame_id = "world";
@@ -79,6 +124,19 @@ class PoseTopicTest : public ::testing::Test {
     m.pose.position.y = y;
     m.pose.orientation.w = qw;
     plain_pub_.publish(m);
+    return m.header.stamp;
+  }
+
+  // Every scan with a valid range must be stamped at most pose_timeout after the last good pose.
+  void expectNoScanFromAStalePose(const std::vector<sensor_msgs::LaserScan::ConstPtr>& scans,
+                                  const ros::Time& last_good) {
+    for (const auto& scan : scans) {
+      const double age = (scan->header.stamp - last_good).toSec();
+      if (age > kPoseTimeout) {
+        EXPECT_FALSE(anyValid(*scan)) << "a scan at t = " << scan->header.stamp << " from a pose "
+                                      << age << " s old (~pose_timeout " << kPoseTimeout << ")";
+      }
+    }
   }
 
   ros::NodeHandle nh_;
@@ -87,6 +145,7 @@ class PoseTopicTest : public ::testing::Test {
   tf2_ros::StaticTransformBroadcaster static_broadcaster_;
   std::mutex mutex_;
   sensor_msgs::LaserScan::ConstPtr cov_scan_, plain_scan_;
+  std::vector<sensor_msgs::LaserScan::ConstPtr> plain_all_;
 };
 
 // Beam 4 looks along +x at the box face x = 2.5 (test/data/node_scene.urdf); beam 0 along -x at the
@@ -95,26 +154,47 @@ TEST_F(PoseTopicTest, PoseWithCovarianceOfAnotherFrameIsCombinedWithTf) {
   // base at x = -0.5 puts the laser at the origin.
   sensor_msgs::LaserScan scan = scanAfter([&] { publishCov(-0.5, 0); }, &cov_scan_);
   ASSERT_EQ(scan.ranges.size(), 8u);
-  EXPECT_NEAR(scan.ranges[4], 2.5, kTolerance);
-  EXPECT_NEAR(scan.ranges[0], 1.5, kTolerance);
+  EXPECT_NEAR(rangeOf(scan, 4), 2.5, kTolerance);
+  EXPECT_NEAR(rangeOf(scan, 0), 1.5, kTolerance);
   // base at x = 0.5: the laser at x = 1.
   scan = scanAfter([&] { publishCov(0.5, 0); }, &cov_scan_);
-  EXPECT_NEAR(scan.ranges[4], 1.5, kTolerance);
-  EXPECT_NEAR(scan.ranges[0], 2.5, kTolerance);
+  EXPECT_NEAR(rangeOf(scan, 4), 1.5, kTolerance);
+  EXPECT_NEAR(rangeOf(scan, 0), 2.5, kTolerance);
 }
 
-TEST_F(PoseTopicTest, PoseStampedGivesTheLaserPoseAndBadPosesAreIgnored) {
-  sensor_msgs::LaserScan scan = scanAfter([&] { publishPlain(0.5, 0, 1); }, &plain_scan_);
+TEST_F(PoseTopicTest, PoseStampedGivesTheLaserPose) {
+  const sensor_msgs::LaserScan scan = scanAfter([&] { publishPlain(0.5, 0, 1); }, &plain_scan_);
   ASSERT_EQ(scan.ranges.size(), 8u);
-  EXPECT_NEAR(scan.ranges[4], 2.0, kTolerance);
-  // A NaN position and a zero quaternion are dropped: scans keep using the last good pose.
-  scan = scanAfter(
-      [&] {
-        publishPlain(std::numeric_limits<double>::quiet_NaN(), 0, 1);
-        publishPlain(0.1, 0, 0);
-      },
-      &plain_scan_);
-  EXPECT_NEAR(scan.ranges[4], 2.0, kTolerance);
+  EXPECT_NEAR(rangeOf(scan, 4), 2.0, kTolerance);
+}
+
+// The publisher stops: the last pose serves scans for ~pose_timeout, then none come.
+TEST_F(PoseTopicTest, NoScanFromAPoseOlderThanPoseTimeout) {
+  scanAfter([&] { publishPlain(0.5, 0, 1); }, &plain_scan_);
+  const ros::Time last_good = publishPlain(0.5, 0, 1);
+  const auto scans = plainScansWhile(2.0, [] {});
+  expectNoScanFromAStalePose(scans, last_good);
+  // The pose was held while fresh: scans came after the last message, none later than the timeout.
+  int held = 0;
+  for (const auto& scan : scans) held += scan->header.stamp > last_good && anyValid(*scan);
+  EXPECT_GT(held, 0) << "no scan from the last pose while it was fresh";
+  // And they resume with the publisher.
+  const sensor_msgs::LaserScan again = scanAfter([&] { publishPlain(1.0, 0, 1); }, &plain_scan_);
+  EXPECT_NEAR(rangeOf(again, 4), 1.5, kTolerance);
+}
+
+// A NaN position or a zero quaternion says the pose is unknown: no scan from the last good pose
+// beyond ~pose_timeout (the node stops at the bad message's stamp).
+TEST_F(PoseTopicTest, NoScanFromANonFinitePose) {
+  const double kNan = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& bad : {std::array<double, 3>{kNan, 0, 1}, std::array<double, 3>{0.1, 0, 0}}) {
+    scanAfter([&] { publishPlain(0.5, 0, 1); }, &plain_scan_);
+    const ros::Time last_good = publishPlain(0.5, 0, 1);
+    const auto scans = plainScansWhile(1.5, [&] { publishPlain(bad[0], bad[1], bad[2]); });
+    expectNoScanFromAStalePose(scans, last_good);
+    const sensor_msgs::LaserScan again = scanAfter([&] { publishPlain(0.5, 0, 1); }, &plain_scan_);
+    EXPECT_NEAR(rangeOf(again, 4), 2.0, kTolerance);
+  }
 }
 
 }  // namespace

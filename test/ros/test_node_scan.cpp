@@ -207,6 +207,7 @@ TEST_F(NodeScanTest, MovingFramesChangeTheScan) {
   expectRange(scan, 0, 2.5);
   // The plate (y in [-3.1, -2.9], x in [-1, 1]) is seen edge-on from x = 1: the -pi/2 beam grazes
   // its end face at x = 1 exactly, so it may hit at 2.9 m; anything else would be wrong.
+  ASSERT_EQ(scan.ranges.size(), 8u);
   EXPECT_TRUE(scan.ranges[2] == std::numeric_limits<float>::infinity() ||
               std::abs(scan.ranges[2] - 2.9) < kTolerance)
       << scan.ranges[2];

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <ros/package.h>
 #include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
 #include <array>
@@ -123,8 +124,15 @@ double logTime(const std::string& output, const std::string& severity, const std
   return std::nan("");
 }
 
+// A subscriber to the scans of the node in namespace ns: the node casts only while someone listens.
+void ignoreScan(const sensor_msgs::LaserScan::ConstPtr&) {}
+ros::Subscriber listenTo(const std::string& ns) {
+  return ros::NodeHandle().subscribe(ns + "/scan", 1, &ignoreScan);
+}
+
 // Transforms that arrive a second after the node starts are waited for without a warning.
 TEST(NodeStartup, WaitsQuietlyForTheFirstTransforms) {
+  const ros::Subscriber listener = listenTo("/t");
   tf2_ros::StaticTransformBroadcaster broadcaster;
   std::thread late([&broadcaster] {
     ros::WallDuration(1.0).sleep();
@@ -148,6 +156,7 @@ TEST(NodeStartup, WaitsQuietlyForTheFirstTransforms) {
 // Transforms that never come are warned about once the grace period is over.
 TEST(NodeStartup, WarnsWhenTheTransformsNeverCome) {
   const double grace = laser_raycast::RaycastNode::kTfGracePeriod;
+  const ros::Subscriber listener = listenTo("/u");
   const NodeRun run =
       runNode(scene("/u") + " _frame_id:=no_such_laser", static_cast<int>(grace) + 4);
   const double ready = logTime(run.output, "INFO", "laser_raycast: ");

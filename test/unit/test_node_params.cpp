@@ -84,7 +84,7 @@ const std::vector<std::string> kReadmeParameters = {
     "samples",      "range_min",      "range_max",  "min_range_policy", "rate",
     "tf_timeout",   "models",         "geometry",   "ignore_links",     "skip_bad_geometry",
     "noise_stddev", "noise_seed",     "intensity",  "reflectivity",     "default_reflectivity",
-    "method",       "cull_backfaces", "pose_topic", "pose_frame"};
+    "method",       "cull_backfaces", "pose_topic", "pose_frame",       "pose_timeout"};
 
 TEST(NodeParams, TheNodeReadsExactlyTheDocumentedParameters) {
   std::vector<std::string> read = laser_raycast::nodeParamNames();
@@ -101,23 +101,26 @@ TEST(NodeParams, EveryDefault) {
     ASSERT_EQ(parsed.error, "");
     EXPECT_TRUE(parsed.report.warnings.empty()) << parsed.report.warnings.front();
     const NodeParams& p = parsed.params;
-    EXPECT_EQ(p.frame_id, "laser");
+    EXPECT_EQ(p.sensors.at(0).frame_id, "laser");
     EXPECT_EQ(p.fixed_frame, "map");
-    EXPECT_EQ(p.scan.fan.angle_min, -M_PI);
-    EXPECT_EQ(p.scan.fan.angle_max, M_PI);
-    EXPECT_EQ(p.scan.fan.angle_increment, 0.0);  // unset: from samples
-    EXPECT_EQ(p.scan.fan.samples, 360);
-    EXPECT_EQ(p.scan.output.range_min, 0.0);
-    EXPECT_EQ(p.scan.output.range_max, 30.0);
-    EXPECT_EQ(p.scan.output.min_range_policy, laser_raycast::core::MinRangePolicy::kNegInf);
-    EXPECT_EQ(p.scan.output.noise_stddev, 0.0);
-    EXPECT_EQ(p.scan.output.noise_seed, 0u);
-    EXPECT_FALSE(p.scan.output.intensity);
-    EXPECT_EQ(p.scan.method, laser_raycast::core::TriangleMethod::kWatertight);
-    EXPECT_FALSE(p.scan.cull_backfaces);
-    EXPECT_EQ(p.scan.elevations, std::vector<double>{0.0});
-    EXPECT_EQ(p.rate, 10.0);
-    EXPECT_EQ(p.tf_timeout, 0.1);
+    EXPECT_EQ(p.sensors.at(0).scan.fan.angle_min, -M_PI);
+    EXPECT_EQ(p.sensors.at(0).scan.fan.angle_max, M_PI);
+    EXPECT_EQ(p.sensors.at(0).scan.fan.angle_increment, 0.0);  // unset: from samples
+    EXPECT_EQ(p.sensors.at(0).scan.fan.samples, 360);
+    EXPECT_EQ(p.sensors.at(0).scan.output.range_min, 0.0);
+    EXPECT_EQ(p.sensors.at(0).scan.output.range_max, 30.0);
+    EXPECT_EQ(p.sensors.at(0).scan.output.min_range_policy,
+              laser_raycast::core::MinRangePolicy::kNegInf);
+    EXPECT_EQ(p.sensors.at(0).scan.output.noise_stddev, 0.0);
+    EXPECT_EQ(p.sensors.at(0).scan.output.noise_seed, 0u);
+    EXPECT_FALSE(p.sensors.at(0).scan.output.intensity);
+    EXPECT_EQ(p.sensors.at(0).scan.method, laser_raycast::core::TriangleMethod::kWatertight);
+    EXPECT_FALSE(p.sensors.at(0).scan.cull_backfaces);
+    EXPECT_EQ(p.sensors.at(0).scan.elevations, std::vector<double>{0.0});
+    EXPECT_EQ(p.sensors.at(0).rate, 10.0);
+    EXPECT_EQ(p.tf_timeout, 0.5);
+    EXPECT_EQ(p.sensors.at(0).pose_timeout, 0.5);
+    EXPECT_EQ(p.sensors.size(), 1u);
     EXPECT_EQ(p.geometry, laser_raycast::GeometrySource::kVisual);
     EXPECT_FALSE(p.skip_bad_geometry);
     ASSERT_EQ(p.models.size(), 1u);
@@ -127,8 +130,8 @@ TEST(NodeParams, EveryDefault) {
     EXPECT_TRUE(p.ignore_links.empty());
     EXPECT_TRUE(p.reflectivity.empty());
     EXPECT_EQ(p.default_reflectivity, 1.0);
-    EXPECT_EQ(p.pose_topic, "");
-    EXPECT_EQ(p.pose_frame, "");
+    EXPECT_EQ(p.sensors.at(0).pose_topic, "");
+    EXPECT_EQ(p.sensors.at(0).pose_frame, "");
   }
 }
 
@@ -146,10 +149,11 @@ TEST(NodeParams, EveryParameterIsLoggedOnceWithItsExactValue) {
     EXPECT_EQ(lines, 1) << name;
   }
   const auto& log = parsed.report.values;
-  for (const char* line : {"~angle_min = -3.141592653589793 rad", "~tf_timeout = 0.1 s",
-                           "~rate = 10 Hz", "~frame_id = 'laser'", "~samples = 360 beams",
-                           "~min_range_policy = '-inf'", "~models[0] = parameter robot_description",
-                           "~reflectivity = {}", "~ignore_links = []", "~cull_backfaces = false"}) {
+  for (const char* line :
+       {"~angle_min = -3.141592653589793 rad", "~tf_timeout = 0.5 s", "~pose_timeout = 0.5 s",
+        "~rate = 10 Hz", "~frame_id = 'laser'", "~samples = 360 beams",
+        "~min_range_policy = '-inf'", "~models[0] = parameter robot_description",
+        "~reflectivity = {}", "~ignore_links = []", "~cull_backfaces = false"}) {
     EXPECT_NE(std::find(log.begin(), log.end(), line), log.end()) << line;
   }
 }
@@ -180,20 +184,22 @@ TEST(NodeParams, EveryValueReachesItsField) {
                                       {"method", "moller_trumbore"},
                                       {"cull_backfaces", true},
                                       {"pose_topic", "/pose"},
-                                      {"pose_frame", "base_link"}}));
+                                      {"pose_frame", "base_link"},
+                                      {"pose_timeout", 0.25}}));
   ASSERT_EQ(parsed.error, "");
   EXPECT_TRUE(parsed.report.warnings.empty()) << parsed.report.warnings.front();
   const NodeParams& p = parsed.params;
-  EXPECT_EQ(p.frame_id, "base_scan");
+  EXPECT_EQ(p.sensors.at(0).frame_id, "base_scan");
   EXPECT_EQ(p.fixed_frame, "odom");
-  EXPECT_EQ(p.scan.fan.angle_min, -1.5);
-  EXPECT_EQ(p.scan.fan.angle_max, 2.0);
-  EXPECT_EQ(p.scan.fan.samples, 100);
-  EXPECT_EQ(p.scan.fan.angle_increment, 0.0);
-  EXPECT_EQ(p.scan.output.range_min, 0.12);
-  EXPECT_EQ(p.scan.output.range_max, 3.5);
-  EXPECT_EQ(p.scan.output.min_range_policy, laser_raycast::core::MinRangePolicy::kPassThrough);
-  EXPECT_EQ(p.rate, 5.5);
+  EXPECT_EQ(p.sensors.at(0).scan.fan.angle_min, -1.5);
+  EXPECT_EQ(p.sensors.at(0).scan.fan.angle_max, 2.0);
+  EXPECT_EQ(p.sensors.at(0).scan.fan.samples, 100);
+  EXPECT_EQ(p.sensors.at(0).scan.fan.angle_increment, 0.0);
+  EXPECT_EQ(p.sensors.at(0).scan.output.range_min, 0.12);
+  EXPECT_EQ(p.sensors.at(0).scan.output.range_max, 3.5);
+  EXPECT_EQ(p.sensors.at(0).scan.output.min_range_policy,
+            laser_raycast::core::MinRangePolicy::kPassThrough);
+  EXPECT_EQ(p.sensors.at(0).rate, 5.5);
   EXPECT_EQ(p.tf_timeout, 0.0);
   ASSERT_EQ(p.models.size(), 3u);
   EXPECT_EQ(p.models[0].param, "robot_description");
@@ -204,24 +210,25 @@ TEST(NodeParams, EveryValueReachesItsField) {
   EXPECT_EQ(p.geometry, laser_raycast::GeometrySource::kCollision);
   EXPECT_EQ(p.ignore_links, (std::vector<std::string>{"base_scan", "w/wall"}));
   EXPECT_TRUE(p.skip_bad_geometry);
-  EXPECT_EQ(p.scan.output.noise_stddev, 0.01);
-  EXPECT_EQ(p.scan.output.noise_seed, 42u);
-  EXPECT_TRUE(p.scan.output.intensity);
+  EXPECT_EQ(p.sensors.at(0).scan.output.noise_stddev, 0.01);
+  EXPECT_EQ(p.sensors.at(0).scan.output.noise_seed, 42u);
+  EXPECT_TRUE(p.sensors.at(0).scan.output.intensity);
   EXPECT_EQ(p.reflectivity, (std::map<std::string, double>{{"a", 0.5}, {"b", 2.0}}));
   EXPECT_EQ(p.default_reflectivity, 0.25);
-  EXPECT_EQ(p.scan.method, laser_raycast::core::TriangleMethod::kMollerTrumbore);
-  EXPECT_TRUE(p.scan.cull_backfaces);
-  EXPECT_EQ(p.pose_topic, "/pose");
-  EXPECT_EQ(p.pose_frame, "base_link");
+  EXPECT_EQ(p.sensors.at(0).scan.method, laser_raycast::core::TriangleMethod::kMollerTrumbore);
+  EXPECT_TRUE(p.sensors.at(0).scan.cull_backfaces);
+  EXPECT_EQ(p.sensors.at(0).pose_topic, "/pose");
+  EXPECT_EQ(p.sensors.at(0).pose_frame, "base_link");
+  EXPECT_EQ(p.sensors.at(0).pose_timeout, 0.25);
 }
 
 TEST(NodeParams, AngleIncrementInsteadOfSamples) {
   const Parsed parsed =
       parse(values({{"angle_min", -1.0}, {"angle_max", 1.0}, {"angle_increment", 0.5}}));
   ASSERT_EQ(parsed.error, "");
-  EXPECT_EQ(parsed.params.scan.fan.angle_increment, 0.5);
-  EXPECT_EQ(parsed.params.scan.fan.samples, 0);
-  EXPECT_EQ(parsed.params.scan.fan.beamCount(), 5);  // -1, -0.5, 0, 0.5, 1
+  EXPECT_EQ(parsed.params.sensors.at(0).scan.fan.angle_increment, 0.5);
+  EXPECT_EQ(parsed.params.sensors.at(0).scan.fan.samples, 0);
+  EXPECT_EQ(parsed.params.sensors.at(0).scan.fan.beamCount(), 5);  // -1, -0.5, 0, 0.5, 1
 }
 
 TEST(NodeParams, WrongTypesNameTheParameterAndTheValue) {
@@ -254,6 +261,9 @@ TEST(NodeParams, OutOfRangeValuesNameTheParameterAndTheValue) {
       {"tf_timeout", 10.5, {"~tf_timeout", "got 10.5"}},
       {"tf_timeout", kNan, {"~tf_timeout", "got nan"}},
       {"noise_seed", -1, {"~noise_seed", "got -1"}},
+      {"pose_timeout", 0.0, {"~pose_timeout", "> 0 s", "got 0"}},
+      {"pose_timeout", -1, {"~pose_timeout", "got -1"}},
+      {"pose_timeout", kNan, {"~pose_timeout", "got nan"}},
       {"default_reflectivity", -0.5, {"~default_reflectivity", "got -0.5"}},
       {"default_reflectivity", kInf, {"~default_reflectivity", "got inf"}},
       {"reflectivity", values({{"wall", -1}}), {"~reflectivity/wall", "got -1"}},
@@ -275,6 +285,7 @@ TEST(NodeParams, TheLimitsThemselvesAreAccepted) {
   expectAccepted(values({{"rate", NodeParams::kMaxRate}}));
   expectAccepted(values({{"tf_timeout", NodeParams::kMaxTfTimeout}}));
   expectAccepted(values({{"tf_timeout", 0}}));
+  expectAccepted(values({{"pose_timeout", kInf}}));  // never stale
   expectAccepted(values({{"samples", 2}}));
   expectAccepted(values({{"noise_seed", 0}, {"default_reflectivity", 0}}));
   expectAccepted(values({{"reflectivity", values({{"black", 0}})}, {"intensity", "reflectivity"}}));
@@ -358,7 +369,7 @@ TEST(NodeParams, UnknownParametersGetAWarning) {
   EXPECT_EQ(parsed.error, "");
   ASSERT_EQ(parsed.report.warnings.size(), 1u);
   expectMentions(parsed.report.warnings[0], {"~angle_incremnt", "not a parameter"});
-  EXPECT_EQ(parsed.params.rate, 20.0);
+  EXPECT_EQ(parsed.params.sensors.at(0).rate, 20.0);
 }
 
 TEST(NodeParams, ReflectivityWithoutIntensityGetsAWarning) {

@@ -38,8 +38,8 @@ TEST(ReconfigureConfig, TheLiveParameters) {
 TEST(ReconfigureConfig, DefaultsAreTheNodes) {
   const RaycastConfig& def = RaycastConfig::__getDefault__();
   const EncoderConfig encoder;
-  const laser_raycast::NodeParams node;
-  EXPECT_EQ(def.rate, node.rate);
+  const laser_raycast::SensorParams sensor;
+  EXPECT_EQ(def.rate, sensor.rate);
   EXPECT_EQ(def.range_min, encoder.range_min);
   EXPECT_EQ(def.range_max, encoder.range_max);
   EXPECT_EQ(def.min_range_policy, toString(encoder.min_range_policy));
@@ -54,7 +54,7 @@ TEST(ReconfigureConfig, DefaultsAreTheNodes) {
 TEST(ReconfigureConfig, LimitsAreTheValidatedOnes) {
   const RaycastConfig& min = RaycastConfig::__getMin__();
   const RaycastConfig& max = RaycastConfig::__getMax__();
-  EXPECT_EQ(max.rate, laser_raycast::NodeParams::kMaxRate);
+  EXPECT_EQ(max.rate, laser_raycast::SensorParams::kMaxRate);
   EXPECT_EQ(min.rate, 0.0);  // exclusive in the node, which refuses 0
   EXPECT_EQ(min.range_min, 0.0);
   EXPECT_EQ(min.noise_stddev, 0.0);

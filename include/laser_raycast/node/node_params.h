@@ -34,33 +34,48 @@ inline const core::EnumNames<bool, 2> kIntensityNames{{{
     {false, "off"}, {true, "reflectivity"},  // reflectivity of the link hit x cos(incidence angle)
 }}};
 
-struct NodeParams {
+// One simulated sensor: its frame, beams, output, rate and pose source. The single-sensor
+// parameters of the private namespace describe one.
+struct SensorParams {
   // Beams when neither ~samples nor ~angle_increment is set: one a degree over the full turn.
   static constexpr int kDefaultSamples = 360;
   // ~rate above this is taken for a slip (a value meant in another unit) rather than served: it is
-  // ten times the fastest real planar scanners (about 100 Hz), and at 1 kHz the timer leaves 1 ms a
-  // scan for the TF look-ups, the cast and publishing.
+  // ten times the fastest real planar scanners (about 100 Hz), and at 1 kHz the cast thread has 1
+  // ms a scan for the TF look-ups, the cast and publishing.
   static constexpr double kMaxRate = 1000.0;  // Hz
-  // ~tf_timeout above this is taken for a slip (milliseconds given as seconds): each scan waits up
-  // to tf_timeout for its transforms inside the timer callback, which delays every later scan by
-  // as much, and 10 s is far beyond any real TF latency.
-  static constexpr double kMaxTfTimeout = 10.0;  // s
 
-  std::string frame_id = "laser";   // sensor frame; header.frame_id of the scans
-  std::string fixed_frame = "map";  // frame the link and sensor poses are looked up in
+  std::string frame_id = "laser";  // sensor frame; header.frame_id of the scans
   // Beams, range limits, min-range policy, noise, intensity, triangle test. fan.samples is 0 here:
   // the parser sets kDefaultSamples when neither it nor angle_increment is given.
   core::ScanSpec scan;
-  double rate = 10.0;       // Hz, in (0, kMaxRate]
-  double tf_timeout = 0.1;  // s, in [0, kMaxTfTimeout]: longest wait for one scan's transforms
+  double rate = 10.0;      // Hz, in (0, kMaxRate]
+  std::string pose_topic;  // empty: the sensor pose comes from TF
+  std::string pose_frame;  // frame whose pose pose_topic gives; empty: frame_id
+  // s, > 0: a topic pose older than this at a scan's time is stale (the scan is skipped). Pose
+  // sources run at 10 to 100 Hz: this is five periods of the slowest.
+  double pose_timeout = 0.5;
+};
+
+struct NodeParams {
+  static constexpr int kDefaultSamples = SensorParams::kDefaultSamples;
+  static constexpr double kMaxRate = SensorParams::kMaxRate;
+  // ~tf_timeout above this is taken for a slip (milliseconds given as seconds): it is how old a
+  // scan may be when it is cast, and the TF buffer keeps 10 s.
+  static constexpr double kMaxTfTimeout = 10.0;  // s
+
+  std::string fixed_frame = "map";  // frame the link and sensor poses are looked up in
+  // s, in [0, kMaxTfTimeout]: how late a transform may arrive. A scan waits (in the cast thread,
+  // never the timer) until TF covers its last beam's time; a transform whose newest data is older
+  // than this is not waited for (its link is left out, or without the sensor's the scan is
+  // skipped). TF 0.1 to 0.3 s late (a loaded tree, a bag, a slow link) is served at full rate.
+  double tf_timeout = 0.5;
   GeometrySource geometry = GeometrySource::kVisual;
   bool skip_bad_geometry = false;
   std::vector<ModelSource> models = {ModelSource{"robot_description", "", ""}};
   std::vector<std::string> ignore_links;
   std::map<std::string, double> reflectivity;  // link name (with TF prefix) -> reflectivity
   double default_reflectivity = 1.0;
-  std::string pose_topic;  // empty: the sensor pose comes from TF
-  std::string pose_frame;  // frame whose pose pose_topic gives; empty: frame_id
+  std::vector<SensorParams> sensors;  // at least one after parsing
 };
 
 // What parsing reports besides the values.

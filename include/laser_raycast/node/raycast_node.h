@@ -1,97 +1,62 @@
-// The ROS wrapper: parameters, scene loading, TF and pose input, timers, and the LaserScan and
-// label publishers around the core. main() and the nodelet only construct it and call init().
+// The ROS wrapper: parameters, the scene, TF, the sensors and their timers, and the cast thread.
+// main() and the nodelet only construct it and call init().
+//
+// Timing: each sensor's timer only queues a scan (stamped on a grid of its period) and returns; the
+// cast thread casts it once TF covers its last beam's time, waiting up to ~tf_timeout for late
+// transforms and not at all for dead ones (docs: README, "Faults"). So late or missing TF never
+// costs the timers their rate.
 #pragma once
 
 #include <ros/ros.h>
-#include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
-#include <topic_tools/shape_shifter.h>
 
-#include <Eigen/Geometry>
 #include <memory>
-#include <mutex>
-#include <optional>
-#include <string>
 #include <vector>
 
-#include "laser_raycast/core/caster.h"
-#include "laser_raycast/core/scan_encoder.h"
-#include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scene.h"
 #include "laser_raycast/node/node_params.h"
 
 namespace laser_raycast {
 
+class CastThread;
+class Sensor;
+class TfSource;
+
 class RaycastNode {
  public:
   // TF publishers usually start with or after the node (robot_state_publisher, a driver, a
-  // simulator), so for this long after the first scan attempt, until the first scan, scans that
-  // lack a transform are skipped without a warning. ROS time, like the scan timer: under
+  // simulator), so for this long after a sensor's first scan attempt, until its first scan, scans
+  // that lack a transform are skipped without a warning. ROS time, like the scan timers: under
   // use_sim_time it follows /clock, as the TF publishers do. Then missing transforms are warned
   // about.
   static constexpr double kTfGracePeriod = 5.0;  // s
 
   RaycastNode(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~RaycastNode();  // stops the timers, then the cast thread
 
   // Reads and validates the parameters, loads the scene, and starts publishing. Returns false after
   // logging (ROS_FATAL) what is wrong: a bad parameter, a missing URDF, or bad geometry.
   bool init();
 
  private:
-  bool loadScene();
-  void onTimer(const ros::TimerEvent& event);
-  void onPose(const topic_tools::ShapeShifter::ConstPtr& msg);
-  // The pose of frame_id in fixed_frame for this scan; false if unknown, with what is missing in
-  // *why and TF's message (if any) in *detail.
-  bool sensorPose(const ros::Time& stamp, const ros::Time& deadline, Eigen::Isometry3d* pose,
-                  std::string* why, std::string* detail);
-  // The link poses for this scan into frame_poses_. Links without a transform are left out with a
-  // throttled warning; while `waiting` (for the first transforms) the scan is skipped quietly
-  // instead (false).
-  bool linkPoses(const ros::Time& stamp, const ros::Time& deadline, bool waiting);
-  // The pose of `frame` in `target` from TF at stamp, waiting until deadline at most (identity if
-  // they are the same frame); false with the reason in *error.
-  bool lookup(const std::string& target, const std::string& frame, const ros::Time& stamp,
-              const ros::Time& deadline, Eigen::Isometry3d* pose, std::string* error);
+  void startTimer(int sensor);
+  void onTick(int sensor, const ros::Time& expected);
+  void onReport(const ros::TimerEvent& event);
 
-  // A condition that lasts (missing transforms, no pose yet, bad pose messages) is warned about at
-  // most this often: every scan (10 to 100 Hz) would flood the log.
-  static constexpr double kWarnPeriod = 5.0;  // s
-  // A pose topic of the wrong message type is a set-up error that does not go away by itself.
-  static constexpr double kErrorPeriod = 10.0;  // s
-  // Scans queued for a slow subscriber before the oldest is dropped (1 s at the default rate).
-  static constexpr std::uint32_t kPublishQueue = 10;
-  // Pose messages queued for the callback; only the latest is used.
-  static constexpr std::uint32_t kPoseQueue = 10;
-  // Link names a message lists before "... (N more)": a few in the repeated warning about missing
-  // transforms, more in the one-off error about an unknown reflectivity link.
-  static constexpr std::size_t kLinksInWarning = 5, kLinksInError = 20;
+  // Achieved rates are checked (and warned about when low) this often.
+  static constexpr double kReportPeriod = 1.0;  // s
 
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
   core::Scene scene_;
-  std::unique_ptr<core::ScanPattern> pattern_;
-  core::CastConfig cast_config_;
-  core::Caster caster_;
-  std::unique_ptr<core::ScanEncoder> encoder_;
-  std::vector<double> reflectivity_by_label_;
-  core::FramePoses frame_poses_;
-  core::EncodedScan encoded_;
-
-  tf2_ros::Buffer tf_buffer_;
-  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
-  ros::Publisher scan_pub_, labels_pub_;
-  ros::Subscriber pose_sub_;
-  ros::Timer timer_;
-
-  // The latest pose from pose_topic (of pose_frame, in fixed_frame), guarded for multi-threaded
-  // nodelet managers.
-  std::mutex pose_mutex_;
-  std::optional<Eigen::Isometry3d> topic_pose_;
-
-  // Reported in the throttled warnings.
-  std::uint64_t scans_ = 0, scans_skipped_ = 0, missing_link_poses_ = 0;
-  ros::Time first_attempt_;  // the first timer tick with a non-zero time
+  std::vector<double> reflectivity_;  // by label
+  std::unique_ptr<TfSource> tf_;
+  std::vector<std::unique_ptr<Sensor>> sensors_;
+  std::unique_ptr<CastThread> cast_thread_;
+  // Per sensor: a one-shot timer that starts the periodic one on its period's grid, the periodic
+  // timer, and the last scan time queued.
+  std::vector<ros::Timer> align_timers_, timers_;
+  std::vector<ros::Time> last_queued_;
+  ros::Timer report_timer_;
 };
 
 }  // namespace laser_raycast

@@ -1,0 +1,170 @@
+#include "cast_thread.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "param_reader.h"
+
+namespace laser_raycast {
+
+CastThread::CastThread(Context context) : context_(std::move(context)) {
+  thread_ = std::thread([this] { run(); });
+}
+
+CastThread::~CastThread() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+void CastThread::setCapacity(std::size_t capacity) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  queue_.setCapacity(capacity);
+}
+
+void CastThread::schedule(int sensor, const std::vector<ros::Time>& times) {
+  std::optional<ScanJob> dropped;
+  std::size_t queued;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dropped = queue_.push(times, sensor);
+    queued = queue_.size();
+  }
+  wake_.notify_all();
+  if (!dropped) return;
+  for (const int s : dropped->sensors) {
+    (*context_.sensors)[s]->skip(Sensor::Skip::kBehind, dropped->stamp(),
+                                 "the cast thread is " + std::to_string(queued) +
+                                     " scans behind (casting takes longer than the scan period)");
+  }
+}
+
+void CastThread::run() {
+  const auto poll = std::chrono::duration<double>(kPollPeriod);
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stop_) {
+    if (queue_.empty()) {
+      wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      continue;
+    }
+    const ScanJob front = queue_.front();
+    lock.unlock();
+    const bool go = ready(front);
+    lock.lock();
+    if (!go) {
+      wake_.wait_for(lock, poll, [this] { return stop_; });
+      continue;
+    }
+    // Sensors may have joined the job meanwhile, or an earlier job come in front of it.
+    if (queue_.empty() || queue_.front().times != front.times) continue;
+    const ScanJob job = queue_.pop();
+    lock.unlock();
+    process(job);
+    lock.lock();
+  }
+}
+
+bool CastThread::ready(const ScanJob& job) {
+  const ros::Time now = ros::Time::now();
+  if (now.isZero()) return false;  // simulated time has not started
+  if (wait_.last != job.last() || wait_.chains.empty()) {
+    wait_.last = job.last();
+    wait_.chains.clear();
+    for (const std::string& frame : context_.scene->frames()) {
+      wait_.chains.emplace_back(context_.fixed_frame, frame);
+    }
+    wait_.state.assign(wait_.chains.size(), FrameAvailability::kWaiting);
+  }
+  // The sensors' chains, for sensors that joined the job since.
+  for (const int s : job.sensors) {
+    const auto chain = (*context_.sensors)[s]->tfChain();
+    if (std::find(wait_.chains.begin(), wait_.chains.end(), chain) == wait_.chains.end()) {
+      wait_.chains.push_back(chain);
+      wait_.state.push_back(FrameAvailability::kWaiting);
+    }
+  }
+  for (std::size_t i = 0; i < wait_.chains.size(); ++i) {
+    if (wait_.state[i] != FrameAvailability::kWaiting) continue;
+    const auto& [target, source] = wait_.chains[i];
+    wait_.state[i] =
+        context_.tf->availability(target, source, job.last(), now, context_.tf_timeout);
+    if (wait_.state[i] == FrameAvailability::kWaiting) return false;
+  }
+  return true;
+}
+
+void CastThread::process(const ScanJob& job) {
+  std::vector<core::FramePoses> frames;
+  std::vector<std::string> missing;
+  std::string first_error;
+  linkPoses(job.times, &frames, &missing, &first_error);
+  for (const int s : job.sensors) {
+    castSensor(*(*context_.sensors)[s], job, frames, missing, first_error);
+  }
+}
+
+void CastThread::linkPoses(const std::vector<ros::Time>& times,
+                           std::vector<core::FramePoses>* frames, std::vector<std::string>* missing,
+                           std::string* first_error) {
+  const core::Scene& scene = *context_.scene;
+  frames->resize(times.size());
+  std::vector<char> lost(scene.frames().size(), 0);
+  for (std::size_t j = 0; j < times.size(); ++j) {
+    core::resolveFramePoses(
+        scene,
+        [&](const std::string& frame, Eigen::Isometry3d& pose) {
+          std::string error;
+          if (context_.tf->lookup(context_.fixed_frame, frame, times[j], &pose, &error)) {
+            return true;
+          }
+          if (first_error->empty()) *first_error = error;
+          return false;
+        },
+        &(*frames)[j]);
+    for (std::size_t f = 0; f < lost.size(); ++f) lost[f] |= !(*frames)[j].valid[f];
+  }
+  for (std::size_t f = 0; f < lost.size(); ++f) {
+    if (lost[f]) missing->push_back(scene.frames()[f]);
+  }
+}
+
+void CastThread::castSensor(Sensor& sensor, const ScanJob& job,
+                            const std::vector<core::FramePoses>& frames,
+                            const std::vector<std::string>& missing,
+                            const std::string& first_error) {
+  const bool quiet = sensor.quiet(job.stamp());
+  std::vector<Eigen::Isometry3d> poses(job.times.size());
+  for (std::size_t j = 0; j < job.times.size(); ++j) {
+    std::string why;
+    if (!sensor.poseAt(job.times[j], *context_.tf, &poses[j], &why)) {
+      sensor.skip(quiet ? Sensor::Skip::kWaiting : Sensor::Skip::kNoPose, job.stamp(), why);
+      return;
+    }
+  }
+  if (!missing.empty()) {
+    if (quiet) {
+      sensor.skip(Sensor::Skip::kWaiting, job.stamp(),
+                  std::to_string(missing.size()) + " link frames have no transform yet (" +
+                      joinFirst(missing, kLinksInWarning) + ")");
+      return;
+    }
+    const ros::WallTime now = ros::WallTime::now();
+    if (last_link_warning_.isZero() || (now - last_link_warning_).toSec() >= kWarnPeriod) {
+      last_link_warning_ = now;
+      ROS_WARN(
+          "%zu of %zu link frames have no transform to '%s' at t = %.3f; their geometry is "
+          "left out of this scan (a transform older than ~tf_timeout %.3f s is not waited "
+          "for): %s (%s)",
+          missing.size(), context_.scene->frames().size(), context_.fixed_frame.c_str(),
+          job.last().toSec(), context_.tf_timeout.toSec(),
+          joinFirst(missing, kLinksInWarning).c_str(), first_error.c_str());
+    }
+  }
+  sensor.castAndPublish(*context_.scene, *context_.reflectivity, job.times, frames, poses,
+                        missing.size());
+}
+
+}  // namespace laser_raycast

@@ -1,0 +1,82 @@
+// The node's cast thread. Sensor timers only queue scans (ScanQueue); this thread takes them in the
+// order their transforms become due, waits until TF covers each one's last beam (tf_timing.h: a
+// late transform is waited for up to ~tf_timeout, a dead one not at all), looks the link poses up
+// once for every sensor due at those times, and has each sensor cast and publish. So a wait for TF
+// never costs the timers their rate: scans queue up behind it and are cast as the transforms come.
+#pragma once
+
+#include <ros/ros.h>
+
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "laser_raycast/core/scene.h"
+#include "scan_queue.h"
+#include "sensor.h"
+#include "tf_source.h"
+
+namespace laser_raycast {
+
+class CastThread {
+ public:
+  // Everything the thread reads; it must outlive the thread (the node owns both).
+  struct Context {
+    const core::Scene* scene = nullptr;
+    const std::vector<double>* reflectivity = nullptr;  // by label
+    const TfSource* tf = nullptr;
+    std::vector<std::unique_ptr<Sensor>>* sensors = nullptr;
+    std::string fixed_frame;
+    ros::Duration tf_timeout;
+  };
+
+  explicit CastThread(Context context);
+  ~CastThread();  // stops and joins
+
+  // Queues sensor's scan whose poses are sampled at `times` (Sensor::sampleTimes).
+  void schedule(int sensor, const std::vector<ros::Time>& times);
+  // At most this many jobs wait; beyond, the oldest is dropped (counted as skipped by its sensors).
+  void setCapacity(std::size_t capacity);
+
+ private:
+  // Which transforms the front job still waits for; reset when another job comes to the front.
+  struct Wait {
+    ros::Time last;
+    std::vector<std::pair<std::string, std::string>> chains;  // (target, source)
+    std::vector<FrameAvailability> state;
+  };
+
+  void run();
+  // Whether every transform the job needs is covered, stale or missing (none still late).
+  bool ready(const ScanJob& job);
+  void process(const ScanJob& job);
+  // The link poses at each time (shared by the job's sensors); the names of links without a pose
+  // at some time in *missing.
+  void linkPoses(const std::vector<ros::Time>& times, std::vector<core::FramePoses>* frames,
+                 std::vector<std::string>* missing, std::string* first_error);
+  void castSensor(Sensor& sensor, const ScanJob& job, const std::vector<core::FramePoses>& frames,
+                  const std::vector<std::string>& missing, const std::string& first_error);
+
+  // How often the front job's transforms are checked while it waits (wall time): short against
+  // any scan period, long against a TF look-up (microseconds).
+  static constexpr double kPollPeriod = 0.002;  // s
+  // A condition that lasts (missing link transforms) is warned about at most this often.
+  static constexpr double kWarnPeriod = 5.0;  // s
+  // Link names a warning lists before "... (N more)".
+  static constexpr std::size_t kLinksInWarning = 5;
+
+  Context context_;
+  std::mutex mutex_;  // queue_ and stop_
+  std::condition_variable wake_;
+  ScanQueue queue_;
+  bool stop_ = false;
+  Wait wait_;  // the cast thread's own
+  ros::WallTime last_link_warning_;
+  std::thread thread_;
+};
+
+}  // namespace laser_raycast

@@ -1,0 +1,125 @@
+#include "pose_topic.h"
+
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "laser_raycast/core/pose_samples.h"
+
+namespace laser_raycast {
+namespace {
+
+// A message's quaternion may be this far from unit length (relative) and is normalised; farther off
+// is a bad message, not rounding: poses written with 3 or 4 decimals are within 0.1%.
+constexpr double kQuaternionNormTolerance = 0.01;
+
+// A pose from a message: finite, with a quaternion near unit length.
+bool poseFromMsg(const geometry_msgs::Pose& msg, Eigen::Isometry3d* pose) {
+  const Eigen::Vector3d t(msg.position.x, msg.position.y, msg.position.z);
+  Eigen::Quaterniond q(msg.orientation.w, msg.orientation.x, msg.orientation.y, msg.orientation.z);
+  const double norm = q.norm();
+  if (!t.allFinite() || !(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) return false;
+  q.coeffs() /= norm;
+  pose->setIdentity();
+  pose->linear() = q.toRotationMatrix();
+  pose->translation() = t;
+  return true;
+}
+
+std::string seconds(double s) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(3) << s;
+  return out.str();
+}
+
+}  // namespace
+
+PoseTopic::PoseTopic(ros::NodeHandle& nh, const std::string& topic, std::string fixed_frame,
+                     ros::Duration timeout, ros::Duration keep)
+    : fixed_frame_(std::move(fixed_frame)), timeout_(timeout), history_(keep, kMaxEntries) {
+  sub_ = nh.subscribe(topic, kQueue, &PoseTopic::onPose, this);
+}
+
+void PoseTopic::setTimeout(ros::Duration timeout) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  timeout_ = timeout;
+}
+
+void PoseTopic::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
+  const std::string& type = msg->getDataType();
+  std_msgs::Header header;
+  geometry_msgs::Pose pose_msg;
+  if (type == "geometry_msgs/PoseStamped") {
+    const auto m = msg->instantiate<geometry_msgs::PoseStamped>();
+    header = m->header;
+    pose_msg = m->pose;
+  } else if (type == "geometry_msgs/PoseWithCovarianceStamped") {
+    const auto m = msg->instantiate<geometry_msgs::PoseWithCovarianceStamped>();
+    header = m->header;
+    pose_msg = m->pose.pose;
+  } else {
+    const ros::WallTime now = ros::WallTime::now();
+    if (last_type_error_.isZero() || (now - last_type_error_).toSec() >= kErrorPeriod) {
+      last_type_error_ = now;
+      ROS_ERROR(
+          "~pose_topic %s carries %s; expected geometry_msgs/PoseStamped or "
+          "geometry_msgs/PoseWithCovarianceStamped (message ignored)",
+          sub_.getTopic().c_str(), type.c_str());
+    }
+    return;
+  }
+  PoseHistory::Entry entry;
+  // A publisher that leaves the stamp unset means "now".
+  entry.stamp = header.stamp.isZero() ? ros::Time::now() : header.stamp;
+  entry.frame = header.frame_id.empty() ? fixed_frame_ : header.frame_id;
+  entry.valid = poseFromMsg(pose_msg, &entry.pose);
+  std::lock_guard<std::mutex> lock(mutex_);
+  history_.add(entry);
+}
+
+bool PoseTopic::inFixedFrame(const PoseHistory::Entry& e, const TfSource& tf,
+                             Eigen::Isometry3d* pose, std::string* why) const {
+  Eigen::Isometry3d fixed_from_frame;
+  std::string error;
+  if (!tf.lookup(fixed_frame_, e.frame, e.stamp, &fixed_from_frame, &error)) {
+    *why = "the pose on " + sub_.getTopic() + " is in '" + e.frame +
+           "', which has no transform to '" + fixed_frame_ + "' at its stamp (" + error + ")";
+    return false;
+  }
+  *pose = fixed_from_frame * e.pose;
+  return true;
+}
+
+bool PoseTopic::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose,
+                       std::string* why) {
+  PoseHistory::Query q;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    q = history_.at(t, timeout_);
+  }
+  switch (q.status) {
+    case PoseHistory::Status::kNone:
+      *why = "no pose received yet on " + sub_.getTopic();
+      return false;
+    case PoseHistory::Status::kInvalid:
+      *why = "the pose on " + sub_.getTopic() + " at t = " + seconds(q.a.stamp.toSec()) +
+             " is not finite or its quaternion is not unit length";
+      return false;
+    case PoseHistory::Status::kStale:
+      *why = "the pose on " + sub_.getTopic() + " is " + seconds(q.age) +
+             " s old at the scan's time t = " + seconds(t.toSec()) + " (~pose_timeout " +
+             seconds(timeout_.toSec()) + " s)";
+      return false;
+    case PoseHistory::Status::kOk:
+      break;
+  }
+  Eigen::Isometry3d a, b;
+  if (!inFixedFrame(q.a, tf, &a, why) || !inFixedFrame(q.b, tf, &b, why)) return false;
+  *pose = core::interpolatePose(a, b, q.s);
+  return true;
+}
+
+}  // namespace laser_raycast

@@ -1,0 +1,119 @@
+#include "scene_source.h"
+
+#include <algorithm>
+#include <mutex>
+#include <set>
+
+#include "laser_raycast/loader/package_resolver.h"
+#include "laser_raycast/loader/scene_loader.h"
+#include "param_reader.h"
+
+namespace laser_raycast {
+namespace {
+
+// Link names the error about an unknown reflectivity link lists before "... (N more)".
+constexpr std::size_t kLinksInError = 20;
+
+// The process's loader: its mesh cache outlives the nodes (meshes stay loaded for the process).
+struct SharedLoader {
+  std::mutex mutex;
+  SceneLoader loader{rosPackagePath};
+};
+
+SharedLoader& sharedLoader() {
+  static SharedLoader shared;
+  return shared;
+}
+
+// The loader options for one model: ~ignore_links may name links with or without its prefix.
+LoaderOptions optionsFor(const NodeParams& params, const ModelSource& model) {
+  LoaderOptions options;
+  options.geometry = params.geometry;
+  options.skip_bad_geometry = params.skip_bad_geometry;
+  options.tf_prefix = model.tf_prefix;
+  for (const std::string& link : params.ignore_links) {
+    options.ignore_links.push_back(link);
+    if (!model.tf_prefix.empty() && link.compare(0, model.tf_prefix.size(), model.tf_prefix) == 0) {
+      options.ignore_links.push_back(link.substr(model.tf_prefix.size()));
+    }
+  }
+  return options;
+}
+
+// Adds model i to scene; false after ROS_FATAL.
+bool loadModel(const ros::NodeHandle& nh, const NodeParams& params, std::size_t i,
+               core::Scene* scene, std::set<std::string>* all_links) {
+  const ModelSource& model = params.models[i];
+  const LoaderOptions options = optionsFor(params, model);
+  LoadedModel loaded;
+  try {
+    SharedLoader& shared = sharedLoader();
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    if (!model.param.empty()) {
+      std::string xml;
+      if (!nh.getParam(model.param, xml)) {
+        ROS_FATAL_STREAM("~models[" << i << "]: parameter " << nh.resolveName(model.param)
+                                    << " is not set or is not a string: no URDF to load");
+        return false;
+      }
+      loaded = shared.loader.addUrdfString(xml, "", options, scene,
+                                           "parameter " + nh.resolveName(model.param));
+    } else {
+      loaded = shared.loader.addUrdfFile(model.file, options, scene);
+    }
+  } catch (const SceneLoadError& e) {
+    // The message starts with the URDF's source (file or parameter).
+    ROS_FATAL_STREAM(e.what() << (params.skip_bad_geometry
+                                      ? ""
+                                      : " (set ~skip_bad_geometry to skip bad elements)"));
+    return false;
+  }
+  for (const std::string& warning : loaded.warnings) ROS_WARN_STREAM("skipped: " << warning);
+  for (const auto& link : loaded.link_frames) all_links->insert(link.first);
+  ROS_INFO(
+      "model '%s' (%s): %zu links, %zu bodies, %zu triangles; loaded in %.3f s, BVHs built in "
+      "%.3f s",
+      loaded.name.c_str(), model.describe().c_str(), loaded.links, loaded.bodies, loaded.triangles,
+      loaded.load_seconds, loaded.bvh_build_seconds);
+  return true;
+}
+
+}  // namespace
+
+bool loadScene(const ros::NodeHandle& nh, const NodeParams& params, core::Scene* scene,
+               std::vector<double>* reflectivity) {
+  std::set<std::string> all_links;
+  for (std::size_t i = 0; i < params.models.size(); ++i) {
+    if (!loadModel(nh, params, i, scene, &all_links)) return false;
+  }
+  for (const std::string& link : params.ignore_links) {
+    bool found = all_links.count(link) > 0;
+    for (const ModelSource& model : params.models) {
+      found |= all_links.count(model.tf_prefix + link) > 0;
+    }
+    if (!found) ROS_WARN_STREAM("~ignore_links: no model has a link '" << link << "'");
+  }
+
+  // Reflectivity per label (labels are the links, with their TF prefix).
+  const auto& labels = scene->labels();
+  for (const auto& entry : params.reflectivity) {
+    if (std::find(labels.begin(), labels.end(), entry.first) == labels.end()) {
+      ROS_FATAL_STREAM("~reflectivity names link '"
+                       << entry.first << "', which has no geometry in any model (links with "
+                       << "geometry: " << joinFirst(labels, kLinksInError) << ")");
+      return false;
+    }
+  }
+  reflectivity->clear();
+  for (const std::string& label : labels) {
+    const auto it = params.reflectivity.find(label);
+    reflectivity->push_back(it != params.reflectivity.end() ? it->second
+                                                            : params.default_reflectivity);
+  }
+  if (scene->bodies().empty()) {
+    ROS_WARN("the scene has no geometry: every beam will report +Inf");
+  }
+  return true;
+}
+
+}  // namespace laser_raycast

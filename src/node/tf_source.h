@@ -1,0 +1,42 @@
+// The node's TF input: one buffer and listener for every sensor. It answers two questions without
+// ever waiting (the cast thread decides how long a scan waits, tf_timing.h): how recent a
+// transform is, and what it is at a time.
+#pragma once
+
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <string>
+
+#include "tf_timing.h"
+
+namespace laser_raycast {
+
+class TfSource {
+ public:
+  // cache: how far back the buffer keeps transforms (tf2's default is 10 s).
+  TfSource(const ros::NodeHandle& nh, ros::Duration cache);
+
+  // The newest time target <- source can be looked up at (ros::Time(0): static only), nullopt if
+  // TF has no chain between them (TF's message in *error).
+  std::optional<ros::Time> latest(const std::string& target, const std::string& source,
+                                  std::string* error) const;
+  // Whether target <- source can serve a scan whose last beam is at `needed` (tf_timing.h). The
+  // same frame twice is always covered.
+  FrameAvailability availability(const std::string& target, const std::string& source,
+                                 const ros::Time& needed, const ros::Time& now,
+                                 const ros::Duration& tf_timeout) const;
+  // The pose of `source` in `target` at t (identity for the same frame); false with TF's message
+  // in *error.
+  bool lookup(const std::string& target, const std::string& source, const ros::Time& t,
+              Eigen::Isometry3d* pose, std::string* error) const;
+
+ private:
+  tf2_ros::Buffer buffer_;
+  tf2_ros::TransformListener listener_;  // on its own thread: TF arrives while scans are cast
+};
+
+}  // namespace laser_raycast
