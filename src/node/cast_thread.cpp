@@ -36,9 +36,10 @@ void CastThread::schedule(int sensor, const std::vector<ros::Time>& times) {
   wake_.notify_all();
   if (!dropped) return;
   for (const int s : dropped->sensors) {
-    (*context_.sensors)[s]->skip(Sensor::Skip::kBehind, dropped->stamp(),
-                                 "the cast thread is " + std::to_string(queued) +
-                                     " scans behind (casting takes longer than the scan period)");
+    (*context_.sensors)[s]->monitor().skipped(
+        SensorMonitor::Skip::kBehind, dropped->stamp(),
+        "the cast thread is " + std::to_string(queued) +
+            " scans behind (casting takes longer than the scan period)");
   }
 }
 
@@ -135,20 +136,26 @@ void CastThread::castSensor(Sensor& sensor, const ScanJob& job,
                             const std::vector<core::FramePoses>& frames,
                             const std::vector<std::string>& missing,
                             const std::string& first_error) {
-  const bool quiet = sensor.quiet(job.stamp());
+  SensorMonitor& monitor = sensor.monitor();
+  const bool quiet = monitor.quiet(job.stamp());
   std::vector<Eigen::Isometry3d> poses(job.times.size());
   for (std::size_t j = 0; j < job.times.size(); ++j) {
     std::string why;
-    if (!sensor.poseAt(job.times[j], *context_.tf, &poses[j], &why)) {
-      sensor.skip(quiet ? Sensor::Skip::kWaiting : Sensor::Skip::kNoPose, job.stamp(), why);
+    bool from_tf;
+    if (!sensor.poseAt(job.times[j], *context_.tf, &poses[j], &why, &from_tf)) {
+      using Skip = SensorMonitor::Skip;
+      monitor.skipped(quiet     ? Skip::kWaiting
+                      : from_tf ? Skip::kNoTransform
+                                : Skip::kStalePose,
+                      job.stamp(), why);
       return;
     }
   }
   if (!missing.empty()) {
     if (quiet) {
-      sensor.skip(Sensor::Skip::kWaiting, job.stamp(),
-                  std::to_string(missing.size()) + " link frames have no transform yet (" +
-                      joinFirst(missing, kLinksInWarning) + ")");
+      monitor.skipped(SensorMonitor::Skip::kWaiting, job.stamp(),
+                      std::to_string(missing.size()) + " link frames have no transform yet (" +
+                          joinFirst(missing, kLinksInWarning) + ")");
       return;
     }
     const ros::WallTime now = ros::WallTime::now();

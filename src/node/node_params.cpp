@@ -141,15 +141,99 @@ void readScene(ParamReader* r, NodeParams* p) {
   p->ignore_links = r->textList("ignore_links");
 }
 
-// Every group, in the order the log lists them: the node's own, then the sensor's.
+// The default topic of a sensor: relative to the node's namespace, under its name for an entry.
+std::string defaultTopic(const SensorParams& s, bool entry) {
+  const std::string type = s.planar() ? "scan" : "points";
+  return entry ? s.name + "/" + type : type;
+}
+
+// Entry i of ~sensors, with `base` (the private namespace's sensor) as its defaults; false (after
+// r->fail) if it is bad.
+bool readSensorEntry(ParamReader* r, int i, const XmlRpc::XmlRpcValue& e, const SensorParams& base,
+                     SensorParams* s, std::vector<std::string>* warnings) {
+  const std::string where = "sensors[" + std::to_string(i) + "]";
+  if (e.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+    r->wrongType(where, e, "a dict of sensor parameters with at least frame_id");
+    return false;
+  }
+  ParamReader er(e, r->prefix() + where + "/");
+  *s = base;
+  readSensor(&er, s, true, warnings);
+  for (const std::string& line : er.log()) r->note(line);
+  for (const std::string& name : er.unknown()) {
+    warnings->push_back(er.prefix() + name + " is not a sensor parameter (ignored; a typo?)");
+  }
+  if (!er.error().empty()) {
+    r->failWith(er.error());
+    return false;
+  }
+  std::string why;
+  if (s->name.empty()) s->name = s->frame_id;
+  if (!ros::names::validate(s->name, why) || s->name.find('/') != std::string::npos) {
+    r->fail(where + "/name", "'" + s->name + "' is not a valid name without '/' (it names the " +
+                                 "sensor's namespace): " + why);
+    return false;
+  }
+  if (s->topic.empty()) s->topic = defaultTopic(*s, true);
+  if (!ros::names::validate(s->topic, why)) {
+    r->fail(where + "/topic", "'" + s->topic + "' is not a valid topic name: " + why);
+    return false;
+  }
+  return true;
+}
+
+// Two sensors with one name or one topic (scans or labels) would mix their messages.
+void checkDistinct(ParamReader* r, const std::vector<SensorParams>& sensors) {
+  for (std::size_t i = 0; i < sensors.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      const std::string here = "sensors[" + std::to_string(i) + "]";
+      const std::string there = r->prefix() + "sensors[" + std::to_string(j) + "]";
+      if (sensors[i].name == sensors[j].name) {
+        r->fail(here + "/name", "'" + sensors[i].name + "' is also the name of " + there);
+      }
+      for (const std::string& a : {sensors[i].topic, sensors[i].labelsTopic()}) {
+        for (const std::string& b : {sensors[j].topic, sensors[j].labelsTopic()}) {
+          if (a == b) r->fail(here + "/topic", "'" + a + "' is also a topic of " + there);
+        }
+      }
+    }
+  }
+}
+
+// The sensors: the private namespace's sensor parameters describe one, or, with ~sensors, are the
+// defaults of each entry.
+void readSensors(ParamReader* r, NodeParams* p, std::vector<std::string>* warnings) {
+  SensorParams base;
+  readSensor(r, &base, false, warnings);
+  p->sensors.clear();
+  const XmlRpc::XmlRpcValue* v = r->get("sensors");
+  if (!v) {
+    base.name = base.frame_id;
+    base.topic = defaultTopic(base, false);
+    p->sensors.push_back(base);
+    r->note(r->prefix() + "sensors unset (one sensor: the parameters above)");
+    return;
+  }
+  if (v->getType() != XmlRpc::XmlRpcValue::TypeArray || v->size() == 0) {
+    r->wrongType("sensors", *v, "a non-empty list of dicts of sensor parameters");
+    return;
+  }
+  for (int i = 0; i < v->size(); ++i) {
+    SensorParams s;
+    if (!readSensorEntry(r, i, (*v)[i], base, &s, warnings)) return;
+    p->sensors.push_back(s);
+  }
+  checkDistinct(r, p->sensors);
+}
+
+// Every group, in the order the log lists them: the node's own, then the sensors'.
 void readAll(ParamReader* r, NodeParams* p, std::vector<std::string>* warnings) {
   p->fixed_frame = r->text("fixed_frame", p->fixed_frame);
   checkFrame(r, "fixed_frame", p->fixed_frame, false);
   readTfTimeout(r, p);
   readScene(r, p);
   readReflectivity(r, p);
-  p->sensors.assign(1, SensorParams());
-  readSensor(r, &p->sensors[0]);
+  readSensors(r, p, warnings);
   const bool any_intensity =
       std::any_of(p->sensors.begin(), p->sensors.end(),
                   [](const SensorParams& s) { return s.scan.output.intensity; });
@@ -171,18 +255,14 @@ std::string parseNodeParams(const XmlRpc::XmlRpcValue& values, NodeParams* p, Pa
   ParamReader r(values, "~");
   readAll(&r, p, &report->warnings);
 
-  // The angles and beam count, ranges and noise through the core's own validation, which names
-  // the field (the fields share the parameters' names).
-  if (r.error().empty()) {
-    try {
-      for (const SensorParams& sensor : p->sensors) sensor.scan.validate();
-    } catch (const std::invalid_argument& e) {
-      r.failWith(std::string("bad parameter: ") + e.what());
-    }
-  }
   for (const std::string& name : r.unknown()) {
-    report->warnings.push_back(r.prefix() + name +
-                               " is not a parameter of this node (ignored; a typo?)");
+    // dynamic_reconfigure keeps an entry's live parameters under ~<its name>.
+    const bool live = std::any_of(p->sensors.begin(), p->sensors.end(),
+                                  [&](const SensorParams& s) { return s.name == name; });
+    if (!live) {
+      report->warnings.push_back(r.prefix() + name +
+                                 " is not a parameter of this node (ignored; a typo?)");
+    }
   }
   report->values = r.log();
   return r.error();

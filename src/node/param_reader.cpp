@@ -162,6 +162,33 @@ std::vector<std::string> ParamReader::textList(const std::string& name) {
   return value;
 }
 
+std::vector<double> ParamReader::numberList(const std::string& name,
+                                            const std::vector<double>& fallback, const char* unit) {
+  std::vector<double> value = fallback;
+  if (const XmlRpc::XmlRpcValue* v = get(name)) {
+    value.clear();
+    if (v->getType() != XmlRpc::XmlRpcValue::TypeArray) {
+      wrongType(name, *v, "a list of numbers");
+    } else {
+      for (int i = 0; i < v->size(); ++i) {
+        const XmlRpc::XmlRpcValue& entry = (*v)[i];
+        if (entry.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+          value.push_back(static_cast<const double&>(entry));
+        } else if (entry.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+          value.push_back(static_cast<const int&>(entry));
+        } else {
+          wrongType(name + "[" + std::to_string(i) + "]", entry, "a number");
+          break;
+        }
+      }
+    }
+  }
+  std::string shown;
+  for (const double x : value) shown += (shown.empty() ? "" : ", ") + formatNumber(x);
+  note(prefix_ + name + " = [" + shown + "]" + (*unit ? " " : "") + unit);
+  return value;
+}
+
 void ParamReader::fail(const std::string& name, const std::string& message) {
   failWith("parameter " + prefix_ + name + ": " + message);
 }

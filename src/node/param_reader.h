@@ -41,6 +41,9 @@ class ParamReader {
   bool boolean(const std::string& name, bool fallback);
   std::string text(const std::string& name, const std::string& fallback);
   std::vector<std::string> textList(const std::string& name);
+  // A list of numbers (ints or doubles), the fallback if unset; logged as "[a, b] unit".
+  std::vector<double> numberList(const std::string& name, const std::vector<double>& fallback,
+                                 const char* unit);
   // A string naming one entry of a table (fallback if unset; an error naming the choices if not in
   // it).
   template <typename E, std::size_t N>

@@ -4,8 +4,10 @@
 #include <cmath>
 
 #include "cast_thread.h"
+#include "node_diagnostics.h"
 #include "scene_source.h"
 #include "sensor.h"
+#include "sensor_reconfigure.h"
 #include "tf_source.h"
 #include "tf_timing.h"
 
@@ -16,6 +18,7 @@ RaycastNode::RaycastNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 
 RaycastNode::~RaycastNode() {
   report_timer_.stop();
+  reconfigure_.clear();
   for (ros::Timer& t : align_timers_) t.stop();
   for (ros::Timer& t : timers_) t.stop();
   cast_thread_.reset();  // joins: nothing casts after this
@@ -34,14 +37,10 @@ bool RaycastNode::init() {
   for (const SensorParams& s : params_.sensors) longest_scan = std::max(longest_scan, 1.0 / s.rate);
   const double history = params_.tf_timeout + longest_scan + 1.0;
   tf_ = std::make_unique<TfSource>(nh_, ros::Duration(std::max(10.0, history)));
-  std::size_t capacity = 0;
   for (const SensorParams& s : params_.sensors) {
     const double pose_history = history + std::min(s.pose_timeout, NodeParams::kMaxTfTimeout);
     sensors_.push_back(std::make_unique<Sensor>(nh_, s, params_.fixed_frame, kTfGracePeriod,
                                                 ros::Duration(pose_history)));
-    // Enough queued scans to wait out tf_timeout at full rate, and two to spare.
-    capacity +=
-        static_cast<std::size_t>(std::ceil(s.rate * (params_.tf_timeout + 1.0 / s.rate))) + 2;
   }
   CastThread::Context context;
   context.scene = &scene_;
@@ -51,27 +50,50 @@ bool RaycastNode::init() {
   context.fixed_frame = params_.fixed_frame;
   context.tf_timeout = ros::Duration(params_.tf_timeout);
   cast_thread_ = std::make_unique<CastThread>(context);
-  cast_thread_->setCapacity(capacity);
+  updateCapacity();
+  diagnostics_ = std::make_unique<NodeDiagnostics>(nh_, pnh_, sensors_);
 
   align_timers_.resize(sensors_.size());
   timers_.resize(sensors_.size());
   last_queued_.assign(sensors_.size(), ros::Time());
+  const bool shorthand = params_.sensors.size() == 1 && params_.sensors[0].name.empty();
   for (std::size_t i = 0; i < sensors_.size(); ++i) {
-    startTimer(static_cast<int>(i));
-    const SensorParams& s = sensors_[i]->params();
-    ROS_INFO_STREAM("laser_raycast: " << s.scan.pattern().size() << " beams from "
-                                      << s.scan.fan.angle_min << " rad at " << s.rate
-                                      << " Hz in frame '" << s.frame_id << "', sensor pose from "
-                                      << (s.pose_topic.empty() ? "TF" : "topic " + s.pose_topic)
-                                      << "; publishing " << nh_.resolveName("scan"));
+    const int index = static_cast<int>(i);
+    const SensorParams& s = params_.sensors[i];
+    // The one sensor's live parameters are the node's own; an entry's are under ~<name>.
+    const ros::NodeHandle live_ns = shorthand ? pnh_ : ros::NodeHandle(pnh_, s.name);
+    reconfigure_.push_back(std::make_unique<SensorReconfigure>(live_ns, sensors_[i].get(), [=] {
+      startTimer(index);
+      updateCapacity();
+    }));
+    startTimer(index);
+    ROS_INFO(
+        "sensor '%s': %d beams (%zu rings) at %g Hz, %s, in frame '%s', pose from %s; "
+        "publishing %s",
+        s.name.c_str(), s.scan.pattern().size(), s.scan.elevations.size(), s.rate,
+        kSweepNames.name(s.sweep), s.frame_id.c_str(),
+        s.pose_topic.empty() ? "TF" : ("topic " + s.pose_topic).c_str(),
+        nh_.resolveName(s.topic).c_str());
   }
   report_timer_ = nh_.createTimer(ros::Duration(kReportPeriod), &RaycastNode::onReport, this);
+  ROS_INFO("laser_raycast: started, %zu sensor%s over %zu bodies", sensors_.size(),
+           sensors_.size() == 1 ? "" : "s", scene_.bodies().size());
   return true;
+}
+
+void RaycastNode::updateCapacity() {
+  std::size_t capacity = 0;
+  for (const auto& sensor : sensors_) {
+    const double rate = sensor->live().rate;
+    capacity += static_cast<std::size_t>(std::ceil(rate * params_.tf_timeout)) + 2;
+  }
+  cast_thread_->setCapacity(capacity);
 }
 
 void RaycastNode::startTimer(int i) {
   // First a one-shot timer to the next multiple of the period, then the periodic timer from there:
   // scan times on the period's grid (tf_timing.h).
+  timers_[i].stop();
   const ros::Duration period = sensors_[i]->period();
   const ros::Duration delay = untilNextMultiple(ros::Time::now(), period);
   align_timers_[i] = nh_.createTimer(
@@ -91,13 +113,14 @@ void RaycastNode::onTick(int i, const ros::Time& expected) {
   if (stamp <= last_queued_[i]) return;
   last_queued_[i] = stamp;
   const bool listened = sensor.hasSubscribers();
-  sensor.setActive(listened, stamp);
+  sensor.monitor().setActive(listened, stamp);
   if (listened) cast_thread_->schedule(i, sensor.sampleTimes(stamp));
 }
 
 void RaycastNode::onReport(const ros::TimerEvent&) {
   const ros::Time now = ros::Time::now();
-  for (const auto& sensor : sensors_) sensor->reportRate(now);
+  for (const auto& sensor : sensors_) sensor->monitor().reportRate(now, sensor->live().rate);
+  diagnostics_->publish();
 }
 
 }  // namespace laser_raycast

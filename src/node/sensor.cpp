@@ -1,31 +1,44 @@
 #include "sensor.h"
 
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
 
 #include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 
 #include "laser_raycast/ScanLabels.h"
+#include "laser_raycast/core/pose_samples.h"
+#include "laser_raycast/node/point_cloud.h"
+#include "param_reader.h"
 #include "tf_timing.h"
 
 namespace laser_raycast {
 
 Sensor::Sensor(ros::NodeHandle& nh, const SensorParams& params, const std::string& fixed_frame,
                double grace_period, ros::Duration history)
-    : params_(params),
+    : name_(params.name),
       fixed_frame_(fixed_frame),
-      grace_period_(grace_period),
-      period_(1.0 / params.rate),
+      params_(params),
+      cast_params_(params),
       pattern_(params.scan.pattern()),
       cast_config_(params.scan.castConfig()),
-      encoder_(params.scan.output) {
-  scan_pub_ = nh.advertise<sensor_msgs::LaserScan>("scan", kPublishQueue);
-  labels_pub_ = nh.advertise<laser_raycast::ScanLabels>("scan_labels", kPublishQueue);
-  if (!params_.pose_topic.empty()) {
-    pose_topic_ = std::make_unique<PoseTopic>(nh, params_.pose_topic, fixed_frame_,
-                                              ros::Duration(params_.pose_timeout), history);
+      encoder_(params.scan.output),
+      monitor_(params.name, nh.resolveName(params.topic), grace_period) {
+  if (params.planar()) {
+    scan_pub_ = nh.advertise<sensor_msgs::LaserScan>(params.topic, kPublishQueue);
+  } else {
+    cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>(params.topic, kPublishQueue);
+  }
+  labels_pub_ = nh.advertise<laser_raycast::ScanLabels>(params.labelsTopic(), kPublishQueue);
+  if (!params.pose_topic.empty()) {
+    pose_topic_ = std::make_unique<PoseTopic>(nh, params.pose_topic, fixed_frame_,
+                                              ros::Duration(params.pose_timeout), history);
+  }
+  if (params.sweep == Sweep::kRotating) {
+    column_times_ = rotatingColumnTimes(pattern_.azimuthCount(), params.timeIncrement());
   }
 }
 
@@ -35,36 +48,74 @@ std::pair<std::string, std::string> Sensor::tfChain() const {
 }
 
 bool Sensor::hasSubscribers() const {
-  return scan_pub_.getNumSubscribers() > 0 || labels_pub_.getNumSubscribers() > 0;
+  return scan_pub_.getNumSubscribers() > 0 || cloud_pub_.getNumSubscribers() > 0 ||
+         labels_pub_.getNumSubscribers() > 0;
 }
 
-void Sensor::setActive(bool active, const ros::Time& now) {
+ros::Duration Sensor::period() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (active && !active_) {
-    window_start_ = now;
-    window_published_ = stats_.published;
-    window_skipped_ = stats_.skipped.total();
-    ROS_DEBUG("sensor '%s': subscribed: casting", name().c_str());
-  } else if (!active && (active_ || idle_since_.isZero())) {
-    idle_since_ = now;
-  }
-  active_ = active;
-  // Subscribers connect a moment after the node starts: only a lasting absence is logged.
-  if (!active && !idle_logged_ && (now - idle_since_).toSec() >= kIdleLogDelay) {
-    idle_logged_ = true;
-    ROS_INFO("sensor '%s': nobody subscribes to %s: not cast until someone does (logged once)",
-             name().c_str(), scan_pub_.getTopic().c_str());
-  }
+  return ros::Duration(1.0 / params_.rate);
 }
 
-std::vector<ros::Time> Sensor::sampleTimes(const ros::Time& stamp) const { return {stamp}; }
+std::vector<ros::Time> Sensor::sampleTimes(const ros::Time& stamp) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return laser_raycast::sampleTimes(stamp, ros::Duration(params_.sweepDuration()),
+                                    ros::Duration(kSweepSampleSpacing));
+}
+
+Sensor::Live Sensor::live() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return Live{params_.scan.output, params_.rate};
+}
+
+std::string Sensor::setLive(const Live& live) {
+  SensorParams next;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    next = params_;
+  }
+  next.scan.output = live.output;
+  next.rate = live.rate;
+  if (!(std::isfinite(live.rate) && live.rate > 0 && live.rate <= SensorParams::kMaxRate)) {
+    return "rate must be in (0, " + formatNumber(SensorParams::kMaxRate) + "] Hz, got " +
+           formatNumber(live.rate);
+  }
+  if (next.sweep == Sweep::kRotating && next.scan_time > 1.0 / next.rate) {
+    return "rate " + formatNumber(next.rate) + " Hz is too fast for scan_time " +
+           formatNumber(next.scan_time) +
+           " s (a head turns once a scan; scan_time needs a restart)";
+  }
+  try {
+    next.scan.output.validate();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  params_ = next;
+  pending_ = live;
+  return "";
+}
+
+void Sensor::applyLive() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!pending_) return;
+  cast_params_ = params_;
+  cast_config_ = cast_params_.scan.castConfig();
+  encoder_.setConfig(cast_params_.scan.output);
+  if (cast_params_.sweep == Sweep::kRotating) {
+    column_times_ = rotatingColumnTimes(pattern_.azimuthCount(), cast_params_.timeIncrement());
+  }
+  pending_.reset();
+}
 
 bool Sensor::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose,
-                    std::string* why) {
+                    std::string* why, bool* from_tf) {
   // Without a pose topic the sensor is a TF frame like any other; with one, the topic gives the
   // pose of pose_frame, and TF (usually a static mount) the sensor relative to it.
   Eigen::Isometry3d world_from_pose_frame = Eigen::Isometry3d::Identity();
+  *from_tf = false;
   if (pose_topic_ && !pose_topic_->poseAt(t, tf, &world_from_pose_frame, why)) return false;
+  *from_tf = true;
   const auto [target, source] = tfChain();
   Eigen::Isometry3d target_from_sensor;
   std::string error;
@@ -79,117 +130,80 @@ bool Sensor::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* p
   return true;
 }
 
-bool Sensor::quiet(const ros::Time& stamp) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (first_attempt_.isZero()) first_attempt_ = stamp;
-  return stats_.published == 0 && (stamp - first_attempt_).toSec() < grace_period_;
-}
-
 void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>& reflectivity,
                             const std::vector<ros::Time>& times,
                             const std::vector<core::FramePoses>& frames,
                             const std::vector<Eigen::Isometry3d>& poses,
                             std::size_t missing_links) {
+  applyLive();
   const auto start = std::chrono::steady_clock::now();
-  const core::ScanResult& result =
-      caster_.cast(scene, frames.front(), poses.front(), pattern_, cast_config_);
+  const core::ScanResult* result;
+  if (times.size() == 1) {
+    result = &caster_.cast(scene, frames.front(), poses.front(), pattern_, cast_config_);
+  } else {
+    // A rotating scan: each beam column from the poses at its own time (s after the stamp).
+    core::PoseSamples samples;
+    for (const ros::Time& t : times) samples.times.push_back((t - times.front()).toSec());
+    samples.world_from_sensor = poses;
+    samples.frames = frames;
+    result =
+        &caster_.castSweep(scene, samples, pattern_, cast_config_, cast_params_.timeIncrement());
+  }
   const double cast_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  encoder_.encode(scene, result, reflectivity, &encoded_);
-  publishScan(scene, times.front());
+  encoder_.encode(scene, *result, reflectivity, &encoded_);
+  if (cast_params_.planar()) {
+    publishScan(times.front());
+  } else {
+    publishCloud(times.front());
+  }
+  std_msgs::Header header;
+  header.stamp = times.front();
+  header.frame_id = cast_params_.frame_id;
+  publishLabels(scene, header);
 
+  const core::EncoderConfig& out = cast_params_.scan.output;
   std::size_t hits = 0;
-  for (const float r : encoded_.ranges) {
-    hits += r >= params_.scan.output.range_min && r <= params_.scan.output.range_max;
-  }
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (stats_.published == 0) {
-    ROS_INFO(
-        "sensor '%s': first scan at t = %.3f, %.3f s after the first attempt (%lu skipped "
-        "while waiting for transforms)",
-        name().c_str(), times.front().toSec(), (times.front() - first_attempt_).toSec(),
-        static_cast<unsigned long>(stats_.skipped.total()));
-  }
-  if (stats_.published == 0) window_start_ = times.front();
-  ++stats_.published;
-  stats_.missing_links += missing_links;
-  stats_.last_cast_seconds = cast_seconds;
-  stats_.last_hit_share = encoded_.ranges.empty() ? 0.0 : double(hits) / encoded_.ranges.size();
+  for (const float r : encoded_.ranges) hits += r >= out.range_min && r <= out.range_max;
+  monitor_.published(times.front(), missing_links, cast_seconds,
+                     encoded_.ranges.empty() ? 0.0 : double(hits) / encoded_.ranges.size());
 }
 
-void Sensor::publishScan(const core::Scene& scene, const ros::Time& stamp) {
+void Sensor::publishScan(const ros::Time& stamp) {
   sensor_msgs::LaserScan scan;
-  scan.header.stamp = stamp;  // every beam is cast at this instant
-  scan.header.frame_id = params_.frame_id;
+  scan.header.stamp = stamp;  // the first beam's time (every beam's, when instantaneous)
+  scan.header.frame_id = cast_params_.frame_id;
   scan.angle_min = static_cast<float>(pattern_.angleMin());
   scan.angle_max = static_cast<float>(pattern_.angleMax());
   scan.angle_increment = static_cast<float>(pattern_.angleIncrement());
-  scan.time_increment = 0.0f;  // instantaneous: all beams share the stamp
-  scan.scan_time = static_cast<float>(period_.toSec());
-  scan.range_min = static_cast<float>(params_.scan.output.range_min);
-  scan.range_max = static_cast<float>(params_.scan.output.range_max);
+  scan.time_increment = static_cast<float>(cast_params_.timeIncrement());
+  scan.scan_time = static_cast<float>(cast_params_.scanTime());
+  scan.range_min = static_cast<float>(cast_params_.scan.output.range_min);
+  scan.range_max = static_cast<float>(cast_params_.scan.output.range_max);
   scan.ranges = encoded_.ranges;
   scan.intensities = encoded_.intensities;
   scan_pub_.publish(scan);
-
-  if (labels_pub_.getNumSubscribers() > 0) {
-    laser_raycast::ScanLabels labels;
-    labels.header = scan.header;
-    labels.link_names = scene.labels();
-    labels.labels.assign(encoded_.labels.begin(), encoded_.labels.end());
-    labels_pub_.publish(labels);
-  }
 }
 
-void Sensor::skip(Skip kind, const ros::Time& stamp, const std::string& why) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  switch (kind) {
-    case Skip::kNoPose:
-      ++stats_.skipped.no_pose;
-      break;
-    case Skip::kWaiting:
-      ++stats_.skipped.waiting;
-      ROS_DEBUG("sensor '%s': waiting for the first transforms: %s", name().c_str(), why.c_str());
-      return;
-    case Skip::kBehind:
-      ++stats_.skipped.behind;
-      break;
-  }
-  const ros::WallTime now = ros::WallTime::now();
-  if (!last_warning_.isZero() && (now - last_warning_).toSec() < kWarnPeriod) return;
-  last_warning_ = now;
-  ROS_WARN("sensor '%s': scan skipped (t = %.3f): %s (%lu of %lu so far)", name().c_str(),
-           stamp.toSec(), why.c_str(), static_cast<unsigned long>(stats_.skipped.total()),
-           static_cast<unsigned long>(stats_.skipped.total() + stats_.published));
+void Sensor::publishCloud(const ros::Time& stamp) {
+  std_msgs::Header header;
+  header.stamp = stamp;  // the first beam column's time; each point has its own in `time`
+  header.frame_id = cast_params_.frame_id;
+  CloudOptions options;
+  options.organized = cast_params_.organized;
+  sensor_msgs::PointCloud2 cloud;
+  buildPointCloud(pattern_, encoded_, column_times_, header, options, &cloud);
+  cloud_pub_.publish(cloud);
 }
 
-SensorStats Sensor::stats() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return stats_;
-}
-
-void Sensor::reportRate(const ros::Time& now) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!active_ || stats_.published == 0 || (now - window_start_).toSec() < kRateWindow) return;
-  const double seconds = (now - window_start_).toSec();
-  const double achieved = (stats_.published - window_published_) / seconds;
-  const std::uint64_t skipped = stats_.skipped.total() - window_skipped_;
-  if (achieved < kRateWarnShare * params_.rate) {
-    ROS_WARN(
-        "sensor '%s': %.1f Hz of the configured %.1f Hz over the last %.0f s (%lu scans "
-        "skipped; the warnings above say why)",
-        name().c_str(), achieved, params_.rate, seconds, static_cast<unsigned long>(skipped));
-    rate_warned_ = true;
-  } else if (rate_warned_) {
-    ROS_INFO("sensor '%s': back to %.1f Hz of the configured %.1f Hz", name().c_str(), achieved,
-             params_.rate);
-    rate_warned_ = false;
-  } else {
-    ROS_DEBUG("sensor '%s': %.1f Hz of %.1f Hz", name().c_str(), achieved, params_.rate);
-  }
-  window_start_ = now;
-  window_published_ = stats_.published;
-  window_skipped_ = stats_.skipped.total();
+void Sensor::publishLabels(const core::Scene& scene, const std_msgs::Header& header) {
+  // The labels are computed with every scan; the message is built only for a subscriber.
+  if (labels_pub_.getNumSubscribers() == 0) return;
+  laser_raycast::ScanLabels labels;
+  labels.header = header;
+  labels.link_names = scene.labels();
+  labels.labels.assign(encoded_.labels.begin(), encoded_.labels.end());
+  labels_pub_.publish(labels);
 }
 
 }  // namespace laser_raycast

@@ -5,37 +5,74 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <stdexcept>
+
+#include "laser_raycast/core/sensor_model.h"
 
 namespace laser_raycast {
 namespace {
 
-// The beam count comes from exactly one of angle_increment and samples (neither:
-// kDefaultSamples); the core checks the angles and the beam count.
+// The beam count comes from exactly one of angle_increment and samples; with neither, from the
+// fallback fan (a preset's, or an entry's defaults) or else kDefaultSamples. The core checks the
+// angles and the beam count.
 void readFan(ParamReader* r, core::FanSpec* fan) {
   fan->angle_min = r->number("angle_min", fan->angle_min, "rad");
   fan->angle_max = r->number("angle_max", fan->angle_max, "rad");
   const bool has_increment = r->has("angle_increment"), has_samples = r->has("samples");
+  if (has_increment && has_samples) {
+    r->fail("samples", "set " + r->prefix() + "angle_increment or " + r->prefix() +
+                           "samples, not both (got angle_increment " +
+                           describeValue(*r->get("angle_increment")) + " and samples " +
+                           describeValue(*r->get("samples")) + ")");
+  }
   if (has_increment) {
     fan->angle_increment = r->number("angle_increment", 0.0, "rad");
+    fan->samples = 0;
     if (!(std::isfinite(fan->angle_increment) && fan->angle_increment > 0)) {
       r->fail("angle_increment",
               "must be finite and > 0 rad, got " + formatNumber(fan->angle_increment));
     }
-  } else {
-    r->note(r->prefix() + "angle_increment unset (beams from " + r->prefix() + "samples)");
-  }
-  if (has_samples || !has_increment) {
-    fan->samples = r->integer("samples", SensorParams::kDefaultSamples, "beams");
+    r->note(r->prefix() + "samples unset (beams from " + r->prefix() + "angle_increment)");
+  } else if (has_samples || fan->angle_increment == 0) {
+    const int fallback = fan->samples > 0 ? fan->samples : SensorParams::kDefaultSamples;
+    fan->samples = r->integer("samples", fallback, "beams");
+    fan->angle_increment = 0;
     if (fan->samples < 2) r->fail("samples", "must be >= 2, got " + std::to_string(fan->samples));
+    r->note(r->prefix() + "angle_increment unset (beams from " + r->prefix() + "samples)");
   } else {
+    // The fallback's spacing: a preset's (or, in an entry, the private namespace's).
+    fan->angle_increment = r->number("angle_increment", fan->angle_increment, "rad");
     r->note(r->prefix() + "samples unset (beams from " + r->prefix() + "angle_increment)");
   }
-  if (has_increment && has_samples) {
-    r->fail("samples", "set " + r->prefix() + "angle_increment or " + r->prefix() +
-                           "samples, not both (got angle_increment " +
-                           formatNumber(fan->angle_increment) + " and samples " +
-                           std::to_string(fan->samples) + ")");
+}
+
+// ~elevations: one fan per elevation (rad, any order); [0] is a planar scanner.
+void readElevations(ParamReader* r, core::ScanSpec* scan) {
+  const bool given = r->has("elevations");
+  scan->elevations = r->numberList("elevations", scan->elevations, "rad");
+  if (!given) return;
+  if (scan->elevations.empty()) {
+    r->fail("elevations", "must not be empty (a planar scanner is [0])");
   }
+  for (std::size_t i = 0; i < scan->elevations.size(); ++i) {
+    if (!std::isfinite(scan->elevations[i])) {
+      r->fail("elevations[" + std::to_string(i) + "]",
+              "must be finite, got " + formatNumber(scan->elevations[i]));
+    }
+  }
+}
+
+// ~sensor_model: a preset's pattern, range limits and rate, before the explicit parameters.
+void readSensorModel(ParamReader* r, SensorParams* s) {
+  s->sensor_model = r->text("sensor_model", s->sensor_model);
+  if (s->sensor_model.empty()) return;
+  const std::optional<core::SensorModel> model = core::findSensorModel(s->sensor_model);
+  if (!model) {
+    r->fail("sensor_model", core::kSensorModelNames.notOneOf(s->sensor_model));
+    return;
+  }
+  model->apply(&s->scan, &s->rate);
 }
 
 // What the sensor reports: range limits, min-range policy, noise, intensity; and how it casts.
@@ -50,6 +87,9 @@ void readOutput(ParamReader* r, core::ScanSpec* scan) {
   if (seed < 0) r->fail("noise_seed", "must be >= 0, got " + std::to_string(seed));
   out.noise_seed = static_cast<std::uint64_t>(std::max(seed, 0));
   out.intensity = r->choice("intensity", out.intensity, kIntensityNames);
+  out.range_bias = r->number("range_bias", out.range_bias, "m");
+  out.range_resolution = r->number("range_resolution", out.range_resolution, "m");
+  out.dropout_probability = r->number("dropout_probability", out.dropout_probability, "");
   scan->method = r->choice("method", scan->method, core::kTriangleMethodNames);
   scan->cull_backfaces = r->boolean("cull_backfaces", scan->cull_backfaces);
 }
@@ -60,6 +100,29 @@ void readRate(ParamReader* r, SensorParams* s) {
     r->fail("rate", "must be in (0, " + formatNumber(SensorParams::kMaxRate) + "] Hz, got " +
                         formatNumber(s->rate));
   }
+}
+
+// When the beams are taken, and how a 3D scan is published.
+void readSweep(ParamReader* r, SensorParams* s, std::vector<std::string>* warnings) {
+  s->sweep = r->choice("sweep", s->sweep, kSweepNames);
+  if (r->has("scan_time")) {
+    s->scan_time = r->number("scan_time", 0.0, "s");
+    // One head turns once per scan: a turn longer than the period would overlap the next scan.
+    const double period = 1.0 / s->rate;
+    if (!(std::isfinite(s->scan_time) && s->scan_time > 0 && s->scan_time <= period)) {
+      r->fail("scan_time", "must be in (0, 1 / " + r->prefix() + "rate] = (0, " +
+                               formatNumber(period) + "] s, got " + formatNumber(s->scan_time));
+    }
+    if (s->sweep == Sweep::kInstant) {
+      warnings->push_back(r->prefix() + "scan_time has no effect with " + r->prefix() +
+                          "sweep 'instant'");
+    }
+  } else if (s->scan_time > 0) {
+    r->note(r->prefix() + "scan_time = " + formatNumber(s->scan_time) + " s");
+  } else {
+    r->note(r->prefix() + "scan_time unset (1 / " + r->prefix() + "rate)");
+  }
+  s->organized = r->boolean("organized", s->organized);
 }
 
 // Where the sensor pose comes from: TF, or a topic giving the pose of pose_frame.
@@ -93,21 +156,49 @@ void checkFrame(ParamReader* r, const std::string& name, const std::string& fram
   }
 }
 
-void readSensor(ParamReader* r, SensorParams* s) {
+void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::string>* warnings) {
+  if (entry) {
+    s->name = r->text("name", "");
+    s->topic = r->text("topic", "");
+    if (!r->has("frame_id")) {
+      r->failWith("parameter " + r->prefix() + "frame_id: not set (each entry of ~sensors names " +
+                  "its sensor frame)");
+    }
+  }
+  readSensorModel(r, s);
   s->frame_id = r->text("frame_id", s->frame_id);
   checkFrame(r, "frame_id", s->frame_id, false);
   readFan(r, &s->scan.fan);
+  readElevations(r, &s->scan);
   readOutput(r, &s->scan);
   readRate(r, s);
+  readSweep(r, s, warnings);
   readPoseSource(r, s);
+  // The angles and beam count, elevations, ranges, noise and realism through the core's own
+  // validation, which names the field (the fields share the parameters' names).
+  if (r->error().empty()) {
+    try {
+      s->scan.validate();
+    } catch (const std::invalid_argument& e) {
+      const std::string& where = r->prefix();
+      r->failWith("bad parameter" +
+                  (where == "~" ? std::string() : " in " + where.substr(0, where.size() - 1)) +
+                  ": " + e.what());
+    }
+  }
+  if (s->organized && s->planar()) {
+    warnings->push_back(r->prefix() + "organized has no effect for a planar pattern (published " +
+                        "as a LaserScan)");
+  }
 }
 
-std::vector<std::string> sensorParamNames() {
-  const XmlRpc::XmlRpcValue none;
-  ParamReader r(none, "~");
-  SensorParams s;
-  readSensor(&r, &s);
-  return r.known();
+double SensorParams::timeIncrement() const {
+  if (sweep != Sweep::kRotating) return 0.0;
+  return scan.fan.increment() * scanTime() / (2 * M_PI);
+}
+
+double SensorParams::sweepDuration() const {
+  return sweep == Sweep::kRotating ? (scan.fan.beamCount() - 1) * timeIncrement() : 0.0;
 }
 
 }  // namespace laser_raycast

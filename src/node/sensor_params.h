@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "laser_raycast/node/node_params.h"
 #include "param_reader.h"
@@ -13,10 +14,10 @@ namespace laser_raycast {
 // optional).
 void checkFrame(ParamReader* r, const std::string& name, const std::string& frame, bool optional);
 
-// Every sensor parameter, in the order the log lists them, into *s (which holds the defaults).
-void readSensor(ParamReader* r, SensorParams* s);
-
-// The names readSensor reads, in order.
-std::vector<std::string> sensorParamNames();
+// Every sensor parameter, in the order the log lists them, into *s, whose values are the
+// fallbacks (the defaults, or for an entry of ~sensors the private namespace's sensor). An entry
+// (`entry`) also has a name and a topic, and must give its frame_id. Settings without effect go to
+// *warnings.
+void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::string>* warnings);
 
 }  // namespace laser_raycast

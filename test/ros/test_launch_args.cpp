@@ -95,11 +95,23 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
   EXPECT_EQ(p.sensors.at(0).pose_topic, "/all/pose");
   EXPECT_EQ(p.sensors.at(0).pose_frame, "base_link");
   EXPECT_EQ(p.sensors.at(0).pose_timeout, 0.2);
+  EXPECT_EQ(p.sensors.at(0).sensor_model, "UTM-30LX");
+  EXPECT_EQ(p.sensors.at(0).scan.elevations, (std::vector<double>{0.1, -0.1}));
+  EXPECT_EQ(p.sensors.at(0).sweep, laser_raycast::Sweep::kRotating);
+  EXPECT_EQ(p.sensors.at(0).scan_time, 0.1);
+  EXPECT_TRUE(p.sensors.at(0).organized);
+  EXPECT_EQ(p.sensors.at(0).scan.output.range_bias, 0.01);
+  EXPECT_EQ(p.sensors.at(0).scan.output.range_resolution, 0.002);
+  EXPECT_EQ(p.sensors.at(0).scan.output.dropout_probability, 0.05);
 
   const Parsed samples = parseFromMaster("/samples/laser_raycast");
   ASSERT_EQ(samples.error, "");
   EXPECT_EQ(samples.params.sensors.at(0).scan.fan.samples, 100);
   EXPECT_EQ(samples.params.sensors.at(0).scan.fan.angle_increment, 0.0);
+  ASSERT_EQ(samples.params.sensors.size(), 2u);
+  EXPECT_EQ(samples.params.sensors[0].frame_id, "front");
+  EXPECT_EQ(samples.params.sensors[1].name, "top");
+  EXPECT_EQ(samples.params.sensors[1].sensor_model, "VLP-16");
 
   // Between them, the two set every parameter the node reads.
   std::set<std::string> set = keys(all.values);
@@ -110,7 +122,8 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
 }
 
 TEST(LaunchArgs, TheNodesStart) {
-  const std::vector<std::string> scans = {"/defaults/scan", "/all/scan_all", "/samples/scan"};
+  const std::vector<std::string> scans = {"/defaults/scan", "/all/points_all",
+                                          "/samples/front/scan", "/samples/top/points"};
   std::set<std::string> advertised;
   const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(60.0);
   while (advertised.size() < scans.size() && ros::WallTime::now() < give_up) {

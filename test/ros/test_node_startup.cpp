@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <regex>
 #include <string>
 #include <thread>
@@ -67,6 +68,46 @@ XmlRpc::XmlRpcValue modelFile(const std::string& path) {
 // One wrong parameter, end to end (test/unit/test_node_params.cpp checks every parameter).
 TEST(NodeStartup, AWrongParameterStopsTheNode) {
   expectRefused(scene("/d") + " _rate:=fast", {"~rate", "'fast'", "expected a number"});
+}
+
+// The sensors' bad input, end to end: refused with the parameter and the value named, before
+// anything starts (no topic advertised, no "started" line).
+TEST(NodeStartup, BadSensorInputStopsTheNodeBeforeAnythingStarts) {
+  const auto refused = [](const std::string& args, const std::vector<std::string>& mentions) {
+    const NodeRun run = runNode(args);
+    EXPECT_EQ(run.status, 1) << args << "\n" << run.output;
+    EXPECT_EQ(run.output.find("laser_raycast: started"), std::string::npos) << run.output;
+    EXPECT_EQ(run.output.find("model '"), std::string::npos) << "the scene was loaded:\n"
+                                                             << run.output;
+    for (const std::string& m : mentions) {
+      EXPECT_NE(run.output.find(m), std::string::npos) << "the message should say '" << m << "':\n"
+                                                       << run.output;
+    }
+  };
+  ros::NodeHandle nh;
+  refused(scene("/p1") + " _sensor_model:=VLP-15",
+          {"~sensor_model", "'VLP-15' is not one of", "VLP-16"});
+  XmlRpc::XmlRpcValue empty;
+  empty.setSize(0);
+  nh.setParam("/p2/node/elevations", empty);
+  refused(scene("/p2"), {"~elevations", "must not be empty"});
+  XmlRpc::XmlRpcValue infinite;
+  infinite[0] = 0.1;
+  infinite[1] = std::numeric_limits<double>::infinity();
+  nh.setParam("/p3/node/elevations", infinite);
+  refused(scene("/p3"), {"~elevations[1]", "got inf"});
+  XmlRpc::XmlRpcValue no_frame;
+  no_frame[0]["frame_id"] = "a";
+  no_frame[1]["samples"] = 10;
+  nh.setParam("/p4/node/sensors", no_frame);
+  refused(scene("/p4"), {"~sensors[1]/frame_id", "not set"});
+  XmlRpc::XmlRpcValue same_topic;
+  same_topic[0]["frame_id"] = "a";
+  same_topic[0]["topic"] = "scan";
+  same_topic[1]["frame_id"] = "b";
+  same_topic[1]["topic"] = "scan";
+  nh.setParam("/p5/node/sensors", same_topic);
+  refused(scene("/p5"), {"~sensors[1]/topic", "'scan'", "~sensors[0]"});
 }
 
 TEST(NodeStartup, ReflectivityOfAnUnknownLink) {

@@ -34,8 +34,19 @@ inline const core::EnumNames<bool, 2> kIntensityNames{{{
     {false, "off"}, {true, "reflectivity"},  // reflectivity of the link hit x cos(incidence angle)
 }}};
 
-// One simulated sensor: its frame, beams, output, rate and pose source. The single-sensor
-// parameters of the private namespace describe one.
+// ~sweep: when each beam is taken.
+enum class Sweep {
+  kInstant,   // "instant": every beam at the stamp (time_increment 0)
+  kRotating,  // "rotating": the head turns once per scan_time; beam column c at stamp + c * dt
+};
+inline const core::EnumNames<Sweep, 2> kSweepNames{{{
+    {Sweep::kInstant, "instant"},
+    {Sweep::kRotating, "rotating"},
+}}};
+
+// One simulated sensor: its frame, beams, output, timing and pose source. The sensor parameters of
+// the private namespace describe one (the shorthand); each entry of ~sensors describes one, with
+// those as its defaults.
 struct SensorParams {
   // Beams when neither ~samples nor ~angle_increment is set: one a degree over the full turn.
   static constexpr int kDefaultSamples = 360;
@@ -44,16 +55,34 @@ struct SensorParams {
   // ms a scan for the TF look-ups, the cast and publishing.
   static constexpr double kMaxRate = 1000.0;  // Hz
 
+  // Entries of ~sensors: its name (in the log, the diagnostics, and the namespace of its live
+  // parameters), default frame_id; and its topic, default <name>/scan or <name>/points. The
+  // shorthand: frame_id, and scan or points (relative to the node's namespace).
+  std::string name;
+  std::string topic;
+  std::string sensor_model;        // a preset (core::kSensorModelNames), "" for none
   std::string frame_id = "laser";  // sensor frame; header.frame_id of the scans
   // Beams, range limits, min-range policy, noise, intensity, triangle test. fan.samples is 0 here:
   // the parser sets kDefaultSamples when neither it nor angle_increment is given.
   core::ScanSpec scan;
-  double rate = 10.0;      // Hz, in (0, kMaxRate]
+  double rate = 10.0;  // Hz, in (0, kMaxRate]
+  Sweep sweep = Sweep::kInstant;
+  double scan_time = 0;    // s, in (0, 1 / rate]: one turn of a rotating head; 0: 1 / rate
+  bool organized = false;  // PointCloud2: every beam, height = rings (else valid returns only)
   std::string pose_topic;  // empty: the sensor pose comes from TF
   std::string pose_frame;  // frame whose pose pose_topic gives; empty: frame_id
   // s, > 0: a topic pose older than this at a scan's time is stale (the scan is skipped). Pose
   // sources run at 10 to 100 Hz: this is five periods of the slowest.
   double pose_timeout = 0.5;
+
+  // A single ring at elevation 0: a LaserScan (otherwise a PointCloud2).
+  bool planar() const { return scan.elevations.size() == 1 && scan.elevations[0] == 0.0; }
+  double scanTime() const { return scan_time > 0 ? scan_time : 1.0 / rate; }
+  // s between beam columns: angle_increment * scan_time / 2 pi when rotating, else 0.
+  double timeIncrement() const;
+  // s from the first beam column to the last (0 when instantaneous).
+  double sweepDuration() const;
+  std::string labelsTopic() const { return topic + "_labels"; }
 };
 
 struct NodeParams {

@@ -18,7 +18,9 @@
 namespace laser_raycast {
 
 class CastThread;
+class NodeDiagnostics;
 class Sensor;
+class SensorReconfigure;
 class TfSource;
 
 class RaycastNode {
@@ -39,10 +41,12 @@ class RaycastNode {
 
  private:
   void startTimer(int sensor);
+  // The cast queue's capacity: enough scans to wait out tf_timeout at every sensor's rate.
+  void updateCapacity();
   void onTick(int sensor, const ros::Time& expected);
   void onReport(const ros::TimerEvent& event);
 
-  // Achieved rates are checked (and warned about when low) this often.
+  // Achieved rates are checked (and warned about when low), and diagnostics published, this often.
   static constexpr double kReportPeriod = 1.0;  // s
 
   ros::NodeHandle nh_, pnh_;
@@ -52,6 +56,8 @@ class RaycastNode {
   std::unique_ptr<TfSource> tf_;
   std::vector<std::unique_ptr<Sensor>> sensors_;
   std::unique_ptr<CastThread> cast_thread_;
+  std::unique_ptr<NodeDiagnostics> diagnostics_;
+  std::vector<std::unique_ptr<SensorReconfigure>> reconfigure_;
   // Per sensor: a one-shot timer that starts the periodic one on its period's grid, the periodic
   // timer, and the last scan time queued.
   std::vector<ros::Timer> align_timers_, timers_;
