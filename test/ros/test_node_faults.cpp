@@ -14,6 +14,8 @@
 #include <mutex>
 #include <vector>
 
+#include "scan_access.h"
+
 namespace laser_raycast_test {
 namespace {
 
@@ -23,15 +25,6 @@ constexpr double kTfTimeout = 0.5;  // s
 // Each scan checked against the geometry at its stamp: ranges are float (1e-7 relative) and TF
 // interpolates the test's smooth path linearly between 100 Hz samples (below 1e-5 m here).
 constexpr double kTolerance = 1e-4;  // m
-
-// The range of `beam`, or NaN (with a failure) if the scan has no such beam.
-double rangeOf(const sensor_msgs::LaserScan& scan, std::size_t beam) {
-  if (beam >= scan.ranges.size()) {
-    ADD_FAILURE() << "the scan has " << scan.ranges.size() << " beams, not " << beam + 1;
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-  return scan.ranges[beam];
-}
 
 geometry_msgs::TransformStamped transform(const ros::Time& stamp, const std::string& child,
                                           double x, double y, double z) {

@@ -14,22 +14,14 @@
 #include <mutex>
 #include <vector>
 
+#include "scan_access.h"
+
 namespace laser_raycast_test {
 namespace {
 
 constexpr double kTolerance = 1e-5;  // m
 // ~pose_timeout of node "plain" (node_pose_topic.test).
 constexpr double kPoseTimeout = 0.3;  // s
-
-// The range of `beam`, or NaN (with a failure naming the topic) if the scan has no such beam: a
-// scan that never came fails the test with a message instead of crashing it.
-double rangeOf(const sensor_msgs::LaserScan& scan, std::size_t beam) {
-  if (beam >= scan.ranges.size()) {
-    ADD_FAILURE() << "the scan has " << scan.ranges.size() << " beams, not " << beam + 1;
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-  return scan.ranges[beam];
-}
 
 bool anyValid(const sensor_msgs::LaserScan& scan) {
   for (const float r : scan.ranges) {

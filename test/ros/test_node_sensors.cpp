@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "scan_access.h"
+
 namespace laser_raycast_test {
 namespace {
 
@@ -133,14 +135,6 @@ class Rig {
 };
 
 Rig* rig = nullptr;
-
-double rangeOf(const sensor_msgs::LaserScan& scan, std::size_t beam) {
-  if (beam >= scan.ranges.size()) {
-    ADD_FAILURE() << "the scan has " << scan.ranges.size() << " beams, not " << beam + 1;
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-  return scan.ranges[beam];
-}
 
 // "front": 8 beams from -pi by pi/4, at (0, 0, 1): the walls 5 m (x) and 4 m (y) away, the
 // diagonals 4 sqrt(2) m (the y walls come first).
