@@ -1,7 +1,8 @@
 // rostest node_startup.test: what start-up needs a running node for. A wrong parameter, a missing
 // URDF or bad geometry stops laser_raycast_node with exit status 1 and a message naming the
 // parameter or file; skip_bad_geometry lets it start anyway. Each case runs the node executable
-// with rosrun against the test's master. (Every parameter check is in test_node_params.cpp.)
+// with rosrun against the test's master. (Every parameter check is in test_node_params.cpp and
+// test_sensor_params.cpp.)
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/package.h>
@@ -65,7 +66,8 @@ XmlRpc::XmlRpcValue modelFile(const std::string& path) {
   return models;
 }
 
-// One wrong parameter, end to end (test/unit/test_node_params.cpp checks every parameter).
+// One wrong parameter, end to end (test/unit/test_node_params.cpp and
+// test_sensor_params.cpp check every parameter).
 TEST(NodeStartup, AWrongParameterStopsTheNode) {
   expectRefused(scene("/d") + " _rate:=fast", {"~rate", "'fast'", "expected a number"});
 }

@@ -1,0 +1,187 @@
+// The sensor parameters beyond a planar instantaneous scan, parsed as the node parses them (no
+// parameter server, no roscore): rings, sweeps, range realism, presets and the sensors list, each
+// value reaching its field and each bad one refused naming the parameter (or the entry) and the
+// value.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "laser_raycast/node/node_params.h"
+#include "node_params_inputs.h"
+
+namespace laser_raycast_test {
+namespace {
+
+using XmlRpc::XmlRpcValue;
+
+const double kNan = std::numeric_limits<double>::quiet_NaN();
+const double kInf = std::numeric_limits<double>::infinity();
+
+TEST(SensorParams, ThreeDSweepAndRealismValuesReachTheirFields) {
+  const Parsed parsed = parse(values({{"elevations", list({0.1, -0.2, 0})},  // any order
+                                      {"sweep", "rotating"},
+                                      {"rate", 10},
+                                      {"scan_time", 0.05},
+                                      {"organized", true},
+                                      {"range_bias", -0.02},
+                                      {"range_resolution", 0.002},
+                                      {"dropout_probability", 0.1}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_TRUE(parsed.report.warnings.empty()) << parsed.report.warnings.front();
+  const laser_raycast::SensorParams& s = parsed.params.sensors.at(0);
+  EXPECT_EQ(s.scan.elevations, (std::vector<double>{0.1, -0.2, 0}));
+  EXPECT_FALSE(s.planar());
+  EXPECT_EQ(s.topic, "points");
+  EXPECT_EQ(s.sweep, laser_raycast::Sweep::kRotating);
+  EXPECT_EQ(s.scan_time, 0.05);
+  EXPECT_TRUE(s.organized);
+  EXPECT_EQ(s.scan.output.range_bias, -0.02);
+  EXPECT_EQ(s.scan.output.range_resolution, 0.002);
+  EXPECT_EQ(s.scan.output.dropout_probability, 0.1);
+  // 360 beams from -pi to pi: 2 pi / 359 apart; the head turns 2 pi in 0.05 s.
+  EXPECT_NEAR(s.timeIncrement(), 0.05 / 359, 1e-15);
+  EXPECT_NEAR(s.sweepDuration(), 0.05, 1e-15);
+}
+
+TEST(SensorParams, ARotatingScanTurnsOncePerScanTimeOrPeriod) {
+  const Parsed parsed = parse(values({{"sweep", "rotating"}, {"rate", 20}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.params.sensors.at(0).scanTime(), 0.05);  // 1 / rate
+  expectRefused(values({{"sweep", "rotating"}, {"rate", 10}, {"scan_time", 0.2}}),
+                {"~scan_time", "(0, 0.1] s", "got 0.2"});
+  expectRefused(values({{"sweep", "rotating"}, {"scan_time", 0}}), {"~scan_time", "got 0"});
+  expectRefused(values({{"sweep", "spinning"}}),
+                {"~sweep", "'spinning' is not one of instant, rotating"});
+  const Parsed instant = parse(values({{"scan_time", 0.05}}));
+  ASSERT_EQ(instant.report.warnings.size(), 1u);
+  expectMentions(instant.report.warnings[0], {"~scan_time", "no effect", "instant"});
+  const Parsed organized = parse(values({{"organized", true}}));
+  ASSERT_EQ(organized.report.warnings.size(), 1u);
+  expectMentions(organized.report.warnings[0], {"~organized", "planar"});
+}
+
+TEST(SensorParams, BadElevationsNameTheParameterAndTheValue) {
+  expectRefused(values({{"elevations", list({})}}), {"~elevations", "must not be empty"});
+  expectRefused(values({{"elevations", list({0.1, kNan})}}), {"~elevations[1]", "got nan"});
+  expectRefused(values({{"elevations", list({0.1, kInf})}}), {"~elevations[1]", "got inf"});
+  expectRefused(values({{"elevations", list({0.1, "up"})}}), {"~elevations[1]", "'up'"});
+  expectRefused(values({{"elevations", 0.1}}), {"~elevations", "a list of numbers"});
+  // Checked by the core: within [-pi/2, pi/2], distinct.
+  expectRefused(values({{"elevations", list({2.0})}}), {"elevations", "2"});
+  expectRefused(values({{"elevations", list({0.1, 0.1})}}), {"elevations", "0.1"});
+}
+
+// The VLP-16's datasheet: 16 rings every 2 deg from -15 to +15, 0.2 deg at 10 Hz, up to 100 m.
+TEST(SensorParams, APresetSetsThePatternRangesAndRateAndExplicitValuesWin) {
+  Parsed parsed = parse(values({{"sensor_model", "VLP-16"}}));
+  ASSERT_EQ(parsed.error, "");
+  const laser_raycast::SensorParams& s = parsed.params.sensors.at(0);
+  ASSERT_EQ(s.scan.elevations.size(), 16u);
+  EXPECT_NEAR(s.scan.elevations.front(), -15 * M_PI / 180, 1e-12);
+  EXPECT_NEAR(s.scan.elevations.back(), 15 * M_PI / 180, 1e-12);
+  EXPECT_NEAR(s.scan.fan.increment(), 0.2 * M_PI / 180, 1e-12);
+  EXPECT_EQ(s.scan.fan.beamCount(), 1800);
+  EXPECT_EQ(s.scan.output.range_max, 100.0);
+  EXPECT_EQ(s.rate, 10.0);
+  EXPECT_EQ(s.topic, "points");
+
+  parsed = parse(
+      values({{"sensor_model", "VLP-16"}, {"range_max", 50}, {"rate", 20}, {"samples", 900}}));
+  ASSERT_EQ(parsed.error, "");
+  const laser_raycast::SensorParams& t = parsed.params.sensors.at(0);
+  EXPECT_EQ(t.scan.output.range_max, 50.0);
+  EXPECT_EQ(t.scan.output.range_min, 0.4);  // the preset's
+  EXPECT_EQ(t.rate, 20.0);
+  EXPECT_EQ(t.scan.fan.samples, 900);
+  EXPECT_EQ(t.scan.fan.angle_increment, 0.0);
+  EXPECT_EQ(t.scan.elevations.size(), 16u);
+
+  // A planar preset keeps the LaserScan.
+  parsed = parse(values({{"sensor_model", "LDS-01"}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_TRUE(parsed.params.sensors.at(0).planar());
+  EXPECT_EQ(parsed.params.sensors.at(0).scan.fan.beamCount(), 360);
+  EXPECT_EQ(parsed.params.sensors.at(0).scan.output.range_max, 3.5);
+}
+
+TEST(SensorParams, AnUnknownPresetNamesTheChoices) {
+  expectRefused(values({{"sensor_model", "VLP-15"}}),
+                {"~sensor_model", "'VLP-15' is not one of", "VLP-16", "LDS-01"});
+}
+
+XmlRpcValue sensor(const std::vector<std::pair<std::string, XmlRpcValue>>& entries) {
+  return values(entries);
+}
+
+// The private namespace's sensor parameters are every entry's defaults; an entry's own preset and
+// keys override them.
+TEST(SensorParams, SeveralSensors) {
+  const Parsed parsed =
+      parse(values({{"noise_stddev", 0.01},
+                    {"rate", 20},
+                    {"sensors", list({sensor({{"frame_id", "front"}, {"samples", 100}}),
+                                      sensor({{"name", "top"},
+                                              {"frame_id", "velodyne"},
+                                              {"sensor_model", "VLP-16"},
+                                              {"topic", "velodyne_points"}})})}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_TRUE(parsed.report.warnings.empty()) << parsed.report.warnings.front();
+  ASSERT_EQ(parsed.params.sensors.size(), 2u);
+  const laser_raycast::SensorParams& front = parsed.params.sensors[0];
+  EXPECT_EQ(front.name, "front");
+  EXPECT_EQ(front.frame_id, "front");
+  EXPECT_EQ(front.topic, "front/scan");
+  EXPECT_EQ(front.labelsTopic(), "front/scan_labels");
+  EXPECT_EQ(front.scan.fan.samples, 100);
+  EXPECT_EQ(front.rate, 20.0);
+  EXPECT_EQ(front.scan.output.noise_stddev, 0.01);
+  const laser_raycast::SensorParams& top = parsed.params.sensors[1];
+  EXPECT_EQ(top.name, "top");
+  EXPECT_EQ(top.topic, "velodyne_points");
+  EXPECT_EQ(top.rate, 10.0);  // the entry's preset over the namespace's rate
+  EXPECT_EQ(top.scan.elevations.size(), 16u);
+  EXPECT_EQ(top.scan.output.noise_stddev, 0.01);
+  const auto& log = parsed.report.values;
+  EXPECT_NE(std::find(log.begin(), log.end(), "~sensors[1]/sensor_model = 'VLP-16'"), log.end());
+}
+
+TEST(SensorParams, BadSensorsEntriesNameTheEntry) {
+  const auto two = [](const XmlRpcValue& second) {
+    return values({{"sensors", list({sensor({{"frame_id", "a"}}), second})}});
+  };
+  expectRefused(two(sensor({{"samples", 10}})), {"~sensors[1]/frame_id", "not set"});
+  expectRefused(two(sensor({{"frame_id", "b"}, {"topic", "a/scan"}})),
+                {"~sensors[1]/topic", "'a/scan'", "~sensors[0]"});
+  expectRefused(two(sensor({{"frame_id", "b"}, {"topic", "a/scan_labels"}})),
+                {"~sensors[1]/topic", "'a/scan_labels'", "~sensors[0]"});
+  expectRefused(two(sensor({{"frame_id", "b"}, {"name", "a"}})),
+                {"~sensors[1]/name", "'a'", "~sensors[0]"});
+  expectRefused(two(sensor({{"frame_id", "b"}, {"rate", -1}})), {"~sensors[1]/rate", "got -1"});
+  expectRefused(two(sensor({{"frame_id", "b"}, {"sensor_model", "X"}})),
+                {"~sensors[1]/sensor_model", "'X'"});
+  expectRefused(two(sensor({{"frame_id", "b"}, {"elevations", list({})}})),
+                {"~sensors[1]/elevations", "empty"});
+  expectRefused(two(sensor({{"frame_id", "b"}, {"range_min", 5}, {"range_max", 1}})),
+                {"in ~sensors[1]", "range_max", "1"});
+  expectRefused(two(sensor({{"frame_id", "b"}, {"name", "b/c"}})), {"~sensors[1]/name", "'b/c'"});
+  expectRefused(two(XmlRpcValue("b")), {"~sensors[1]", "'b'", "a dict"});
+  expectRefused(values({{"sensors", list({})}}), {"~sensors", "non-empty list"});
+  expectRefused(values({{"sensors", "front"}}), {"~sensors", "non-empty list"});
+}
+
+TEST(SensorParams, SensorsEntriesWarnAboutUnknownKeysButNotTheirLiveParameters) {
+  const Parsed parsed =
+      parse(values({{"sensors", list({sensor({{"frame_id", "a"}, {"sampels", 5}})})},
+                    {"a", values({{"rate", 10}})}}));
+  ASSERT_EQ(parsed.error, "");
+  ASSERT_EQ(parsed.report.warnings.size(), 1u) << parsed.report.warnings.back();
+  expectMentions(parsed.report.warnings[0], {"~sensors[0]/sampels", "not a sensor parameter"});
+}
+
+}  // namespace
+}  // namespace laser_raycast_test
