@@ -43,11 +43,6 @@ PoseTopic::PoseTopic(ros::NodeHandle& nh, const std::string& topic, std::string 
   sub_ = nh.subscribe(topic, kQueue, &PoseTopic::onPose, this);
 }
 
-void PoseTopic::setTimeout(ros::Duration timeout) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  timeout_ = timeout;
-}
-
 void PoseTopic::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
   const std::string& type = msg->getDataType();
   std_msgs::Header header;

@@ -28,7 +28,6 @@ class PoseTopic {
   bool poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose, std::string* why);
 
   std::string topic() const { return sub_.getTopic(); }
-  void setTimeout(ros::Duration timeout);
 
  private:
   void onPose(const topic_tools::ShapeShifter::ConstPtr& msg);
@@ -46,7 +45,7 @@ class PoseTopic {
   std::string fixed_frame_;
   ros::Subscriber sub_;
   std::mutex mutex_;  // the history is filled by the subscriber, read by the cast thread
-  ros::Duration timeout_;
+  const ros::Duration timeout_;
   PoseHistory history_;
   ros::WallTime last_type_error_;
 };
