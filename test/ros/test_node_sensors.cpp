@@ -207,6 +207,7 @@ TEST(NodeSensors, ARotatingScannerMovingAwayFromAWall) {
   const double first = rangeOf(*scan, 0), last = rangeOf(*scan, 720);
   std::cout << "rotating scanner at 1 m/s: the wall behind is " << first << " m away in the first "
             << "beam, " << last << " m in the last: " << last - first << " m apart\n";
+  RecordProperty("rotating_last_minus_first_beam_m", std::to_string(last - first));
   EXPECT_NEAR(last - first, kSpeed * 720 * dt, 0.005);
   // And every beam on that wall, each at its own time.
   int on_wall = 0;
