@@ -17,8 +17,6 @@ namespace core {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// More threads than this is a mistake, not a machine.
-constexpr int kMaxThreads = 1024;
 
 // A cast is split between threads only if each gets at least this many beams: a 2D fan of a few
 // thousand beams is cast in tens of microseconds, about what handing work to another thread costs.
@@ -41,8 +39,9 @@ void CastConfig::validate() const {
     msg << "tmin must be finite and >= 0, got " << tmin;
   } else if (!(tmax > tmin)) {
     msg << "tmax (" << tmax << " m) must be greater than tmin (" << tmin << " m)";
-  } else if (threads < 0 || threads > kMaxThreads) {
-    msg << "threads must be in [0, " << kMaxThreads << "] (0: every core), got " << threads;
+  } else if (threads < 0 || threads > CastConfig::kMaxThreads) {
+    msg << "threads must be in [0, " << CastConfig::kMaxThreads << "] (0: every core), got "
+        << threads;
   } else {
     return;
   }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "laser_raycast/core/caster.h"
 #include "param_reader.h"
 #include "sensor_params.h"
 
@@ -72,6 +73,15 @@ void readTfTimeout(ParamReader* r, NodeParams* p) {
         p->tf_timeout <= NodeParams::kMaxTfTimeout)) {
     r->fail("tf_timeout", "must be in [0, " + formatNumber(NodeParams::kMaxTfTimeout) +
                               "] s, got " + formatNumber(p->tf_timeout));
+  }
+}
+
+// ~threads: what core::CastConfig::threads accepts.
+void readThreads(ParamReader* r, NodeParams* p) {
+  p->threads = r->integer("threads", p->threads, "");
+  if (p->threads < 0 || p->threads > core::CastConfig::kMaxThreads) {
+    r->fail("threads", "must be in [0, " + std::to_string(core::CastConfig::kMaxThreads) +
+                           "] (0: every core), got " + std::to_string(p->threads));
   }
 }
 
@@ -231,6 +241,7 @@ void readAll(ParamReader* r, NodeParams* p, std::vector<std::string>* warnings) 
   p->fixed_frame = r->text("fixed_frame", p->fixed_frame);
   checkFrame(r, "fixed_frame", p->fixed_frame, false);
   readTfTimeout(r, p);
+  readThreads(r, p);
   readScene(r, p);
   readReflectivity(r, p);
   readSensors(r, p, warnings);

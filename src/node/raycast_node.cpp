@@ -40,7 +40,7 @@ bool RaycastNode::init() {
   for (const SensorParams& s : params_.sensors) {
     const double pose_history = history + std::min(s.pose_timeout, NodeParams::kMaxTfTimeout);
     sensors_.push_back(std::make_unique<Sensor>(nh_, s, params_.fixed_frame, kTfGracePeriod,
-                                                ros::Duration(pose_history)));
+                                                ros::Duration(pose_history), params_.threads));
   }
   CastThread::Context context;
   context.scene = &scene_;

@@ -18,15 +18,17 @@
 namespace laser_raycast {
 
 Sensor::Sensor(ros::NodeHandle& nh, const SensorParams& params, const std::string& fixed_frame,
-               double grace_period, ros::Duration history)
+               double grace_period, ros::Duration history, int threads)
     : name_(params.name),
       fixed_frame_(fixed_frame),
       params_(params),
       cast_params_(params),
       pattern_(params.scan.pattern()),
       cast_config_(params.scan.castConfig()),
+      threads_(threads),
       encoder_(params.scan.output),
       monitor_(params.name, nh.resolveName(params.topic), grace_period) {
+  cast_config_.threads = threads_;
   if (params.planar()) {
     scan_pub_ = nh.advertise<sensor_msgs::LaserScan>(params.topic, kPublishQueue);
   } else {
@@ -101,6 +103,7 @@ void Sensor::applyLive() {
   if (!pending_) return;
   cast_params_ = params_;
   cast_config_ = cast_params_.scan.castConfig();
+  cast_config_.threads = threads_;
   encoder_.setConfig(cast_params_.scan.output);
   if (cast_params_.sweep == Sweep::kRotating) {
     column_times_ = rotatingColumnTimes(pattern_.azimuthCount(), cast_params_.timeIncrement());

@@ -38,9 +38,9 @@ class Sensor {
     double rate = 10.0;          // Hz
   };
 
-  // history: how long pose topic messages are kept (s).
+  // history: how long pose topic messages are kept (s); threads: per cast (CastConfig::threads).
   Sensor(ros::NodeHandle& nh, const SensorParams& params, const std::string& fixed_frame,
-         double grace_period, ros::Duration history);
+         double grace_period, ros::Duration history, int threads);
 
   const std::string& name() const { return name_; }
   // The TF chain its pose needs, as (target, source): fixed_frame <- frame_id, or, with a pose
@@ -90,6 +90,7 @@ class Sensor {
   SensorParams cast_params_;
   core::ScanPattern pattern_;
   core::CastConfig cast_config_;
+  const int threads_;  // ~threads (node-wide), for every cast
   core::Caster caster_;
   core::ScanEncoder encoder_;
   core::EncodedScan encoded_;

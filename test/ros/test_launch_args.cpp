@@ -76,6 +76,7 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
             laser_raycast::core::MinRangePolicy::kPassThrough);
   EXPECT_EQ(p.sensors.at(0).rate, 5.0);
   EXPECT_EQ(p.tf_timeout, 0.25);
+  EXPECT_EQ(p.threads, 2);
   ASSERT_EQ(p.models.size(), 2u);
   EXPECT_EQ(p.models[0].param, "scene_description");
   EXPECT_EQ(p.models[0].tf_prefix, "s/");

@@ -49,6 +49,7 @@ const std::vector<std::string> kReadmeParameters = {"frame_id",
                                                     "min_range_policy",
                                                     "rate",
                                                     "tf_timeout",
+                                                    "threads",
                                                     "models",
                                                     "geometry",
                                                     "ignore_links",
@@ -106,6 +107,7 @@ TEST(NodeParams, EveryDefault) {
     EXPECT_EQ(p.sensors.at(0).scan.elevations, std::vector<double>{0.0});
     EXPECT_EQ(p.sensors.at(0).rate, 10.0);
     EXPECT_EQ(p.tf_timeout, 0.5);
+    EXPECT_EQ(p.threads, 1);
     EXPECT_EQ(p.sensors.at(0).pose_timeout, 0.5);
     ASSERT_EQ(p.sensors.size(), 1u);
     const laser_raycast::SensorParams& s = p.sensors[0];
@@ -171,6 +173,7 @@ TEST(NodeParams, EveryValueReachesItsField) {
                                       {"min_range_policy", "pass_through"},
                                       {"rate", 5.5},
                                       {"tf_timeout", 0},
+                                      {"threads", 2},
                                       {"models", models},
                                       {"geometry", "collision"},
                                       {"ignore_links", list({"base_scan", "w/wall"})},
@@ -200,6 +203,7 @@ TEST(NodeParams, EveryValueReachesItsField) {
             laser_raycast::core::MinRangePolicy::kPassThrough);
   EXPECT_EQ(p.sensors.at(0).rate, 5.5);
   EXPECT_EQ(p.tf_timeout, 0.0);
+  EXPECT_EQ(p.threads, 2);
   ASSERT_EQ(p.models.size(), 3u);
   EXPECT_EQ(p.models[0].param, "robot_description");
   EXPECT_EQ(p.models[1].file, "package://pkg/world.urdf");
@@ -259,6 +263,8 @@ TEST(NodeParams, OutOfRangeValuesNameTheParameterAndTheValue) {
       {"tf_timeout", -0.1, {"~tf_timeout", "[0, 10] s", "got -0.1"}},
       {"tf_timeout", 10.5, {"~tf_timeout", "got 10.5"}},
       {"tf_timeout", kNan, {"~tf_timeout", "got nan"}},
+      {"threads", -1, {"~threads", "[0, 1024]", "got -1"}},
+      {"threads", 1025, {"~threads", "got 1025"}},
       {"noise_seed", -1, {"~noise_seed", "got -1"}},
       {"pose_timeout", 0.0, {"~pose_timeout", "> 0 s", "got 0"}},
       {"pose_timeout", -1, {"~pose_timeout", "got -1"}},
@@ -284,6 +290,8 @@ TEST(NodeParams, TheLimitsThemselvesAreAccepted) {
   expectAccepted(values({{"rate", NodeParams::kMaxRate}}));
   expectAccepted(values({{"tf_timeout", NodeParams::kMaxTfTimeout}}));
   expectAccepted(values({{"tf_timeout", 0}}));
+  expectAccepted(values({{"threads", 0}}));  // every core
+  expectAccepted(values({{"threads", laser_raycast::core::CastConfig::kMaxThreads}}));
   expectAccepted(values({{"pose_timeout", kInf}}));  // never stale
   expectAccepted(values({{"samples", 2}}));
   expectAccepted(values({{"noise_seed", 0}, {"default_reflectivity", 0}}));

@@ -30,6 +30,7 @@ struct CastConfig {
   // Threads a cast uses (the calling one included); 0: every core. The beams are split between
   // them; the result is the same, bit for bit, for any number.
   int threads = 1;
+  static constexpr int kMaxThreads = 1024;  // more is a mistake, not a machine
   // Skip bodies and BVH nodes that every beam able to reach them has already passed (a nearer
   // hit). Never changes the result; off only to test that.
   bool occlusion_culling = true;

@@ -98,6 +98,9 @@ struct NodeParams {
   // than this is not waited for (its link is left out, or without the sensor's the scan is
   // skipped). TF 0.1 to 0.3 s late (a loaded tree, a bag, a slow link) is served at full rate.
   double tf_timeout = 0.5;
+  // Threads each cast uses (core::CastConfig::threads; 0: every core). The ranges do not depend on
+  // it; a large 3D scan is cast faster, a 2D fan stays on one thread.
+  int threads = 1;
   GeometrySource geometry = GeometrySource::kVisual;
   bool skip_bad_geometry = false;
   std::vector<ModelSource> models = {ModelSource{"robot_description", "", ""}};
