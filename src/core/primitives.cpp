@@ -11,6 +11,7 @@ namespace core {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kMaxFinite = std::numeric_limits<double>::max();
 
 // The two roots of a t^2 + 2 b t + c = 0, given the discriminant b^2 - a c. It is passed in because
 // the callers compute it without cancellation (see sphere and cylinder). Returns false if there is
@@ -37,12 +38,14 @@ void requirePositive(const char* what, double value) {
   }
 }
 
-// Keeps the nearest accepted candidate.
+// Keeps the nearest accepted candidate: t in [tmin, tmax] and finite. A distance that overflowed
+// to +-Inf (a tiny direction, a far or huge primitive) is no hit, even with tmax = +Inf.
 struct Nearest {
   double tmin, tmax;
   std::optional<PrimitiveHit> hit;
   void offer(double t, const Eigen::Vector3d& normal) {
-    if (t >= tmin && t <= tmax && (!hit || t < hit->t)) hit = PrimitiveHit{t, normal};
+    const bool accepted = t >= tmin && t <= tmax && std::abs(t) <= kMaxFinite;
+    if (accepted && (!hit || t < hit->t)) hit = PrimitiveHit{t, normal};
   }
 };
 

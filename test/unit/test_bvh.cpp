@@ -457,6 +457,56 @@ TEST(Bvh, TmaxAtHitRegression) {
   EXPECT_TRUE(bvh.anyHit<TriangleMethod::kWatertight>(ray));
 }
 
+// Every interval the API accepts, against brute force: tmin negative (down to -inf) so that the
+// ray reaches behind its origin, tmin and tmax exactly 0 with the origin on a triangle (a hit at
+// t = 0), tmax = +inf (the Ray default), empty and inverted intervals, -0.0.
+TEST(Bvh, MatchesBruteForceForEveryInterval) {
+  const ExemptionBudget budget;
+  Rng rng(4711);
+  for (const int n : {1, 10, 300}) {
+    for (const bool clustered : {false, true}) {
+      const Soup s = clustered ? clusteredSoup(rng, n) : spreadSoup(rng, n);
+      const Bvh bvh = Bvh::build(s.vertices, s.triangles);
+      const BvhF bvhf = BvhF::build(s.vertices, s.triangles);
+      for (int i = 0; i < 200; ++i) {
+        Ray ray = randomRay(rng, s.bounds(), s);
+        if (i % 2 == 0) {
+          // From a point on a triangle (its barycentric combination, rounded): hits at t = 0 or
+          // within rounding of it, on either side.
+          const auto& tri = s.triangles[std::uniform_int_distribution<std::size_t>(
+              0, s.triangles.size() - 1)(rng)];
+          const Eigen::Vector2d uv = randomBarycentrics(rng);
+          ray.origin = (1 - uv.x() - uv.y()) * s.vertices[tri[0]] + uv.x() * s.vertices[tri[1]] +
+                       uv.y() * s.vertices[tri[2]];
+          ray.dir = randomUnitVector(rng);
+        }
+        const double reach = 2 * s.bounds().extent().norm() / ray.dir.norm();
+        const double kIntervals[][2] = {{-kInf, kInf},
+                                        {-reach, kInf},
+                                        {-uniform(rng, 0, reach), 0.0},
+                                        {0.0, 0.0},
+                                        {-0.0, 0.0},
+                                        {0.0, kInf},
+                                        {-0.0, kInf},
+                                        {-kInf, 0.0},
+                                        {-kInf, -uniform(rng, 0, reach)},
+                                        {-reach, -0.5 * reach},
+                                        {-uniform(rng, 0, reach), uniform(rng, 0, reach)},
+                                        {0.0, -0.0},
+                                        {1.0, -1.0},
+                                        {kInf, kInf}};
+        for (const auto& interval : kIntervals) {
+          ray.tmin = interval[0];
+          ray.tmax = interval[1];
+          SCOPED_TRACE(testing::Message() << "n " << n << (clustered ? " clustered" : " spread"));
+          checkRayBothPrecisions(bvh, bvhf, s, ray);
+          if (HasFatalFailure()) return;
+        }
+      }
+    }
+  }
+}
+
 // Literal tmin/tmax cases on one wall at x = 3 (t is a distance: unit direction).
 TEST(Bvh, TminTmaxLimits) {
   Soup s;
@@ -482,6 +532,25 @@ TEST(Bvh, TminTmaxLimits) {
       EXPECT_EQ(t(3.001, kInf), 5.0) << toString(M);  // the nearer wall is before tmin
       EXPECT_EQ(t(5.001, kInf), kInf) << toString(M);
       EXPECT_EQ(t(3.5, 4.5), kInf) << toString(M);  // between the walls
+    });
+  }
+}
+
+// A hit is finite through the BVH too: a wall 1e300 away along a direction of length 1e-10 lies at
+// t = 1e310, beyond the largest double. Every method used to report t = +Inf with tmax = +Inf.
+TEST(Bvh, HitBeyondTheLargestFiniteTIsNoHitRegression) {
+  Soup s;
+  s.add(Eigen::Vector3d(1e300, -1, -1), Eigen::Vector3d(1e300, 1, -1),
+        Eigen::Vector3d(1e300, 0, 2));
+  const Bvh bvh = Bvh::build(s.vertices, s.triangles);
+  Ray ray;
+  ray.dir = Eigen::Vector3d(1e-10, 0, 0);
+  for (const TriangleMethod method : kAllTriangleMethods) {
+    dispatchTriangleMethod(method, [&](auto m) {
+      constexpr TriangleMethod M = decltype(m)::value;
+      EXPECT_FALSE(bvh.closestHit<M>(ray)) << toString(M);
+      EXPECT_FALSE(bvh.anyHit<M>(ray)) << toString(M);
+      EXPECT_FALSE(bruteForceClosestHit(M, s.vertices, s.triangles, ray)) << toString(M);
     });
   }
 }

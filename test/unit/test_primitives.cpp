@@ -130,15 +130,39 @@ TEST(BoxIntersect, CornerHitHasOneOfTheTouchingFacesNormals) {
 // Regression: the entry and exit axes started at -1 and were set only by a strictly larger entry
 // (smaller exit) than +-inf. When every slab distance overflows (a tiny direction in a huge box),
 // neither was set and the normal was written at index -1, out of bounds. The true distance here,
-// 5e349, rounds to +inf, where the ray leaves through +x.
+// 5e349, rounds to +inf: no hit (a hit is finite; see the next test), but nothing out of bounds on
+// the way (the sanitizer build checks). A direction 1e100 times longer reaches the +x face at
+// 5e249.
 TEST(BoxIntersect, OverflowingSlabDistancesRegression) {
   const Box huge{Vector3d(1e200, 1e200, 1e200)};
-  const auto hit = intersect(makeRay({0, 0, 0}, {1e-150, 0, 0}), huge);
-  ASSERT_TRUE(hit);
-  EXPECT_EQ(hit->t, kInf);
-  EXPECT_EQ(hit->normal, Vector3d(1, 0, 0));
-  // With a finite far limit there is nothing to hit.
+  EXPECT_FALSE(intersect(makeRay({0, 0, 0}, {1e-150, 0, 0}), huge));
   EXPECT_FALSE(intersect(makeRay({0, 0, 0}, {1e-150, 0, 0}, 0, 1e300), huge));
+  const auto hit = intersect(makeRay({0, 0, 0}, {1e-50, 0, 0}), huge);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 5e249, 5e249 * 1e-15);
+  EXPECT_EQ(hit->normal, Vector3d(1, 0, 0));
+}
+
+// Regression: a hit is always finite. With a direction so short that the true distance exceeds
+// the largest double (1e310 here), every primitive computed t = +Inf and, with tmax = +Inf (the
+// Ray default), reported it as a hit. From the inside (the exit surface) and from outside (the
+// entry).
+TEST(PrimitiveContracts, HitBeyondTheLargestFiniteTIsNoHitRegression) {
+  const Vector3d tiny_x(1e-160, 0, 0), tiny_z(0, 0, 1e-120);
+  // From the centre of a sphere and a cylinder of radius 1e150: exit at 1e150 / 1e-160.
+  EXPECT_FALSE(intersect(makeRay({0, 0, 0}, tiny_x), Sphere{1e150}));
+  EXPECT_FALSE(intersect(makeRay({0, 0, 0}, tiny_x), Cylinder{1e150, 2}));
+  EXPECT_FALSE(intersect(makeRay({0, 0, 0}, tiny_x), Box{Vector3d(2e150, 2, 2)}));
+  // From 1e200 below a unit box and cylinder, along z: entry at (1e200 - 1) / 1e-120.
+  EXPECT_FALSE(intersect(makeRay({0, 0, -1e200}, tiny_z), kBox));
+  EXPECT_FALSE(intersect(makeRay({0, 0, -1e200}, tiny_z), Cylinder{1, 2}));
+  // The same shapes within reach are hit, at finite distances.
+  const auto sphere = intersect(makeRay({0, 0, 0}, {1e-150, 0, 0}), Sphere{1e140});
+  ASSERT_TRUE(sphere);
+  EXPECT_NEAR(sphere->t, 1e290, 1e290 * 1e-12);
+  const auto cylinder = intersect(makeRay({0, 0, -1e100}, tiny_z), Cylinder{1, 2});
+  ASSERT_TRUE(cylinder);
+  EXPECT_NEAR(cylinder->t, 1e220, 1e220 * 1e-12);
 }
 
 // Enters at t = 4 and leaves at t = 6 (both exact).

@@ -644,6 +644,36 @@ TYPED_TEST(TriangleLiteral, WatertightInfiniteDirectionRegression) {
   }
 }
 
+// Regression: a hit is always finite. A triangle 1e300 (1e30 in float) away along a direction of
+// length 1e-10 lies at t = 1e310 (1e40), beyond the largest finite value: every method computed
+// t = +Inf, and with tmax = +Inf (the Ray default) reported it as a hit. The true t cannot be
+// represented, so there is no hit to report; with the triangle near, the same ray still hits.
+TYPED_TEST(TriangleLiteral, HitBeyondTheLargestFiniteTIsNoHitRegression) {
+  using T = TypeParam;
+  const double far = std::is_same<T, float>::value ? 1e30 : 1e300;
+  const Vector3d dir(1e-10, 0, 0);
+  for (const double x : {far, -far}) {
+    const Vector3d a(x, -1, -1), b(x, 1, -1), c(x, 0, 2);
+    const Vector3d origin(0, 0, 0);
+    const RayT<T> ray = makeRay<T>(origin, x > 0 ? dir : Vector3d(-dir), 0, kInf);
+    for (const TriangleMethod m : kAllTriangleMethods) {
+      for (const bool cull : {false, true}) {
+        const auto hit = hitTriangle<T>(m, ray, a, b, c, cull);
+        EXPECT_FALSE(hit) << toString(m) << " cull " << cull << " x " << x
+                          << ": t = " << (hit ? double(hit->t) : 0.0);
+      }
+      // The reverse winding, which the cull flag treats as the front face.
+      const auto reversed = hitTriangle<T>(m, ray, a, c, b, true);
+      EXPECT_FALSE(reversed) << toString(m) << " reversed, x " << x;
+      // Nearer, the same ray hits (t = 1e10 exactly representable in double; checked in range).
+      const Vector3d near_a(1, -1, -1), near_b(1, 1, -1), near_c(1, 0, 2);
+      const auto near = hitTriangle<T>(m, makeRay<T>(origin, dir), near_a, near_b, near_c);
+      ASSERT_TRUE(near) << toString(m);
+      EXPECT_NEAR(double(near->t), 1e10, 1e10 * Tolerance<T>::kT) << toString(m);
+    }
+  }
+}
+
 // The ray-plane worked example of docs/design.md §6.4: plane [1 0 0 -7], R0 = [2 3 4],
 // Rd = [0.577 0.577 0.577] give Vd = 0.577, V0 = 5, t = 8.66 and Pi = [7 8 9]; "Vd > 0: the plane
 // points away from the ray", so the ray-facing normal is [-1 0 0]. (Its source says "x = -7";

@@ -23,8 +23,9 @@ struct Sphere {
   double radius;  // m
 };
 
-// The first surface crossing with t in [ray.tmin, ray.tmax]. Surfaces are surfaces: a ray that
-// starts inside a primitive hits it from the inside, on the way out.
+// The first surface crossing with a finite t in [ray.tmin, ray.tmax] (a t that overflows is no
+// hit). Surfaces are surfaces: a ray that starts inside a primitive hits it from the inside, on
+// the way out.
 struct PrimitiveHit {
   double t;
   Eigen::Vector3d normal;  // outward unit normal at the hit, in the primitive's frame

@@ -3,8 +3,8 @@
 // formulas and sources are in docs/design.md §6, the watertight test's reasoning in §4.3.
 //
 // Conventions shared by every method, so that they are interchangeable:
-// - A hit has t in [ray.tmin, tmax] (inclusive) and barycentrics u, v: the weights of b and c, so
-//   the hit point is (1 - u - v) a + u b + v c.
+// - A hit has a finite t in [ray.tmin, tmax] (inclusive) and barycentrics u, v: the weights of b
+//   and c, so the hit point is (1 - u - v) a + u b + v c. A t that overflows is no hit.
 // - Edges and vertices: the reference methods count a point on an edge or vertex as inside (>= 0
 //   tests), so a ray through a shared edge hits both triangles, or, after rounding, neither. The
 //   watertight method gives each shared edge and vertex to exactly one of the triangles around it.
@@ -116,6 +116,14 @@ inline bool ownsBoundary(T dx, T dy) {
   return dy > 0 || (dy == 0 && dx > 0);
 }
 
+// Whether a computed t is a hit: in [tmin, tmax] (inclusive) and finite. A t that overflowed to
+// +-Inf (a far triangle along a short direction: the true t exceeds the largest finite value) is
+// no hit, even when tmax is +Inf, the Ray default. Written so that NaN fails.
+template <typename T>
+inline bool acceptsT(T t, T tmin, T tmax) {
+  return t >= tmin && t <= tmax && std::abs(t) <= std::numeric_limits<T>::max();
+}
+
 }  // namespace detail
 
 // A ray prepared for testing many triangles with one method. intersect() takes the current far
@@ -142,7 +150,7 @@ class PreparedRay<T, TriangleMethod::kSeedPlane> {
     if (!(denom != 0)) return std::nullopt;
     if (cull_ && denom > 0) return std::nullopt;
     const T t = -(n.dot(ray_.origin) + h_w) / denom;  // -H.[V,1] / H.[W,0]
-    if (!(t >= ray_.tmin && t <= tmax)) return std::nullopt;
+    if (!detail::acceptsT(t, ray_.tmin, tmax)) return std::nullopt;
     const Vec3<T> p = ray_.origin + t * ray_.dir;
     const Vec3<T> pa = n.cross(c - b);
     const Vec3<T> pb = n.cross(a - c);
@@ -181,7 +189,7 @@ class PreparedRay<T, TriangleMethod::kSeedUv> {
     // This normal is AC x AB, the opposite of our front normal, so a back face has n.r < 0.
     if (cull_ && n_dot_r < 0) return std::nullopt;
     const T t = n.dot(a - ray_.origin) / n_dot_r;
-    if (!(t >= ray_.tmin && t <= tmax)) return std::nullopt;
+    if (!detail::acceptsT(t, ray_.tmin, tmax)) return std::nullopt;
     const Vec3<T> as = ray_.origin + t * ray_.dir - a;
     const T ab_as = ab.dot(as);
     const T ac_ac = ac.dot(ac);
@@ -226,7 +234,7 @@ class PreparedRay<T, TriangleMethod::kCramer> {
     const T gamma = ray_.dir.dot(e1_x_r) / m;  // det[e1 r d]
     const T t = -e2.dot(e1_x_r) / m;           // det[e1 e2 r]
     if (!(beta >= 0 && gamma >= 0 && beta + gamma <= 1)) return std::nullopt;
-    if (!(t >= ray_.tmin && t <= tmax)) return std::nullopt;
+    if (!detail::acceptsT(t, ray_.tmin, tmax)) return std::nullopt;
     return TriangleHitT<T>{t, beta, gamma};
   }
 
@@ -258,7 +266,7 @@ class PreparedRay<T, TriangleMethod::kMollerTrumbore> {
     const T v = ray_.dir.dot(q) * inv_det;
     if (!(v >= 0 && u + v <= 1)) return std::nullopt;
     const T t = e2.dot(q) * inv_det;
-    if (!(t >= ray_.tmin && t <= tmax)) return std::nullopt;
+    if (!detail::acceptsT(t, ray_.tmin, tmax)) return std::nullopt;
     return TriangleHitT<T>{t, u, v};
   }
 
@@ -344,11 +352,11 @@ class PreparedRay<T, TriangleMethod::kWatertight> {
     // ray with tmax = +inf accepts t = +inf.
     if (!(std::abs(inv_det) <= std::numeric_limits<T>::max())) {
       const T t = scaled_t / det;
-      if (!(t >= tmin_ && t <= tmax)) return std::nullopt;
+      if (!detail::acceptsT(t, tmin_, tmax)) return std::nullopt;
       return TriangleHitT<T>{t, eb / det, ec / det};
     }
     const T t = scaled_t * inv_det;
-    if (!(t >= tmin_ && t <= tmax)) return std::nullopt;
+    if (!detail::acceptsT(t, tmin_, tmax)) return std::nullopt;
     return TriangleHitT<T>{t, eb * inv_det, ec * inv_det};
   }
 
