@@ -192,9 +192,12 @@ class Builder {
     return static_cast<std::uint32_t>(it - order_.begin());
   }
 
+  // Clamped before the conversion to int, which is undefined for NaN and out-of-range values:
+  // coordinates near the largest double make centroids, extents and so x overflow to Inf or NaN.
   int binIndex(double c, double lo, double scale) const {
-    const int b = static_cast<int>((c - lo) * scale);
-    return std::min(std::max(b, 0), config_.bins - 1);
+    const double x = (c - lo) * scale;
+    if (!(x >= 0)) return 0;
+    return x < config_.bins ? static_cast<int>(x) : config_.bins - 1;
   }
 
   const std::vector<BuildTriangle>& tris_;

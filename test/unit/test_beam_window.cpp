@@ -121,5 +121,27 @@ TEST(BeamWindow, BeamRangesHoldTheWindowAndNothingBeyondRounding) {
   EXPECT_LT(padding, 100);  // only beams exactly at a window's end, within rounding
 }
 
+// Regression (found by test/fuzz/fuzz_core): a fan of 720 beams over 1e-9 rad has an increment of
+// 1.4e-12 rad, and a window's far end divided by it (4.5e12) was converted to int: undefined, and
+// in practice INT_MIN (the sanitizer build stops there). Windows beyond the fan visit nothing;
+// a window holding it visits every beam once.
+TEST(BeamWindow, TinyIncrementRegression) {
+  const ScanPattern fan(fanBySamples(0.5, 0.5 + 1e-9, 720));
+  // How often each beam is visited.
+  const auto visits = [&](double start, double width) {
+    std::vector<int> count(720, 0);
+    forEachBeamRange(fan, start, width, [&](int first, int last) {
+      for (int i = first; i <= last; ++i) ++count.at(i);
+    });
+    return count;
+  };
+  const std::vector<int> none(720, 0), once(720, 1);
+  EXPECT_EQ(visits(1.0, 2.0), none);
+  EXPECT_EQ(visits(3.0, 0.0), none);
+  EXPECT_EQ(visits(0.0, 1e-6), once);
+  EXPECT_EQ(visits(2 * M_PI - 1e-6, 2e-6), once);  // from just before a turn
+  EXPECT_EQ(visits(0.0, 2 * M_PI), once);
+}
+
 }  // namespace
 }  // namespace laser_raycast_test

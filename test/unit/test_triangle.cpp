@@ -674,6 +674,30 @@ TYPED_TEST(TriangleLiteral, HitBeyondTheLargestFiniteTIsNoHitRegression) {
   }
 }
 
+// Regression (found by test/fuzz/fuzz_core): an edge function whose exact value is below the
+// smallest subnormal (here about -1e-460 in double, -1e-50 in float) underflowed to -0, and the
+// watertight test took the ray, which passes outside the triangle, for one exactly on its edge and
+// hit. The triangle lies in x = 0, one edge 1e-160 (1e-20) long, the third vertex 1e300 (1e30)
+// away; the ray is nearly parallel to that plane and crosses it at t = 0, at the origin.
+TYPED_TEST(TriangleLiteral, WatertightEdgeFunctionUnderflowRegression) {
+  using T = TypeParam;
+  const bool is_float = std::is_same<T, float>::value;
+  const double small = is_float ? 1e-20 : 1e-160, large = is_float ? 1e30 : 1e300;
+  const Vector3d a(0, 0, 0), b(0, small, 0), c(0, -4, large),
+      dir(-4, 0, 1.0568661007955367 * large);
+  const auto hit = [&](const Vector3d& origin) {
+    return hitTriangle<T>(TriangleMethod::kWatertight, makeRay<T>(origin, dir, -1, 1), a, b, c);
+  };
+  // Below the triangle (z < 0, and the triangle has z >= 0): the case that hit.
+  EXPECT_FALSE(hit(Vector3d(0, small, -0.5)));
+  // Beside its short edge, on either side.
+  EXPECT_FALSE(hit(Vector3d(0, 1.5 * small, 0.5)));
+  EXPECT_FALSE(hit(Vector3d(0, -0.5 * small, 0.5)));
+  // Inside it, near that edge: a hit. (Its t, 0 in exact arithmetic, is not asserted: every term
+  // of t's numerator underflows here.)
+  EXPECT_TRUE(hit(Vector3d(0, 0.5 * small, 0.5)));
+}
+
 // The ray-plane worked example of docs/design.md §6.4: plane [1 0 0 -7], R0 = [2 3 4],
 // Rd = [0.577 0.577 0.577] give Vd = 0.577, V0 = 5, t = 8.66 and Pi = [7 8 9]; "Vd > 0: the plane
 // points away from the ray", so the ray-facing normal is [-1 0 0]. (Its source says "x = -7";

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #ifdef __SSE2__
@@ -54,23 +55,36 @@ struct SlabRay {
   T tmin, tmax;
 
   explicit SlabRay(const RayT<T>& ray) : origin(ray.origin), tmin(ray.tmin), tmax(ray.tmax) {
+    const T largest = ray.dir.cwiseAbs().maxCoeff();
     for (int k = 0; k < 3; ++k) {
       // Adding +0 turns -0 into +0, so a zero component always gives +inf. With -inf, a ray lying
       // exactly in a box face would get (face - origin) * inv = 0 * -inf paired with a -inf bound
       // and miss the box.
       inv_dir[k] = T(1) / (ray.dir[k] + T(0));
+      // A nonzero component below the smallest normal number times the largest one: the
+      // watertight test's shear (this component over the largest) underflows, so the ray it tests
+      // can differ from this one by more than any widening of t covers (found by
+      // test/fuzz/fuzz_core). NaN makes the slab test ignore this axis (see below): conservative.
+      if (ray.dir[k] != 0 && std::abs(ray.dir[k]) < largest * std::numeric_limits<T>::min()) {
+        inv_dir[k] = std::numeric_limits<T>::quiet_NaN();
+      }
     }
   }
 };
 
 // Conservative slab test (Ize, "Robust BVH Ray Traversal", JCGT 2013): the far distance is enlarged
-// by 1 + 2 * gamma(3) so that rounding never culls a box the exact ray touches. True if the ray
-// meets the box within [ray.tmin, tmax]; *t_entry is then where it enters (clamped to ray.tmin).
+// by 1 + 2 * gamma(3) so that rounding never culls a box the exact ray touches. Ize's ray starts at
+// t = 0; for a box behind the origin (negative tmin) the same bound holds mirrored, with the near
+// distance as the one to enlarge: each end is scaled by 1 + 2 gamma(3) where that moves it away
+// from the box (the far end when positive, the near end when negative), never towards it. True if
+// the ray meets the box within [ray.tmin, tmax]; *t_entry is then where it enters (clamped to
+// ray.tmin).
 //
 // A zero direction component gives inv_dir = +inf. Then (bound - origin) * inv_dir is +-inf when
 // the origin is strictly inside or outside that slab, and NaN when it lies exactly on a face. The
 // comparisons below are ordered so that a NaN never tightens the interval: the ray is then treated
-// as inside that slab, which is the conservative answer for a ray lying in a box face.
+// as inside that slab, which is the conservative answer for a ray lying in a box face (and for an
+// axis SlabRay marks with inv_dir = NaN).
 // The box is given as its corners' coordinates (B may be float for a double ray: the box is then
 // converted exactly).
 template <typename T, typename B>
@@ -87,8 +101,10 @@ inline bool slabTest(const SlabRay<T>& ray, const B* lo, const B* hi, T tmax, T*
     tfar = far_k < tfar ? far_k : tfar;       // NaN never replaces tfar
   }
   // Enlarging the nearest exit equals enlarging each exit (rounding is monotonic), for one
-  // multiply.
-  tfar *= 1 + 2 * roundingGamma<T>(3);
+  // multiply; likewise the farthest entry.
+  constexpr T kEnlarge = 1 + 2 * roundingGamma<T>(3);
+  tfar = tfar * kEnlarge > tfar ? tfar * kEnlarge : tfar;       // positive: moved up
+  tnear = tnear * kEnlarge < tnear ? tnear * kEnlarge : tnear;  // negative: moved down
   tfar = tfar < tmax ? tfar : tmax;
   *t_entry = tnear;
   return tnear <= tfar;
@@ -121,7 +137,9 @@ inline void slabTestPair(const SlabRay<double>& ray, const B (*lo)[3], const B (
     tnear = _mm_max_pd(near_k, tnear);          // near_k > tnear ? near_k : tnear
     tfar = _mm_min_pd(far_k, tfar);             // far_k < tfar ? far_k : tfar
   }
-  tfar = _mm_mul_pd(tfar, _mm_set1_pd(1 + 2 * roundingGamma<double>(3)));
+  const __m128d enlarge = _mm_set1_pd(1 + 2 * roundingGamma<double>(3));
+  tfar = _mm_max_pd(_mm_mul_pd(tfar, enlarge), tfar);     // the larger: positive moved up
+  tnear = _mm_min_pd(_mm_mul_pd(tnear, enlarge), tnear);  // the smaller: negative moved down
   tfar = _mm_min_pd(tfar, _mm_set1_pd(tmax));
   const int hits = _mm_movemask_pd(_mm_cmple_pd(tnear, tfar));
   double entries[2];

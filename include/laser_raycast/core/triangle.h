@@ -18,6 +18,7 @@
 //   out (the BVH does so once at build time).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -76,18 +77,47 @@ inline bool isDegenerateTriangle(const Vec3<T>& a, const Vec3<T>& b, const Vec3<
 namespace detail {
 
 // a * b - c * d with the sign of the exact result (and 0 only when the exact result is 0).
-// For float the products are exact in double. For double, Kahan's algorithm with FMA has a relative
+// For float the products are exact in double (a result too small for a float is returned as the
+// smallest float of its sign). For double, Kahan's algorithm with FMA has a relative
 // error of at most 2 ulp (Jeannerod, Louvet, Muller 2013), which preserves the sign. Slow for
 // double without hardware FMA: edgeFunction() calls it only where rounding could have changed the
 // sign.
 inline float exactSignDifferenceOfProducts(float a, float b, float c, float d) {
-  return static_cast<float>(double(a) * double(b) - double(c) * double(d));
+  const double exact = double(a) * double(b) - double(c) * double(d);
+  const float result = static_cast<float>(exact);
+  // Too small for a float (it underflowed to 0): the smallest float of its sign.
+  if (result == 0 && exact != 0) {
+    return static_cast<float>(std::copysign(std::numeric_limits<float>::denorm_min(), exact));
+  }
+  return result;
 }
-inline double exactSignDifferenceOfProducts(double a, double b, double c, double d) {
+inline double kahanDifferenceOfProducts(double a, double b, double c, double d) {
   const double cd = c * d;
   const double cd_error = std::fma(-c, d, cd);  // cd - c * d, exactly
   const double ab_minus_cd = std::fma(a, b, -cd);
   return ab_minus_cd + cd_error;
+}
+// Kahan's bound holds only while the products and their errors are normal numbers. Where they
+// could underflow (found by test/fuzz/fuzz_core: coordinates 1e-160 apart turned an edge function
+// of -1.9e-460 into -0, and a ray outside a triangle hit it) or overflow, a and c are scaled by one
+// power of two and b and d by another: ab - cd scales by their product, so its sign is kept, and
+// the scaling is the same with the pairs swapped, so neighbours still get opposite signs. A result
+// too small for a double then comes back as the smallest one of its sign.
+inline double exactSignDifferenceOfProducts(double a, double b, double c, double d) {
+  const double ac = std::max(std::abs(a), std::abs(c)), bd = std::max(std::abs(b), std::abs(d));
+  if (!(ac > 0 && bd > 0 && ac <= std::numeric_limits<double>::max() &&
+        bd <= std::numeric_limits<double>::max())) {
+    return kahanDifferenceOfProducts(a, b, c, d);  // a zero or non-finite factor: nothing to save
+  }
+  const int i = std::ilogb(ac), j = std::ilogb(bd);
+  if (i + j > -900 && i + j < 900) return kahanDifferenceOfProducts(a, b, c, d);
+  const double scaled = kahanDifferenceOfProducts(std::ldexp(a, -i), std::ldexp(b, -j),
+                                                  std::ldexp(c, -i), std::ldexp(d, -j));
+  const double result = std::ldexp(scaled, i + j);
+  if (result == 0 && scaled != 0) {
+    return std::copysign(std::numeric_limits<double>::denorm_min(), scaled);
+  }
+  return result;
 }
 
 // An edge function a * b - c * d with its exact sign. The rounded difference is kept where rounding
@@ -102,7 +132,12 @@ inline T edgeFunction(T a, T b, T c, T d) {
   const T ab = a * b;
   const T cd = c * d;
   const T e = ab - cd;
-  if (std::abs(e) > std::numeric_limits<T>::epsilon() * (std::abs(ab) + std::abs(cd))) return e;
+  // A product in the subnormal range is off by up to half the smallest subnormal, not by a relative
+  // amount: that much more must separate e from 0.
+  if (std::abs(e) > std::numeric_limits<T>::epsilon() * (std::abs(ab) + std::abs(cd)) +
+                        std::numeric_limits<T>::denorm_min()) {
+    return e;
+  }
   return exactSignDifferenceOfProducts(a, b, c, d);
 }
 
