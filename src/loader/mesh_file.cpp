@@ -1,17 +1,10 @@
 #include "mesh_file.h"
 
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
-#include <tinyxml2.h>
-
 #include <algorithm>
-#include <assimp/Importer.hpp>
 #include <cctype>
-#include <cmath>
-#include <cstdint>
 #include <filesystem>
-#include <limits>
-#include <sstream>
+
+#include "laser_raycast/loader/errors.h"
 
 namespace laser_raycast {
 namespace mesh_file {
@@ -35,58 +28,6 @@ std::string uriScheme(const std::string& uri) {
         return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '-' || c == '.';
       });
   return is_scheme ? scheme : "";
-}
-
-// ---------------------------------------------------------------------------------------------------
-// Mesh files
-
-bool isCollada(const aiScene& scene, const std::string& path) {
-  aiString format;
-  if (scene.mMetaData && scene.mMetaData->Get("SourceAsset_Format", format)) {
-    return std::string(format.C_Str()).find("Collada") != std::string::npos;
-  }
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  return ext == ".dae";
-}
-
-// The Collada <asset><unit meter="..."/>, read from the file as RViz does: assimp puts it into the
-// root node's transformation together with the up-axis rotation, and we do not apply that one. No
-// <unit> (or no meter attribute) means metres, as the Collada specification says.
-double colladaUnit(const std::string& path) {
-  tinyxml2::XMLDocument doc;
-  if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS) {
-    throw SceneLoadError(std::string("cannot read the Collada <unit>: ") + doc.ErrorStr());
-  }
-  const tinyxml2::XMLElement* root = doc.RootElement();
-  const tinyxml2::XMLElement* asset = root ? root->FirstChildElement("asset") : nullptr;
-  const tinyxml2::XMLElement* unit = asset ? asset->FirstChildElement("unit") : nullptr;
-  const char* meter = unit ? unit->Attribute("meter") : nullptr;
-  if (!meter) return 1.0;
-  double value = 0;
-  // Written so that NaN fails.
-  if (unit->QueryDoubleAttribute("meter", &value) != tinyxml2::XML_SUCCESS ||
-      !(std::isfinite(value) && value > 0)) {
-    throw SceneLoadError("invalid Collada <unit meter=\"" + std::string(meter) +
-                         "\">: must be a finite number > 0");
-  }
-  return value;
-}
-
-// A node's transformation. A projective bottom row has no meaning for a mesh: an error rather than
-// silently dropped.
-Eigen::Affine3d toAffine(const aiNode& node) {
-  const aiMatrix4x4& m = node.mTransformation;
-  if (!(m.d1 == 0 && m.d2 == 0 && m.d3 == 0 && m.d4 == 1)) {
-    throw SceneLoadError("node '" + std::string(node.mName.C_Str()) +
-                         "' has a projective transformation");
-  }
-  Eigen::Affine3d t = Eigen::Affine3d::Identity();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 4; ++c) t(r, c) = m[r][c];
-  }
-  return t;
 }
 
 }  // namespace
@@ -115,95 +56,6 @@ std::string resolveUri(const std::string& uri, const std::string& base_dir,
         "without one");
   }
   return (fs::path(base_dir) / uri).string();
-}
-
-MeshData readMeshFile(const std::string& path, const Eigen::Vector3d& scale) {
-  Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(path, 0);
-  if (!scene) {
-    throw SceneLoadError(std::string("assimp cannot read it: ") + importer.GetErrorString());
-  }
-  // Checked before post-processing: vertex joining compares positions, and NaN breaks that; and
-  // validation would call an empty mesh just "invalid".
-  std::size_t vertex_count = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh& mesh = *scene->mMeshes[m];
-    if (!mesh.mVertices) continue;  // broken importer output: validation rejects it below
-    vertex_count += mesh.mNumVertices;
-    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
-      const aiVector3D& p = mesh.mVertices[v];
-      if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) {
-        std::ostringstream msg;
-        msg << "vertex " << v << " of sub-mesh " << m << " is not finite (" << p.x << " " << p.y
-            << " " << p.z << ")";
-        throw SceneLoadError(msg.str());
-      }
-    }
-  }
-  if (vertex_count == 0) throw SceneLoadError("it holds no vertices (an empty mesh)");
-  // Validate first: it guards what follows against broken importer output (indices out of range).
-  // Triangulate polygons; join identical vertices (exact duplicates only: the fan slicer relies on
-  // shared indices for watertight outlines); sort by primitive type so points and lines, which a
-  // ray cannot hit, end up in meshes of their own. Nothing that drops or moves triangles
-  // (FindDegenerates, FindInvalidData, OptimizeMeshes...): core::Mesh handles degenerate ones.
-  scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure | aiProcess_Triangulate |
-                                       aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
-  if (!scene) {
-    throw SceneLoadError(std::string("assimp cannot read it: ") + importer.GetErrorString());
-  }
-  if (!scene->mRootNode) throw SceneLoadError("assimp found no scene graph in it");
-
-  const double unit = isCollada(*scene, path) ? colladaUnit(path) : 1.0;
-  const Eigen::Affine3d scale_unit(Eigen::Scaling(Eigen::Vector3d(scale * unit)));
-
-  MeshData out;
-  // Depth-first over the root's children with an explicit stack (deep graphs must not overflow).
-  std::vector<std::pair<const aiNode*, Eigen::Affine3d>> stack;
-  for (unsigned c = 0; c < scene->mRootNode->mNumChildren; ++c) {
-    stack.emplace_back(scene->mRootNode->mChildren[c], Eigen::Affine3d::Identity());
-  }
-  // Meshes attached to the root itself get no node transform.
-  stack.emplace_back(nullptr, Eigen::Affine3d::Identity());
-  while (!stack.empty()) {
-    auto [node, parent_transform] = stack.back();
-    stack.pop_back();
-    Eigen::Affine3d transform = parent_transform;
-    if (node) {
-      transform = parent_transform * toAffine(*node);
-      for (unsigned c = 0; c < node->mNumChildren; ++c) {
-        stack.emplace_back(node->mChildren[c], transform);
-      }
-    } else {
-      node = scene->mRootNode;
-    }
-    const Eigen::Affine3d to_link = scale_unit * transform;
-    // A mirroring transform turns triangles inside out: swap two corners to keep the front face.
-    const bool flip = to_link.linear().determinant() < 0;
-    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
-      const aiMesh& mesh = *scene->mMeshes[node->mMeshes[i]];
-      if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
-      const std::size_t first = out.vertices.size();
-      if (first + mesh.mNumVertices > std::numeric_limits<std::uint32_t>::max()) {
-        throw SceneLoadError("more vertices than 32-bit indices can address");
-      }
-      for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
-        const aiVector3D& p = mesh.mVertices[v];
-        out.vertices.push_back(to_link * Eigen::Vector3d(p.x, p.y, p.z));
-      }
-      for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-        const aiFace& face = mesh.mFaces[f];
-        if (face.mNumIndices != 3) continue;  // a point or a line
-        core::TriangleIndices tri;
-        for (int k = 0; k < 3; ++k) tri[k] = static_cast<std::uint32_t>(first + face.mIndices[k]);
-        if (flip) std::swap(tri[1], tri[2]);
-        out.triangles.push_back(tri);
-      }
-    }
-  }
-  if (out.triangles.empty()) {
-    throw SceneLoadError("it has no triangles (an empty mesh, or only points or lines)");
-  }
-  return out;
 }
 
 }  // namespace mesh_file

@@ -1,5 +1,5 @@
-// Mesh files for the scene loader: where a URDF mesh URI points, and the triangles a file holds
-// (through assimp) in link-local geometry coordinates. Private to the loader library.
+// Mesh files for the scene loader: where a URDF mesh URI points, and what reading one gives.
+// Private to the loader library.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -19,17 +19,11 @@ namespace mesh_file {
 std::string resolveUri(const std::string& uri, const std::string& base_dir,
                        const PackageResolver& resolver);
 
+// A mesh file's triangles (import_process.h reads them), in link-local coordinates.
 struct MeshData {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<core::TriangleIndices> triangles;
 };
-
-// The file's triangles as v' = scale ⊙ (unit · node_transform · v): the Collada <unit> applied,
-// the node transforms accumulated from the root's children down, the root's own transformation
-// (assimp's unit and up-axis conversion) ignored, as RViz and geometric_shapes do. Points and
-// lines are left out. Throws SceneLoadError with the problem (no vertices, no triangles, a
-// non-finite vertex, what assimp could not read); the caller names the file.
-MeshData readMeshFile(const std::string& path, const Eigen::Vector3d& scale);
 
 }  // namespace mesh_file
 }  // namespace laser_raycast

@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <set>
 #include <sstream>
 
+#include "import_process.h"
 #include "laser_raycast/core/pose.h"
 #include "mesh_file.h"
 #include "urdf_parse.h"
@@ -267,7 +269,9 @@ std::vector<PendingBody> linkBodies(const LinkFrames& frames, const DroppedEleme
         pending.push_back(
             elementBody(element, link->name, frames.frame_of.at(link->name), load_mesh));
       } catch (const SceneLoadError& e) {
-        report(describe(source, link->name, element) + ": " + e.what());
+        const std::string where = describe(source, link->name, element);
+        if (!options.skip_bad_geometry) rethrowWithContext(e, where);
+        warnings->push_back(where + ": " + e.what());
       }
     }
   }
@@ -300,16 +304,39 @@ void commitBodies(std::vector<PendingBody> pending, const std::string& prefix,
 
 }  // namespace
 
+void MeshImportBounds::validate() const {
+  std::ostringstream msg;
+  // Written so that NaN fails.
+  if (!(std::isfinite(max_memory_mb) && max_memory_mb >= kMinMemoryMb)) {
+    msg << "MeshImportBounds.max_memory_mb must be finite and >= " << kMinMemoryMb << ", got "
+        << max_memory_mb;
+  } else if (!(std::isfinite(max_seconds) && max_seconds > 0)) {
+    msg << "MeshImportBounds.max_seconds must be finite and > 0, got " << max_seconds;
+  } else {
+    return;
+  }
+  throw std::invalid_argument(msg.str());
+}
+
 SceneLoader::SceneLoader(PackageResolver resolver) : resolver_(std::move(resolver)) {}
+SceneLoader::~SceneLoader() = default;
+SceneLoader::SceneLoader(SceneLoader&&) noexcept = default;
+SceneLoader& SceneLoader::operator=(SceneLoader&&) noexcept = default;
 
 std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
                                                         const std::string& base_dir,
                                                         const Eigen::Vector3d& scale,
-                                                        const core::BvhConfig& bvh) {
+                                                        const core::BvhConfig& bvh,
+                                                        const MeshImportBounds& bounds) {
   last_bvh_seconds_ = 0;
   std::string where = "mesh " + inQuotes(uri);
   try {
     requirePositive("the mesh scale", scale);
+    try {
+      bounds.validate();
+    } catch (const std::invalid_argument& e) {
+      throw SceneLoadError(e.what());
+    }
     const std::string path = mesh_file::resolveUri(uri, base_dir, resolver_);
     if (path != uri) where += " (" + path + ")";
 
@@ -330,7 +357,8 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
     }
     if (fs::file_size(path, ec) == 0 && !ec) throw SceneLoadError("file is empty (0 bytes)");
 
-    mesh_file::MeshData data = mesh_file::readMeshFile(path, scale);
+    if (!importer_) importer_ = std::make_unique<import_process::MeshImporter>();
+    mesh_file::MeshData data = importer_->import(path, scale, bounds);
     const Clock::time_point start = Clock::now();
     std::shared_ptr<const core::Mesh> mesh;
     try {
@@ -343,7 +371,7 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
     cache_.emplace(key, mesh);
     return mesh;
   } catch (const SceneLoadError& e) {
-    throw SceneLoadError(where + ": " + e.what());
+    rethrowWithContext(e, where);
   }
 }
 
@@ -383,6 +411,7 @@ LoadedModel SceneLoader::addUrdf(const std::string& urdf_xml, const std::string&
   const Clock::time_point start = Clock::now();
   try {
     options.bvh.validate();
+    options.mesh_import.validate();
   } catch (const std::invalid_argument& e) {
     throw SceneLoadError(source + ": " + e.what());
   }
@@ -407,7 +436,7 @@ LoadedModel SceneLoader::addUrdf(const std::string& urdf_xml, const std::string&
   const MeshLoader load_mesh = [&](const urdf::Mesh& mesh) {
     const auto loaded =
         loadMesh(mesh.filename, base_dir, Eigen::Vector3d(mesh.scale.x, mesh.scale.y, mesh.scale.z),
-                 options.bvh);
+                 options.bvh, options.mesh_import);
     bvh_seconds += last_bvh_seconds_;
     return loaded;
   };

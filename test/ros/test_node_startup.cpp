@@ -1,8 +1,8 @@
 // rostest node_startup.test: what start-up needs a running node for. A wrong parameter, a missing
 // URDF or bad geometry stops laser_raycast_node with exit status 1 and a message naming the
-// parameter or file; skip_bad_geometry lets it start anyway. Each case runs the node executable
-// with rosrun against the test's master. (Every parameter check is in test_node_params.cpp and
-// test_sensor_params.cpp.)
+// parameter or file (a nodelet then fails to load); skip_bad_geometry lets it start anyway. Each
+// case runs the node executable (or a nodelet manager) with rosrun against the test's master.
+// (Every parameter check is in test_node_params.cpp and test_sensor_params.cpp.)
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/package.h>
@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <regex>
 #include <string>
@@ -132,6 +133,36 @@ TEST(NodeStartup, MissingMeshNamesTheFileAndLink) {
   ros::NodeHandle().setParam("/i/node/models", modelFile(data("bad_mesh.urdf")));
   expectRefused("__ns:=/i __name:=node",
                 {"does_not_exist.stl", "broken_link", "skip_bad_geometry"});
+}
+
+// A corrupt mesh on which assimp allocates without end: refused at the memory bound, the node
+// stops with the named error (before, it allocated until the machine's memory ran out).
+TEST(NodeStartup, CorruptMeshIsRefusedAtTheMemoryBound) {
+  ros::NodeHandle().setParam("/k/node/models", modelFile(data("corrupt_mesh.urdf")));
+  expectRefused("__ns:=/k __name:=node",
+                {"regression_wall_p_letter.dae", "corrupt_link", "memory bound of 1536 MB"});
+}
+
+// The same file in a nodelet manager: the nodelet fails to load (its load command exits non-zero,
+// not by timeout), the manager logs the named error and keeps running. The manager gets
+// $LASER_RAYCAST_NODELET_PREFIX, as in nodelet_scan.test (the sanitizer build's LD_PRELOAD).
+TEST(NodeStartup, CorruptMeshMakesTheNodeletFailToLoad) {
+  ros::NodeHandle().setParam("/n/node/models", modelFile(data("corrupt_mesh.urdf")));
+  const char* prefix = std::getenv("LASER_RAYCAST_NODELET_PREFIX");
+  const NodeRun run = runCommand(
+      "export ROSCONSOLE_STDOUT_LINE_BUFFERED=1; " + std::string(prefix ? prefix : "") +
+      " rosrun nodelet nodelet manager __ns:=/n __name:=manager 2>&1 & manager=$!; "
+      "timeout 40 rosrun nodelet nodelet load laser_raycast/RaycastNodelet /n/manager __ns:=/n "
+      "__name:=node 2>&1; status=$?; "
+      "if kill -0 $manager; then echo MANAGER_RUNNING; fi; kill -INT $manager; wait $manager; "
+      "exit $status");
+  EXPECT_NE(run.status, 0) << run.output;
+  EXPECT_NE(run.status, 124) << "the load command should fail, not time out:\n" << run.output;
+  for (const std::string& m : {"regression_wall_p_letter.dae", "corrupt_link",
+                               "memory bound of 1536 MB", "MANAGER_RUNNING"}) {
+    EXPECT_NE(run.output.find(m), std::string::npos) << "the output should say '" << m << "':\n"
+                                                     << run.output;
+  }
 }
 
 TEST(NodeStartup, UrdfFileAsPackageUri) {

@@ -449,5 +449,12 @@ TEST(CastScan, BadSceneExitsThree) {
                  "unknown package 'laser_raycast_no_such_package'");
 }
 
+// A corrupt mesh on which assimp allocates without end is refused at the memory bound (before, the
+// tool allocated until the machine's memory ran out).
+TEST(CastScan, CorruptMeshExitsThreeAtTheMemoryBound) {
+  expectBadScene(kData + "corrupt_mesh.urdf", "regression_wall_p_letter.dae");
+  expectBadScene(kData + "corrupt_mesh.urdf", "memory bound of 1536 MB");
+}
+
 }  // namespace
 }  // namespace laser_raycast_test

@@ -23,6 +23,7 @@
 #include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 #include "shared_data.h"
+#include "temp_files.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -42,30 +43,6 @@ const std::vector<Vector3d> kCuboidVertices = {{0, 0, 0}, {1, 0, 0}, {1, 2, 0}, 
                                                {0, 0, 3}, {1, 0, 3}, {1, 2, 3}, {0, 2, 3}};
 const std::vector<std::array<int, 4>> kCuboidQuads = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
                                                       {3, 7, 6, 2}, {0, 4, 7, 3}, {1, 2, 6, 5}};
-
-// A fresh directory for files the tests write, removed at exit.
-struct TempDir {
-  TempDir()
-      : path(fs::temp_directory_path() / ("laser_raycast_test_" + std::to_string(::getpid()))) {
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  fs::path path;
-};
-
-const fs::path& tempDir() {
-  static const TempDir dir;
-  return dir.path;
-}
-
-std::string writeFile(const std::string& name, const std::string& content) {
-  const fs::path path = tempDir() / name;
-  std::ofstream(path, std::ios::binary) << content;
-  return path.string();
-}
 
 // The cuboid as a binary STL (80-byte header, count, 50 bytes per facet), little-endian as x86.
 std::string writeBinaryStl(const std::string& name) {

@@ -32,12 +32,31 @@ inline bool parseGeometrySource(const std::string& name, GeometrySource* source)
   return kGeometrySourceNames.parse(name, source);
 }
 
+// What one mesh file's import may use. Meshes are imported by assimp in a child process
+// (laser_raycast_mesh_import, installed with the package) under these bounds: some corrupt files
+// make assimp allocate without limit, loop, or crash, and the child's failure is then a
+// SceneLoadError (MeshImportBoundError for a bound) instead of the caller's.
+struct MeshImportBounds {
+  // MB of address space for the importing process (assimp, its libraries and the mesh). 1.5 GB
+  // imports meshes of several million triangles.
+  double max_memory_mb = 1536;
+  // s of wall-clock time for one file, start-up included (a few ms).
+  double max_seconds = 10;
+
+  // Throws std::invalid_argument naming the field and its value: each must be finite,
+  // max_memory_mb >= kMinMemoryMb and max_seconds > 0.
+  void validate() const;
+  // The importer itself (its libraries, unused) maps about 40 MB of address space.
+  static constexpr double kMinMemoryMb = 64;
+};
+
 struct LoaderOptions {
   GeometrySource geometry = GeometrySource::kVisual;  // which elements to load
   bool skip_bad_geometry = false;  // a bad element is skipped with a warning instead of an error
   std::string tf_prefix;  // prepended to every link name (frames and labels), e.g. "robot2/"
   std::vector<std::string> ignore_links;  // links (without prefix) whose geometry is not loaded
   core::BvhConfig bvh;                    // BVH build settings for the meshes
+  MeshImportBounds mesh_import;           // per mesh file
 };
 
 // A joint of the model, for forward kinematics (the CLI places links by joint values; the node uses
@@ -65,10 +84,17 @@ struct LoadedModel {
   std::vector<std::string> warnings;  // elements skipped under skip_bad_geometry
 };
 
+namespace import_process {
+class MeshImporter;
+}
+
 class SceneLoader {
  public:
   // resolver finds the packages of package:// URIs, of URDF files and meshes alike.
   explicit SceneLoader(PackageResolver resolver);
+  ~SceneLoader();  // ends the mesh importer's process
+  SceneLoader(SceneLoader&&) noexcept;
+  SceneLoader& operator=(SceneLoader&&) noexcept;
 
   // Adds the model's geometry to scene: frames named after the (merged) links, labels after the
   // links. base_dir is where relative mesh paths are looked up ("" for a URDF that came from a
@@ -82,11 +108,13 @@ class SceneLoader {
   LoadedModel addUrdfFile(const std::string& uri, const LoaderOptions& options, core::Scene* scene);
 
   // The mesh at uri (package://, file://, absolute, or relative to base_dir), with the URDF scale
-  // and the Collada <unit> applied. Each (file, scale) is read and its BVH built once; later calls
-  // share it. Throws SceneLoadError naming the file and the problem.
+  // and the Collada <unit> applied, imported under bounds. Each (file, scale) is read and its BVH
+  // built once; later calls share it. Throws SceneLoadError naming the file and the problem
+  // (MeshImportBoundError if the import exceeded a bound).
   std::shared_ptr<const core::Mesh> loadMesh(const std::string& uri, const std::string& base_dir,
                                              const Eigen::Vector3d& scale,
-                                             const core::BvhConfig& bvh);
+                                             const core::BvhConfig& bvh,
+                                             const MeshImportBounds& bounds = {});
 
   // Files read and BVHs built so far (each (file, scale) once).
   std::size_t meshesLoaded() const { return cache_.size(); }
@@ -97,6 +125,7 @@ class SceneLoader {
                       const std::string& source, const LoaderOptions& options, core::Scene* scene);
 
   PackageResolver resolver_;
+  std::unique_ptr<import_process::MeshImporter> importer_;  // started at the first mesh file
   std::map<std::pair<std::string, std::array<double, 3>>, std::shared_ptr<const core::Mesh>> cache_;
   double last_bvh_seconds_ = 0;
 };

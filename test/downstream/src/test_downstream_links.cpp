@@ -8,6 +8,7 @@
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scene.h"
 #include "laser_raycast/loader/kinematics.h"
+#include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 #include "laser_raycast/node/node_params.h"
 
@@ -22,6 +23,15 @@ TEST(Downstream, UsesTheLoader) {
   laser_raycast::GeometrySource source;
   EXPECT_TRUE(laser_raycast::parseGeometrySource("collision", &source));
   EXPECT_EQ(source, laser_raycast::GeometrySource::kCollision);
+}
+
+// Meshes are read by laser_raycast's importer executable, which the loader finds beside its own
+// library: from another package too.
+TEST(Downstream, LoadsAMeshThroughTheImporter) {
+  laser_raycast::SceneLoader loader(laser_raycast::rosPackagePath);
+  const auto mesh = loader.loadMesh("package://laser_raycast/test/data/meshes/cuboid.obj", "",
+                                    Eigen::Vector3d::Ones(), {});
+  EXPECT_EQ(mesh->triangles().size(), 12u);
 }
 
 TEST(Downstream, UsesTheKinematics) {
