@@ -428,6 +428,16 @@ LoadedModel SceneLoader::addUrdf(const std::string& urdf_xml, const std::string&
   out.links = model->links_.size();
   out.joints = modelJoints(*model, prefix, source);
   const LinkFrames frames = mergeFixedJoints(*model, root);
+  // urdfdom accepts a joint whose parent is its own child; that link hangs from nothing (found by
+  // test/fuzz/fuzz_urdf_loader).
+  for (const auto& [name, link] : model->links_) {
+    if (!frames.frame_of.count(name)) {
+      // Such a link holds itself (child_links): break the cycle, or the model leaks.
+      for (const auto& entry : model->links_) entry.second->child_links.clear();
+      throw SceneLoadError(source + ": link '" + name + "' is not connected to the root link '" +
+                           root->name + "' (a joint that makes it its own parent, or a cycle)");
+    }
+  }
   for (const auto& [link, placement] : frames.frame_of) {
     out.link_frames[prefix + link] = {prefix + placement.first, placement.second};
   }

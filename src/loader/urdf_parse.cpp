@@ -62,6 +62,10 @@ class UrdfParseLog : public console_bridge::OutputHandler {
   std::vector<std::string> errors_;
 };
 
+// More than TinyXML's longest step past a terminator (a UTF-8 sequence, at most 4 bytes, read as
+// one character of a name).
+constexpr std::size_t kTinyXmlOverread = 16;
+
 }  // namespace
 
 urdf::ModelInterfaceSharedPtr parseUrdf(const std::string& xml, const std::string& source,
@@ -70,7 +74,10 @@ urdf::ModelInterfaceSharedPtr parseUrdf(const std::string& xml, const std::strin
   std::vector<std::string> errors;
   UrdfParseLog log;
   try {
-    model = urdf::parseURDF(xml);
+    // TinyXML 2.6.2 (under urdfdom) can read a few bytes past the terminator when the text ends
+    // inside a UTF-8 sequence in a name (found by test/fuzz/fuzz_urdf_loader under
+    // AddressSanitizer): terminators to spare keep those reads inside the buffer.
+    model = urdf::parseURDF(xml + std::string(kTinyXmlOverread, '\0'));
   } catch (const std::exception& e) {
     model.reset();
     errors.push_back(e.what());

@@ -21,7 +21,8 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kFuzzers = LASER_RAYCAST_FUZZERS;  // "" when clang was not found
-const std::string kCorpus = std::string(LASER_RAYCAST_SOURCE_DIR) + "/test/fuzz/corpus/";
+const std::string kSourceDir = LASER_RAYCAST_SOURCE_DIR;
+const std::string kCorpus = kSourceDir + "/test/fuzz/corpus/";
 
 int seconds(int fallback) {
   const char* env = std::getenv("LASER_RAYCAST_FUZZ_SECONDS");
@@ -41,7 +42,9 @@ void smoke(const std::string& harness, int duration, const std::vector<std::stri
       " -timeout=30 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=" + work.string() +
       "/ " + (work / "corpus").string();
   for (const std::string& seed : seeds) command += " " + seed;
-  const CommandResult run = runCommand(command + " 2>&1");
+  // Leaks of libraries outside the package that the harnesses reach (lsan.supp says which).
+  const CommandResult run = runCommand("LSAN_OPTIONS=suppressions=" + kSourceDir +
+                                       "/test/fuzz/lsan.supp " + command + " 2>&1");
   std::smatch executed, rate;
   const bool stats =
       std::regex_search(run.output, executed,
@@ -62,7 +65,7 @@ TEST(FuzzSmoke, Core) { smoke("fuzz_core", seconds(55), {kCorpus + "core"}); }
 
 TEST(FuzzSmoke, MeshLoader) {
   smoke("fuzz_mesh_loader", seconds(50),
-        {kCorpus + "mesh_loader", std::string(LASER_RAYCAST_SOURCE_DIR) + "/test/data/meshes"});
+        {kCorpus + "mesh_loader", kSourceDir + "/test/data/meshes"});
 }
 
 TEST(FuzzSmoke, UrdfLoader) { smoke("fuzz_urdf_loader", seconds(45), {kCorpus + "urdf_loader"}); }

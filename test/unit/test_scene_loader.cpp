@@ -634,6 +634,27 @@ TEST_F(SceneLoaderTest, UnreadableMeshIsAnError) {
   }
 }
 
+// Regression (found by test/fuzz/fuzz_urdf_loader): urdfdom accepts a joint whose parent is its
+// child, and the loader returned a link without a frame.
+TEST_F(SceneLoaderTest, ALinkThatIsItsOwnParentIsAnError) {
+  const std::string xml =
+      "<robot name=\"r\"><link name=\"base\"/><link name=\"ball\"><visual><geometry><sphere "
+      "radius=\"0.1\"/></geometry></visual></link><joint name=\"loop\" type=\"fixed\"><parent "
+      "link=\"ball\"/><child link=\"ball\"/></joint></robot>";
+  SceneLoader loader(nullptr);
+  core::Scene scene;
+  try {
+    loader.addUrdfString(xml, "", {}, &scene, "the test URDF");
+    ADD_FAILURE() << "loaded";
+  } catch (const SceneLoadError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the test URDF: link 'ball' is not connected to the root link 'base'"),
+              std::string::npos)
+        << what;
+  }
+  EXPECT_TRUE(scene.bodies().empty());
+}
+
 TEST_F(SceneLoaderTest, MalformedUrdfIsAlwaysAnError) {
   LoaderOptions options;
   options.skip_bad_geometry = true;

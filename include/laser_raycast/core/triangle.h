@@ -193,7 +193,10 @@ class PreparedRay<T, TriangleMethod::kSeedPlane> {
     const T wa = (p - b).dot(pa) / (a - b).dot(pa);
     const T wb = (p - c).dot(pb) / (b - c).dot(pb);
     const T wc = (p - a).dot(pc) / (c - a).dot(pc);
-    if (!(wa >= 0 && wb >= 0 && wc >= 0)) return std::nullopt;
+    // A hit's barycentrics are finite: an overflowing one (a denominator near the smallest
+    // number; found by test/fuzz/fuzz_core) is no hit. All three >= 0: their sum is finite iff each
+    // is.
+    if (!(wa >= 0 && wb >= 0 && wc >= 0) || !std::isfinite(wa + wb + wc)) return std::nullopt;
     return TriangleHitT<T>{t, wb, wc};
   }
 
