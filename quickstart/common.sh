@@ -43,11 +43,17 @@ install_missing() {
   apt-get update -q >&2 && apt-get install -y -q --no-install-recommends "${missing[@]}" >&2
 }
 
+# The build type and further CMake options (test.sh --sanitize changes them).
+BUILD_TYPE=Release
+CMAKE_OPTIONS=()
+
 build_workspace() {  # extra arguments go to catkin_make (e.g. a target)
   mkdir -p "$WS_DIR/src"
   [ -e "$WS_DIR/src/laser_raycast" ] || ln -s "$REPO_DIR" "$WS_DIR/src/laser_raycast"
   log "building in $WS_DIR"
-  (cd "$WS_DIR" && catkin_make -j"$JOBS" -DCMAKE_BUILD_TYPE=Release "$@" >&2)
+  (cd "$WS_DIR" &&
+    catkin_make -j"$JOBS" -DCMAKE_BUILD_TYPE="$BUILD_TYPE" ${CMAKE_OPTIONS[@]+"${CMAKE_OPTIONS[@]}"} \
+      "$@" >&2)
 }
 
 source_workspace() {

@@ -8,25 +8,54 @@ set -euo pipefail
 
 usage() {
   cat <<'EOF'
-usage: quickstart/test.sh [--help]
+usage: quickstart/test.sh [--sanitize] [--help]
 
 Installs the Debian packages that are missing (apt-get, as root), builds the package in .ws/ inside
 the clone, runs every test (gtest and rostest) and catkin_lint -W2, and prints the summary. Exits
 non-zero on any failure or if no test ran. CI (.ci/run) runs exactly this.
 
+  --sanitize  build with AddressSanitizer and UndefinedBehaviorSanitizer in a workspace under
+              $TMPDIR or /tmp (its path is printed) and run the same tests there (not the fuzz
+              harnesses: they are sanitized builds already); a sanitizer report fails the test
+              that caused it
+
 Environment:
   LASER_RAYCAST_REQUIRE_SHARED_DATA=1  fail instead of skipping when ../shared/data is missing
-  LASER_RAYCAST_WS=DIR                 build in DIR instead of .ws/
+  LASER_RAYCAST_WS=DIR                 build in DIR instead of .ws/ (or the sanitize workspace;
+                                       never inside the clone)
   LASER_RAYCAST_JOBS=N                 parallel build jobs (default: the number of CPUs)
+  LASER_RAYCAST_FUZZ_SECONDS=N         how long each fuzz harness runs in test_fuzz_smoke
 EOF
 }
+sanitize=0
 case "${1:-}" in
   -h|--help) usage; exit 0 ;;
+  --sanitize) sanitize=1 ;;
   "") ;;
   *) echo "quickstart/test.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
 esac
+[ $# -le 1 ] || { echo "quickstart/test.sh: one argument at most (try --help)" >&2; exit 2; }
 
+if [ $sanitize -eq 1 ]; then
+  # A workspace of its own, so that the normal build stays as it is, and outside the clone: rosrun
+  # searches the package's source tree for executables, and a second devel space in it makes every
+  # `rosrun laser_raycast ...` of the rostests ambiguous (in both builds).
+  repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+  : "${LASER_RAYCAST_WS:=${TMPDIR:-/tmp}/laser_raycast_ws_sanitize_$(printf %s "$repo" | cksum | cut -d' ' -f1)}"
+  export LASER_RAYCAST_WS
+fi
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+if [ $sanitize -eq 1 ]; then
+  BUILD_TYPE=RelWithDebInfo
+  CMAKE_OPTIONS=(-Dlaser_raycast_SANITIZE=ON -Dlaser_raycast_FUZZ=OFF)
+  # Undefined behaviour stops the program (compiled with -fno-sanitize-recover); leaks are
+  # reported at exit, except those of the ROS libraries listed in test/sanitizer/lsan.supp.
+  export ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1
+  export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  export LSAN_OPTIONS=suppressions=$REPO_DIR/test/sanitizer/lsan.supp:print_suppressions=0
+  # The nodelet manager is Debian's, not instrumented: the ASan runtime must come first in it.
+  export LASER_RAYCAST_NODELET_PREFIX="env LD_PRELOAD=$(gcc -print-file-name=libasan.so)"
+fi
 
 install_missing "${APT_PACKAGES[@]}"
 # A downstream package that links every exported library, built beside this one (test/downstream).
