@@ -698,6 +698,35 @@ TYPED_TEST(TriangleLiteral, WatertightEdgeFunctionUnderflowRegression) {
   EXPECT_TRUE(hit(Vector3d(0, 0.5 * small, 0.5)));
 }
 
+// Regression (found by test/fuzz/fuzz_core): a vertex about half the largest value from the ray
+// made the edge functions so large that det = ea + eb + ec overflowed to +Inf; t = scaled_t / det
+// came out -0, and a ray over [0, 0] hit a triangle whose true t is -0.19. Scaling the edge
+// functions (detail::rescaledHit) gives the true t. The numbers are the fuzzer's (double), with the
+// large ones taken relative to the largest value so that float overflows the same way.
+TYPED_TEST(TriangleLiteral, WatertightDetOverflowRegression) {
+  using T = TypeParam;
+  const double max = std::numeric_limits<T>::max();
+  const Vector3d a(-0.5, -5.9438276512801007, 3.5), b(1.6449181260460009, 0, 0),
+      c(1, 0.5251521 * max, 0);
+  const Vector3d origin(0, 3.6444008742688023, -0.19068 * max), dir(-3.5, -4, -max);
+  const auto hit = [&](double tmin, double tmax) {
+    return hitTriangle<T>(TriangleMethod::kWatertight, makeRay<T>(origin, dir, tmin, tmax), a, b,
+                          c);
+  };
+  const auto at_origin = hit(0, 0);
+  EXPECT_FALSE(at_origin) << "t = " << (at_origin ? double(at_origin->t) : 0.0);
+  // The triangle's z (0 to 3.5) is nothing beside the origin's, so the true t is -origin.z / dir.z
+  // (the float shear, with 1 / dir.z subnormal, keeps a few digits fewer).
+  const auto found = hit(-1, 1);
+  ASSERT_TRUE(found);
+  const double tolerance = std::is_same<T, float>::value ? 1e-4 : 1e-12;
+  EXPECT_NEAR(double(found->t), -0.19068, tolerance);
+  EXPECT_GE(found->u, 0);
+  EXPECT_GE(found->v, 0);
+  EXPECT_LE(found->u + found->v, 1);
+  EXPECT_FALSE(hit(-0.1, 1));
+}
+
 // The ray-plane worked example of docs/design.md §6.4: plane [1 0 0 -7], R0 = [2 3 4],
 // Rd = [0.577 0.577 0.577] give Vd = 0.577, V0 = 5, t = 8.66 and Pi = [7 8 9]; "Vd > 0: the plane
 // points away from the ray", so the ray-facing normal is [-1 0 0]. (Its source says "x = -7";

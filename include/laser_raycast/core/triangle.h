@@ -159,6 +159,28 @@ inline bool acceptsT(T t, T tmin, T tmax) {
   return t >= tmin && t <= tmax && std::abs(t) <= std::numeric_limits<T>::max();
 }
 
+// The end of the watertight test where det = ea + eb + ec, 1 / det or the scaled t leave the finite
+// range: edge functions near the largest double (a vertex ~1e308 from the ray; found by
+// test/fuzz/fuzz_core: det overflowed to +Inf, t = scaled_t / Inf came out -0 and a ray whose
+// true hit lay at t = -0.19 hit at its origin) or so small that 1 / det is infinite (a triangle
+// ~1e-154 m across in double, or a small one seen nearly edge-on). t, u and v are ratios of the
+// edge functions, so scaling all three by one power of two (exact, but for digits far below the
+// largest one's) changes none of them and brings det into [1, 6). An edge function that is itself
+// infinite or NaN leaves nothing to recover: no hit.
+template <typename T>
+std::optional<TriangleHitT<T>> rescaledHit(T ea, T eb, T ec, T az, T bz, T cz, T tmin, T tmax) {
+  const T largest = std::max({std::abs(ea), std::abs(eb), std::abs(ec)});
+  if (!(largest > 0 && largest <= std::numeric_limits<T>::max())) return std::nullopt;
+  const int exponent = std::ilogb(largest);
+  ea = std::ldexp(ea, -exponent);
+  eb = std::ldexp(eb, -exponent);
+  ec = std::ldexp(ec, -exponent);
+  const T det = ea + eb + ec;  // the three share a sign, so |det| >= 1
+  const T t = (ea * az + eb * bz + ec * cz) / det;
+  if (!acceptsT(t, tmin, tmax)) return std::nullopt;
+  return TriangleHitT<T>{t, eb / det, ec / det};
+}
+
 }  // namespace detail
 
 // A ray prepared for testing many triangles with one method. intersect() takes the current far
@@ -385,13 +407,9 @@ class PreparedRay<T, TriangleMethod::kWatertight> {
     const T cz = sz_ * pc[kz_];
     const T scaled_t = ea * az + eb * bz + ec * cz;
     const T inv_det = T(1) / det;
-    // A det below 1 / max (subnormal: a triangle ~1e-154 m across in double, or a small one seen
-    // nearly edge-on) makes 1 / det infinite; then divide, or t and u, v come out infinite and a
-    // ray with tmax = +inf accepts t = +inf.
-    if (!(std::abs(inv_det) <= std::numeric_limits<T>::max())) {
-      const T t = scaled_t / det;
-      if (!detail::acceptsT(t, tmin_, tmax)) return std::nullopt;
-      return TriangleHitT<T>{t, eb / det, ec / det};
+    constexpr T kMax = std::numeric_limits<T>::max();
+    if (!(std::abs(det) <= kMax && std::abs(inv_det) <= kMax && std::abs(scaled_t) <= kMax)) {
+      return detail::rescaledHit(ea, eb, ec, az, bz, cz, tmin_, tmax);
     }
     const T t = scaled_t * inv_det;
     if (!detail::acceptsT(t, tmin_, tmax)) return std::nullopt;
