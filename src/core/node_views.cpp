@@ -40,14 +40,6 @@ inline __m128 atan2Ps(__m128 y, __m128 x) {
   return _mm_or_ps(r, _mm_and_ps(y, _mm_set1_ps(-0.0f)));
 }
 
-// The children that exist (an empty slot's box, at +inf, gives NaNs that some of the min/max
-// operations above would turn into zeros).
-inline int presentMask(const WideBvh::Node& node) {
-  int mask = 0;
-  for (int k = 0; k < WideBvh::kWidth; ++k) mask |= (node.index[k] != WideBvh::kEmpty) << k;
-  return mask;
-}
-
 }  // namespace
 
 ViewFrame::ViewFrame(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax)
@@ -104,7 +96,7 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewFrame& f) {
   // Present, within tmax, and (planar) meeting the plane.
   __m128 ok = _mm_cmple_ps(near, f.tmax_);
   if (f.planar_) ok = _mm_and_ps(ok, _mm_cmple_ps(absPs(c[2]), e[2]));
-  mask = _mm_movemask_ps(ok) & presentMask(node);
+  mask = _mm_movemask_ps(ok) & node.presentMask();
   if (!mask) return;
 
   // Azimuths: the box's xy extent lies in a disc of radius r around (cx, cy); seen from the
@@ -153,7 +145,7 @@ int planeMask(const WideBvh::Node& node, const ViewFrame& f) {
     mag = _mm_add_ps(mag, _mm_mul_ps(f.abs_rot_[2][k], _mm_add_ps(absPs(cb), eb)));
   }
   ez = _mm_add_ps(ez, _mm_mul_ps(slack, _mm_add_ps(mag, ez)));
-  return _mm_movemask_ps(_mm_cmple_ps(absPs(cz), ez)) & presentMask(node);
+  return _mm_movemask_ps(_mm_cmple_ps(absPs(cz), ez)) & node.presentMask();
 }
 
 }  // namespace core

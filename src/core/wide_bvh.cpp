@@ -252,7 +252,7 @@ bool WideRay<M>::closestHit(const WideBvh& bvh, WideBvh::Ref start, const float*
       tfar = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far_plane, origin_far[k]), inv_dir[k]), tfar);
     }
     tfar = _mm_min_ps(_mm_mul_ps(tfar, widen), _mm_set1_ps(cull));
-    int mask = _mm_movemask_ps(_mm_cmple_ps(tnear, tfar));
+    int mask = _mm_movemask_ps(_mm_cmple_ps(tnear, tfar)) & node.presentMask();
     if (!mask) continue;
     alignas(16) float t_entry[4];
     _mm_store_ps(t_entry, tnear);

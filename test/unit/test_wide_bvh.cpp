@@ -212,6 +212,34 @@ TEST(WideRay, AxisAlignedRaysInBoxFacesFindTheirHits) {
   EXPECT_GT(hits, 50);
 }
 
+// Regression (found by test/fuzz/fuzz_core, through a body scaled far down): a direction component
+// beyond ~1e45 has a float reciprocal of 0, an empty child's box test gave NaN, which the test
+// ignores, and the traversal went into the empty child (index kEmpty: far past the nodes). Long
+// directions, in every axis and sign, against brute force on a tree with empty children.
+TEST(WideRay, LongDirectionsNeverEnterEmptyChildren) {
+  Rng rng(29);
+  const Soup s = spreadSoup(rng, 300);
+  const core::Mesh mesh(s.vertices, s.triangles);
+  const auto& nodes = mesh.wideBvh().nodes();
+  ASSERT_TRUE(std::any_of(nodes.begin(), nodes.end(),
+                          [](const WideBvh::Node& n) { return n.presentMask() != 0xF; }))
+      << "the case needs a node with an empty child";
+  int hits = 0;
+  for (int i = 0; i < 400; ++i) {
+    core::Ray ray;
+    ray.origin = uniformInCube(rng, 14);
+    const auto& tri = s.triangles[static_cast<std::size_t>(i) % s.triangles.size()];
+    const Eigen::Vector3d target = i % 2 ? s.vertices[tri[0]] : uniformInCube(rng, 14);
+    ray.dir = (target - ray.origin).normalized() * (i % 4 < 2 ? 1e50 : 1e300);
+    if (i % 8 == 0) ray.dir[i / 8 % 3] = 0;  // zero components too: NaN from a slab plane
+    expectLikeBruteForce<TriangleMethod::kWatertight>(mesh, ray);
+    expectLikeBruteForce<TriangleMethod::kMollerTrumbore>(mesh, ray);
+    hits += wideHit<TriangleMethod::kWatertight>(mesh, ray).has_value();
+    if (HasFailure()) return;
+  }
+  EXPECT_GT(hits, 100);
+}
+
 TEST(FloatRounding, BelowAndAboveBracketTheDouble) {
   Rng rng(3);
   for (int i = 0; i < 100000; ++i) {

@@ -63,15 +63,23 @@ class WideBvh {
     bool isEmpty() const { return index == kEmpty; }
   };
 
-  // Four children. An empty child has lo = +inf and hi = -inf: every ray's slab test misses it,
-  // whatever its direction and however far it may reach (no NaN arises: the planes are infinite,
-  // the reciprocal direction is never 0).
+  // Four children. An empty child has lo = +inf and hi = -inf, but a box test alone cannot be
+  // trusted to miss it: a direction component beyond ~1e45 has a float reciprocal of 0, and
+  // (+inf - origin) * 0 is NaN, which the tests ignore (found by test/fuzz/fuzz_core: the
+  // traversal pushed an empty child and read past the nodes). Every traversal masks its box tests
+  // with presentMask().
   struct alignas(64) Node {
     float lo[3][kWidth];  // [axis][child]
     float hi[3][kWidth];
     std::uint32_t index[kWidth];
     std::uint32_t count[kWidth];
     Ref child(int k) const { return Ref{index[k], count[k]}; }
+    // Bit k set iff child k exists.
+    int presentMask() const {
+      int mask = 0;
+      for (int k = 0; k < kWidth; ++k) mask |= int(index[k] != kEmpty) << k;
+      return mask;
+    }
   };
 
   WideBvh() = default;
