@@ -24,7 +24,9 @@ Environment:
   LASER_RAYCAST_WS=DIR                 build in DIR instead of .ws/ (or the sanitize workspace;
                                        never inside the clone)
   LASER_RAYCAST_JOBS=N                 parallel build jobs (default: the number of CPUs)
-  LASER_RAYCAST_FUZZ_SECONDS=N         how long each fuzz harness runs in test_fuzz_smoke
+  LASER_RAYCAST_FUZZ_SEED=N            the fuzz smoke test's seed (default fixed; 0: random)
+  LASER_RAYCAST_FUZZ_RUNS=N            inputs per fuzz harness in test_fuzz_smoke
+  LASER_RAYCAST_FUZZ_SECONDS=N         time bound per fuzz harness in test_fuzz_smoke
 EOF
 }
 sanitize=0
