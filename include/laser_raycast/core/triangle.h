@@ -109,6 +109,12 @@ inline double exactSignDifferenceOfProducts(double a, double b, double c, double
         bd <= std::numeric_limits<double>::max())) {
     return kahanDifferenceOfProducts(a, b, c, d);  // a zero or non-finite factor: nothing to save
   }
+  // Both factors within 2^+-449 (the usual case, tested without ilogb, which is a libm call):
+  // their exponents sum to within +-898.
+  constexpr double kLow = 0x1p-449, kHigh = 0x1p449;
+  if (ac > kLow && ac < kHigh && bd > kLow && bd < kHigh) {
+    return kahanDifferenceOfProducts(a, b, c, d);
+  }
   const int i = std::ilogb(ac), j = std::ilogb(bd);
   if (i + j > -900 && i + j < 900) return kahanDifferenceOfProducts(a, b, c, d);
   const double scaled = kahanDifferenceOfProducts(std::ldexp(a, -i), std::ldexp(b, -j),
