@@ -20,71 +20,113 @@ struct Gathered {
 
 }  // namespace
 
-WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) : bvh_(&bvh) {
-  if (bvh.empty()) return;
-  const auto& binary = bvh.nodes();
+// Collapses the binary BVH depth-first into wide nodes, filling the WideBvh's arrays.
+class WideBvh::Builder {
+ public:
   // The group and triangle count of a binary subtree, and its collapsed wide reference.
   struct Summary {
     Ref ref;
     std::int32_t group;
     std::uint32_t triangles;
   };
-  auto leafGroup = [&](const Bvh::Child& leaf) -> std::int32_t {
-    if (slot_group.empty()) return -1;
-    const std::uint32_t g = slot_group[leaf.index];
-    bool mixed = false;
-    for (std::uint32_t s = leaf.index + 1; s < leaf.index + leaf.count; ++s) {
-      mixed |= slot_group[s] != g;
+
+  Builder(WideBvh* out, const Bvh& bvh, const std::vector<std::uint32_t>& slot_group)
+      : out_(*out), binary_(bvh.nodes()), slot_group_(slot_group), span_(binary_.size()) {
+    computeSpans();
+  }
+
+  // The binary tree's depth is bounded (BvhConfig::max_depth), so the recursion is too.
+  Summary collapse(const Bvh::Child& child) {
+    if (const auto leaf = asLeaf(child)) {
+      return Summary{Ref{leaf->index, leaf->count}, leafGroup(*leaf), leaf->count};
     }
-    if (!mixed) return static_cast<std::int32_t>(g);
-    for (std::uint32_t s = leaf.index; s < leaf.index + leaf.count; ++s) {
-      if (slot_group[s] >= group_in_mixed_leaf_.size()) {
-        group_in_mixed_leaf_.resize(slot_group[s] + 1, 0);
+    const std::vector<Gathered> gathered = gather(child);
+    const auto index = static_cast<std::uint32_t>(out_.nodes_.size());
+    out_.nodes_.emplace_back();
+    out_.child_group_.resize(out_.nodes_.size() * kWidth, -1);
+    out_.child_triangles_.resize(out_.nodes_.size() * kWidth, 0);
+    Summary summary{Ref{index, 0}, -2, 0};  // -2: no child seen yet
+    for (int k = 0; k < kWidth; ++k) {
+      if (k >= static_cast<int>(gathered.size())) {
+        setEmpty(&out_.nodes_[index], k);
+        continue;
       }
-      group_in_mixed_leaf_[slot_group[s]] = 1;
+      const Summary sub = collapse(gathered[k].child);  // may grow nodes_
+      Node& node = out_.nodes_[index];
+      for (int a = 0; a < 3; ++a) {
+        node.lo[a][k] = gathered[k].lo[a];
+        node.hi[a][k] = gathered[k].hi[a];
+      }
+      node.index[k] = sub.ref.index;
+      node.count[k] = sub.ref.count;
+      out_.child_group_[index * kWidth + k] = sub.group;
+      out_.child_triangles_[index * kWidth + k] = sub.triangles;
+      summary.group = summary.group == -2 || summary.group == sub.group ? sub.group : -1;
+      summary.triangles += sub.triangles;
     }
-    return -1;
-  };
-  // Each binary inner node's slot range (a subtree's slots are contiguous: the builder partitions
-  // in place) and whether it holds a single group; children come after their parent.
+    return summary;
+  }
+
+ private:
+  // A binary inner node's slot range (a subtree's slots are contiguous: the builder partitions in
+  // place) and whether it holds a single group.
   struct Span {
     std::uint32_t first, count;
     bool one_group;
   };
-  std::vector<Span> span(binary.size());
-  for (std::size_t n = binary.size(); n-- > 0;) {
-    Span out{std::numeric_limits<std::uint32_t>::max(), 0, true};
-    for (int k = 0; k < 2; ++k) {
-      const Bvh::Child c = binary[n].child[k];
-      const Span sub = c.isLeaf() ? Span{c.index, c.count, true} : span[c.index];
-      out.first = std::min(out.first, sub.first);
-      out.count += sub.count;
-      out.one_group = out.one_group && sub.one_group;
+
+  // Children come after their parent, so one backward pass sees every child before its parent.
+  void computeSpans() {
+    for (std::size_t n = binary_.size(); n-- > 0;) {
+      Span out{std::numeric_limits<std::uint32_t>::max(), 0, true};
+      for (int k = 0; k < 2; ++k) {
+        const Bvh::Child c = binary_[n].child[k];
+        const Span sub = c.isLeaf() ? Span{c.index, c.count, true} : span_[c.index];
+        out.first = std::min(out.first, sub.first);
+        out.count += sub.count;
+        out.one_group = out.one_group && sub.one_group;
+      }
+      out.one_group = out.one_group &&
+                      (slot_group_.empty() ||
+                       std::all_of(slot_group_.begin() + out.first,
+                                   slot_group_.begin() + out.first + out.count,
+                                   [&](std::uint32_t g) { return g == slot_group_[out.first]; }));
+      span_[n] = out;
     }
-    out.one_group =
-        out.one_group &&
-        (slot_group.empty() ||
-         std::all_of(slot_group.begin() + out.first, slot_group.begin() + out.first + out.count,
-                     [&](std::uint32_t g) { return g == slot_group[out.first]; }));
-    span[n] = out;
   }
-  // A small subtree of one group becomes one leaf: a few more triangle tests cost less than the
-  // node visits they replace.
-  auto asLeaf = [&](const Bvh::Child& c) -> std::optional<Bvh::Child> {
+
+  // A binary leaf, or a small subtree of one group taken as one leaf: a few more triangle tests
+  // cost less than the node visits they replace.
+  std::optional<Bvh::Child> asLeaf(const Bvh::Child& c) const {
     if (c.isLeaf()) return c;
-    const Span& sub = span[c.index];
+    const Span& sub = span_[c.index];
     if (sub.count <= kMaxLeafTriangles && sub.one_group) return Bvh::Child{sub.first, sub.count};
     return std::nullopt;
-  };
-  // Depth-first; the binary tree's depth is bounded (BvhConfig::max_depth), so recursion is too.
-  auto collapse = [&](auto&& self, const Bvh::Child& child) -> Summary {
-    if (const auto leaf = asLeaf(child)) {
-      return Summary{Ref{leaf->index, leaf->count}, leafGroup(*leaf), leaf->count};
+  }
+
+  // The leaf's group, or -1 if it holds several (which are then marked as in a mixed leaf).
+  std::int32_t leafGroup(const Bvh::Child& leaf) {
+    if (slot_group_.empty()) return -1;
+    const std::uint32_t g = slot_group_[leaf.index];
+    bool mixed = false;
+    for (std::uint32_t s = leaf.index + 1; s < leaf.index + leaf.count; ++s) {
+      mixed |= slot_group_[s] != g;
     }
-    // Open the largest inner child until there are kWidth children or only leaves.
+    if (!mixed) return static_cast<std::int32_t>(g);
+    auto& marked = out_.group_in_mixed_leaf_;
+    for (std::uint32_t s = leaf.index; s < leaf.index + leaf.count; ++s) {
+      if (slot_group_[s] >= marked.size()) marked.resize(slot_group_[s] + 1, 0);
+      marked[slot_group_[s]] = 1;
+    }
+    return -1;
+  }
+
+  // The inner node's children, opening the largest inner one until there are kWidth or only
+  // leaves.
+  std::vector<Gathered> gather(const Bvh::Child& inner) const {
     std::vector<Gathered> gathered;
-    auto open = [&](const Bvh::Child& inner) {
-      const auto& node = binary[inner.index];
+    auto open = [&](const Bvh::Child& c) {
+      const auto& node = binary_[c.index];
       for (int k = 0; k < 2; ++k) {
         Gathered g;
         g.child = node.child[k];
@@ -95,7 +137,7 @@ WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) :
         gathered.push_back(g);
       }
     };
-    open(child);
+    open(inner);
     while (static_cast<int>(gathered.size()) < kWidth) {
       int best = -1;
       for (int k = 0; k < static_cast<int>(gathered.size()); ++k) {
@@ -103,42 +145,32 @@ WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) :
         if (best < 0 || gathered[k].halfArea() > gathered[best].halfArea()) best = k;
       }
       if (best < 0) break;
-      const Bvh::Child inner = gathered[best].child;
+      const Bvh::Child opened = gathered[best].child;
       gathered.erase(gathered.begin() + best);
-      open(inner);
+      open(opened);
     }
-    const auto index = static_cast<std::uint32_t>(nodes_.size());
-    nodes_.emplace_back();
-    child_group_.resize(nodes_.size() * kWidth, -1);
-    child_triangles_.resize(nodes_.size() * kWidth, 0);
-    Summary out{Ref{index, 0}, -2, 0};  // -2: no child seen yet
-    for (int k = 0; k < kWidth; ++k) {
-      Node& node = nodes_[index];
-      if (k >= static_cast<int>(gathered.size())) {
-        for (int a = 0; a < 3; ++a) {
-          node.lo[a][k] = std::numeric_limits<float>::infinity();
-          node.hi[a][k] = -std::numeric_limits<float>::infinity();
-        }
-        node.index[k] = kEmpty;
-        node.count[k] = 0;
-        continue;
-      }
-      const Summary sub = self(self, gathered[k].child);  // may grow nodes_
-      Node& filled = nodes_[index];
-      for (int a = 0; a < 3; ++a) {
-        filled.lo[a][k] = gathered[k].lo[a];
-        filled.hi[a][k] = gathered[k].hi[a];
-      }
-      filled.index[k] = sub.ref.index;
-      filled.count[k] = sub.ref.count;
-      child_group_[index * kWidth + k] = sub.group;
-      child_triangles_[index * kWidth + k] = sub.triangles;
-      out.group = out.group == -2 || out.group == sub.group ? sub.group : -1;
-      out.triangles += sub.triangles;
+    return gathered;
+  }
+
+  static void setEmpty(Node* node, int k) {
+    for (int a = 0; a < 3; ++a) {
+      node->lo[a][k] = std::numeric_limits<float>::infinity();
+      node->hi[a][k] = -std::numeric_limits<float>::infinity();
     }
-    return out;
-  };
-  const Summary root = collapse(collapse, bvh.root());
+    node->index[k] = kEmpty;
+    node->count[k] = 0;
+  }
+
+  WideBvh& out_;
+  const std::vector<Bvh::Node>& binary_;
+  const std::vector<std::uint32_t>& slot_group_;
+  std::vector<Span> span_;
+};
+
+WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) : bvh_(&bvh) {
+  if (bvh.empty()) return;
+  Builder builder(this, bvh, slot_group);
+  const Builder::Summary root = builder.collapse(bvh.root());
   root_ = root.ref;
   root_group_ = root.group;
   root_triangles_ = root.triangles;

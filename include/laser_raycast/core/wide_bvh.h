@@ -109,6 +109,8 @@ class WideBvh {
   }
 
  private:
+  class Builder;  // the collapse of the binary BVH (wide_bvh.cpp)
+
   const Bvh* bvh_ = nullptr;
   std::vector<Node> nodes_;
   Ref root_{kEmpty, 0};
