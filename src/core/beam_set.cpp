@@ -21,11 +21,7 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
   for (const int ring : beam_of_row_) row_elevation_.push_back(elevations[ring]);
   tiles_.reset(&result->range, &beam_of_row_, rows(), cols());
   const std::size_t beams = pattern.directions().size();
-  dispatchTriangleMethod(config.method, [&](auto method) {
-    using Cache = RayCache<decltype(method)::value>;
-    if (!std::holds_alternative<Cache>(rays_)) rays_ = Cache{};
-    std::get<Cache>(rays_).resize(beams);
-  });
+  box_rays_.resize(beams);
   if (ray_stamp_.size() != beams) ray_stamp_.assign(beams, 0);
   prepareSensorRays(config);
 }

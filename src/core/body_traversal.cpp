@@ -12,26 +12,19 @@ namespace laser_raycast {
 namespace core {
 namespace {
 
-// Below this many beams a node's beams are traced through its subtree one ray at a time instead
-// of its children's views being computed: views cost about as much as a few node visits of a
-// traced ray. Only speed depends on it.
-constexpr long long kTraceBeams = 32;
+// The walk's choices below change only how beams and triangles are paired, never a triangle's test,
+// so they change only the speed. Their values come from the benchmark's scenes.
 
-const Eigen::Matrix3d kIdentity = Eigen::Matrix3d::Identity();
-
-// A component of n triangles is rasterised (3D patterns) if its box can reach at least
-// n / kRasterBeamsPerTriangle beams of the whole pattern: setting up a triangle costs about as much
-// as tracing that many beams. Only speed depends on it.
-constexpr double kRasterBeamsPerTriangle = 5.0;
-
-// A subtree being sliced with at most this many triangles is sliced whole; a larger one is walked
-// with windows and occlusion tests first. Only speed depends on it.
-constexpr std::uint32_t kPlainSliceTriangles = 4096;
-
-// What slicing a component costs against testing its beams in 3D, in units of slicing one crossing
-// triangle: a plane cuts about 2 sqrt(n) of a compact closed component's n triangles, and a beam's
-// 3D tests cost about kBeamCostInSegments of those. Only speed depends on it.
-constexpr double kBeamCostInSegments = 2.0;
+// An inner node whose window holds at most this many beams has them traced through its subtree one
+// ray at a time instead of its children's windows being computed.
+constexpr long long kTraceBeams = 12;
+// A leaf whose window holds at most this many beams has them tested against each of its triangles;
+// more are rasterised (3D) against each triangle's edge planes first.
+constexpr long long kLeafDirectBeams = 4;
+// A subtree with at most this many triangles and at least this many beams per triangle in its
+// window is sliced whole (planar fans), without windows or occlusion tests on the way.
+constexpr std::uint32_t kPlainSliceTriangles = 64;
+constexpr double kPlainSliceBeamsPerTriangle = 0.5;
 
 template <TriangleMethod M>
 class MeshWalk {
@@ -41,6 +34,8 @@ class MeshWalk {
       : beams_(beams),
         mesh_(mesh),
         wide_(mesh.wideBvh()),
+        slots_(mesh.bvh().triangleVertices()),
+        ids_(mesh.bvh().triangleIds()),
         active_(active),
         config_(config),
         rot_(active.sensor_from_body.linear()),
@@ -48,7 +43,8 @@ class MeshWalk {
         trans_(active.sensor_from_body.translation()),
         planar_(beams.pattern().planar()),
         slicing_(planar_ && config.planar_fast_path),
-        rastering_(!planar_ && config.raster_fast_path),
+        // Without the fast paths every beam is traced from the root, as the reference.
+        tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
         frame_(active.sensor_from_body, planar_, config.tmax),
         stamp_(beams.newWalkStamp()) {
     if (slicing_) {
@@ -63,54 +59,31 @@ class MeshWalk {
     const View view = boxView(bounds.center(), bounds.extent() * 0.5, rot_, abs_rot_, trans_,
                               beams_.pattern().angleMin(), !planar_);
     if (!(view.near <= config_.tmax)) return;
-    Mode mode = kTest;
-    if (slicing_ || rastering_) {
-      mode = wide_.rootGroup() >= 0
-                 ? decide(wide_.rootGroup(), wide_.rootTriangles(), beams_.beamsReached(view))
-                 : kMixed;
-    }
     top_ = 0;
-    Entry root{wide_.root(), BeamRect{}, view.near, mode, wide_.rootTriangles(), {}, {}};
-    for (int a = 0; a < 3; ++a) {
-      root.lo[a] = floatBelow(bounds.lo[a]);
-      root.hi[a] = floatAbove(bounds.hi[a]);
-    }
+    const Entry root{wide_.root(), BeamRect{}, static_cast<float>(view.near),
+                     wide_.rootTriangles()};
     beams_.forEachRect(view, within, [&](const BeamRect& rect) {
-      root.rect = rect;
-      push(root);
+      Entry e = root;
+      e.rect = rect;
+      push(e);
     });
     while (top_ > 0) {
       const Entry e = stack_[--top_];
       if (!beams_.anyOpen(e.rect, e.near)) continue;  // hidden behind nearer hits
-      if (e.mode == kSlice && e.triangles <= kPlainSliceTriangles) {
-        sliceSubtree(e);
-      } else if (!e.ref.isLeaf()) {
-        if (e.mode == kTest && e.rect.beams() <= kTraceBeams) {
-          traceRect(e);
-        } else {
-          expand(e);
-        }
-      } else if (e.mode == kTest) {
+      if (tracing_only_) {
         traceRect(e);
-      } else if (planar_) {
-        sliceLeaf(e.ref, e.rect, e.near);  // or a leaf of mixed components
       } else {
-        rasterLeaf(e);  // or a leaf of mixed components
+        visit(e);
       }
     }
   }
 
  private:
-  // kMixed: above the mesh's components (when components choose); within one component, chosen
-  // for the whole scan: kSlice (planar fans) or kRaster (other patterns), else kTest (traced).
-  enum Mode : unsigned char { kMixed, kSlice, kRaster, kTest };
   struct Entry {
     WideBvh::Ref ref;
     BeamRect rect;
-    double near;
-    Mode mode;
+    float near;               // no point of ref's box is nearer to the sensor
     std::uint32_t triangles;  // below ref
-    float lo[3], hi[3];       // ref's box (mesh frame, rounded outward)
   };
 
   void push(const Entry& e) {
@@ -118,16 +91,24 @@ class MeshWalk {
     stack_[top_++] = e;
   }
 
-  // The same for every beam and every thread: it depends only on the component (its triangles)
-  // and how many beams of the whole pattern its box can reach.
-  Mode decide(std::int32_t group, std::uint32_t triangles, long long reached) const {
-    const double n = triangles, beams = static_cast<double>(reached);
-    if (planar_) {
-      if (wide_.groupInMixedLeaf(group)) return kSlice;  // sliced wherever it is met
-      return kBeamCostInSegments * beams >= 2 * std::sqrt(n) ? kSlice : kTest;
+  void visit(const Entry& e) {
+    const long long beams = e.rect.beams();
+    if (e.ref.isLeaf()) {
+      if (slicing_) {
+        sliceLeaf(e.ref, e.rect, e.near);
+      } else if (beams <= kLeafDirectBeams) {
+        testLeaf(e);
+      } else {
+        rasterLeaf(e);
+      }
+    } else if (slicing_ && e.triangles <= kPlainSliceTriangles &&
+               beams >= kPlainSliceBeamsPerTriangle * e.triangles) {
+      sliceSubtree(e);
+    } else if (beams <= kTraceBeams) {
+      traceRect(e);
+    } else {
+      expand(e);
     }
-    if (wide_.groupInMixedLeaf(group)) return kRaster;
-    return kRasterBeamsPerTriangle * beams >= n ? kRaster : kTest;
   }
 
   void expand(const Entry& e) {
@@ -139,28 +120,10 @@ class MeshWalk {
     int n = 0;
     for (int k = 0; k < WideBvh::kWidth; ++k) {
       if (!(views.mask & (1 << k))) continue;
-      Mode mode = e.mode;
-      if (mode == kMixed) {
-        const std::int32_t group = wide_.childGroup(e.ref.index, k);
-        if (group >= 0) {
-          long long reached = 0;
-          beams_.forEachChildRect(views, k, beams_.all(),
-                                  [&](const BeamRect& rect) { reached += rect.beams(); });
-          mode = decide(group, wide_.childTriangles(e.ref.index, k), reached);
-        }
-      }
       beams_.forEachChildRect(views, k, e.rect, [&](const BeamRect& rect) {
         if (n < 12) {
-          Entry& child = children[n++];
-          child.ref = node.child(k);
-          child.rect = rect;
-          child.near = views.near[k];
-          child.mode = mode;
-          child.triangles = wide_.childTriangles(e.ref.index, k);
-          for (int a = 0; a < 3; ++a) {
-            child.lo[a] = node.lo[a][k];
-            child.hi[a] = node.hi[a][k];
-          }
+          children[n++] =
+              Entry{node.child(k), rect, views.near[k], wide_.childTriangles(e.ref.index, k)};
         }
       });
     }
@@ -174,68 +137,136 @@ class MeshWalk {
     for (int j = 0; j < n; ++j) push(children[j]);
   }
 
-  // The beam as a ray in the body's frame, the same one for every test against this body.
-  const WideRay<M>& ray(int row, int col) {
-    return beams_.template bodyRay<M>(row, col, stamp_, [&](const Eigen::Vector3d& dir) {
+  // The beam as a ray in the body's frame, for box tests: the same one for every box test of this
+  // walk.
+  const WideBoxRay& boxRay(int row, int col) {
+    return beams_.boxRay(row, col, stamp_, [&](const Eigen::Vector3d& dir) {
       Ray r;
       r.origin = active_.sensor_in_body;
       r.dir = active_.body_from_sensor_rot * dir;
       r.tmin = config_.tmin;
-      return WideRay<M>(r, config_.cull_backfaces, wide_.binary().bounds());
+      return WideBoxRay(r, wide_.binary().bounds());
     });
   }
 
-  void offerMeshHit(int row, int col, double t, std::uint32_t triangle) {
-    beams_.offer(row, col, t, active_.index, static_cast<int>(triangle),
-                 [&] { return Eigen::Vector3d(rot_ * mesh_.normal(triangle)); });
+  // A triangle slot moved into the sensor frame. Every 3D test of this body's triangles is the
+  // beam's sensor-frame ray against these vertices, however the pair was found (traced,
+  // rasterised or tested directly), so shared edges are decided the same way everywhere.
+  struct SensorTriangle {
+    Eigen::Vector3d a, b, c;
+  };
+  SensorTriangle sensorTriangle(std::uint32_t slot) const {
+    const auto& v = slots_[slot];
+    return SensorTriangle{rot_ * v[0] + trans_, rot_ * v[1] + trans_, rot_ * v[2] + trans_};
   }
 
-  // Each open beam of the rect through the node's subtree (or leaf), one ray at a time, starting
-  // with the node's box.
+  Eigen::Vector3d sensorNormal(std::uint32_t triangle) const {
+    return rot_ * mesh_.normal(triangle);
+  }
+
+  // The nearest hit of one beam so far in this walk: a hit improves it if nearer, or as near on a
+  // lower triangle index, so the result does not depend on the order triangles are met in.
+  struct Best {
+    double t = std::numeric_limits<double>::infinity();
+    std::uint32_t triangle = std::numeric_limits<std::uint32_t>::max();
+    std::uint32_t slot = 0;
+    bool found() const { return triangle != std::numeric_limits<std::uint32_t>::max(); }
+    bool improves(double t2, std::uint32_t triangle2) const {
+      return t2 < t || (t2 == t && triangle2 < triangle);
+    }
+  };
+
+  void offer(int row, int col, const Best& best) {
+    beams_.offer(row, col, best.t, active_.index, static_cast<int>(best.triangle), [&] {
+      return slicing_ ? slicer_->sensorNormal(best.slot) : sensorNormal(best.triangle);
+    });
+  }
+
+  // Each open beam of the rect through the node's subtree, one ray at a time.
   void traceRect(const Entry& e) {
     for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
         if (!(range >= e.near)) continue;  // a hit nearer than this node can be
         double tmax = std::min(config_.tmax, range);
-        std::optional<MeshHit> best;
-        if (ray(row, col).closestHit(wide_, e.ref, e.lo, e.hi, &tmax, &best)) {
-          offerMeshHit(row, col, best->t, best->triangle);
+        Best best;
+        if (slicing_) {
+          traceWide(wide_, e.ref, boxRay(row, col), &tmax,
+                    [&](std::uint32_t slot) { sliceOne(slot, col, &tmax, &best); });
+        } else {
+          const auto& ray = beams_.template sensorRay<M>(row, col);
+          traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
+            const SensorTriangle s = sensorTriangle(slot);
+            const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
+            if (hit && best.improves(hit->t, ids_[slot])) {
+              best = Best{hit->t, ids_[slot], slot};
+              tmax = hit->t;
+            }
+          });
         }
+        if (best.found()) offer(row, col, best);
       }
     }
   }
 
-  // Each triangle of the leaf, in the sensor frame, against the open beams of its own window:
-  // four beams at a time through a conservative float test of the three edge planes (through the
-  // sensor and an edge each), then the exact test for the beams that pass. Every beam meets this
-  // component only here, through the same sensor-frame rays, so shared edges stay watertight.
-  void rasterLeaf(const Entry& e) {
-    const auto& slots = mesh_.bvh().triangleVertices();
-    const auto& ids = mesh_.bvh().triangleIds();
-    for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
-      const auto& v = slots[slot];
-      const Eigen::Vector3d a = rot_ * v[0] + trans_, b = rot_ * v[1] + trans_,
-                            c = rot_ * v[2] + trans_;
-      const Eigen::Vector3d lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
-      const View view = boxView((lo + hi) * 0.5, (hi - lo) * 0.5, kIdentity, kIdentity,
-                                Eigen::Vector3d::Zero(), beams_.pattern().angleMin(), true);
-      if (!(view.near <= config_.tmax)) continue;
-      EdgeFilter filter(a, b, c);
-      beams_.forEachRect(view, e.rect, [&](const BeamRect& rect) {
-        for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-          filter.forEachCandidate(beams_, row, rect.col_lo, rect.col_hi, [&](int col) {
-            const double range = beams_.range(row, col);
-            if (!(range >= view.near)) return;
-            const auto hit = beams_.template sensorRay<M>(row, col).intersect(
-                a, b, c, std::min(config_.tmax, range));
-            if (!hit) return;
-            const std::uint32_t triangle = ids[slot];
-            beams_.offer(row, col, hit->t, active_.index, static_cast<int>(triangle),
-                         [&] { return Eigen::Vector3d(rot_ * mesh_.normal(triangle)); });
-          });
+  // The slot's segment in the scan plane against one beam, as slicing tests it.
+  void sliceOne(std::uint32_t slot, int col, double* tmax, Best* best) const {
+    slicer_->sliceSlot(
+        slot, col, col,
+        [&](int, double t) {
+          if (t <= *tmax && best->improves(t, ids_[slot])) {
+            *best = Best{t, ids_[slot], slot};
+            *tmax = t;
+          }
+        },
+        [&](int, double segment_near) { return segment_near <= *tmax; });
+  }
+
+  // A few beams against each triangle of a leaf, directly.
+  void testLeaf(const Entry& e) {
+    SensorTriangle tris[16];  // the leaf's first triangles, moved once
+    const std::uint32_t count = std::min<std::uint32_t>(e.ref.count, 16);
+    for (std::uint32_t i = 0; i < count; ++i) tris[i] = sensorTriangle(e.ref.index + i);
+    for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
+      for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
+        const double range = beams_.range(row, col);
+        if (!(range >= e.near)) continue;
+        const auto& ray = beams_.template sensorRay<M>(row, col);
+        double tmax = std::min(config_.tmax, range);
+        Best best;
+        for (std::uint32_t i = 0; i < e.ref.count; ++i) {
+          const std::uint32_t slot = e.ref.index + i;
+          const SensorTriangle s = i < count ? tris[i] : sensorTriangle(slot);
+          const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
+          if (hit && best.improves(hit->t, ids_[slot])) {
+            best = Best{hit->t, ids_[slot], slot};
+            tmax = hit->t;
+          }
         }
-      });
+        if (best.found()) offer(row, col, best);
+      }
+    }
+  }
+
+  // Each triangle of the leaf against the open beams of the leaf's window: four beams at a time
+  // through a conservative float test of the three edge planes (through the sensor and an edge
+  // each), then the exact test for the beams that pass.
+  void rasterLeaf(const Entry& e) {
+    for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
+      const SensorTriangle s = sensorTriangle(slot);
+      const EdgeFilter filter(s.a, s.b, s.c);
+      const std::uint32_t triangle = ids_[slot];
+      for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
+        filter.forEachCandidate(beams_, row, e.rect.col_lo, e.rect.col_hi, [&](int col) {
+          const double range = beams_.range(row, col);
+          if (!(range >= e.near)) return;
+          const auto hit = beams_.template sensorRay<M>(row, col).intersect(
+              s.a, s.b, s.c, std::min(config_.tmax, range));
+          if (!hit) return;
+          beams_.offer(row, col, hit->t, active_.index, static_cast<int>(triangle),
+                       [&] { return sensorNormal(triangle); });
+        });
+      }
     }
   }
 
@@ -260,12 +291,11 @@ class MeshWalk {
   }
 
   void sliceLeaf(WideBvh::Ref leaf, const BeamRect& rect, double near) {
-    const auto& ids = mesh_.bvh().triangleIds();
     for (std::uint32_t slot = leaf.index; slot < leaf.index + leaf.count; ++slot) {
       slicer_->sliceSlot(
           slot, rect.col_lo, rect.col_hi,
           [&](int col, double t) {
-            beams_.offer(0, col, t, active_.index, static_cast<int>(ids[slot]),
+            beams_.offer(0, col, t, active_.index, static_cast<int>(ids_[slot]),
                          [&] { return slicer_->sensorNormal(slot); });
           },
           [&](int col, double segment_near) {
@@ -277,11 +307,13 @@ class MeshWalk {
   BeamSet& beams_;
   const Mesh& mesh_;
   const WideBvh& wide_;
+  const std::vector<std::array<Eigen::Vector3d, 3>>& slots_;
+  const std::vector<std::uint32_t>& ids_;
   const Caster::ActiveBody& active_;
   const CastConfig& config_;
   const Eigen::Matrix3d rot_, abs_rot_;
   const Eigen::Vector3d trans_;
-  const bool planar_, slicing_, rastering_;
+  const bool planar_, slicing_, tracing_only_;
   const ViewFrame frame_;
   const std::uint32_t stamp_;
   std::optional<PlaneSlicer> slicer_;

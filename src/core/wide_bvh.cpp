@@ -86,11 +86,11 @@ class WideBvh::Builder {
         out.count += sub.count;
         out.one_group = out.one_group && sub.one_group;
       }
-      out.one_group = out.one_group &&
-                      (slot_group_.empty() ||
-                       std::all_of(slot_group_.begin() + out.first,
-                                   slot_group_.begin() + out.first + out.count,
-                                   [&](std::uint32_t g) { return g == slot_group_[out.first]; }));
+      out.one_group =
+          out.one_group &&
+          (slot_group_.empty() ||
+           std::all_of(slot_group_.begin() + out.first, slot_group_.begin() + out.first + out.count,
+                       [&](std::uint32_t g) { return g == slot_group_[out.first]; }));
       span_[n] = out;
     }
   }
@@ -176,15 +176,13 @@ WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) :
   root_triangles_ = root.triangles;
 }
 
-template <TriangleMethod M>
-WideRay<M>::WideRay(const Ray& ray, bool cull_backfaces, const Aabb& bounds)
-    : prepared_(ray, cull_backfaces),
-      tmin_(ray.tmin),
-      reach_((bounds.lo - ray.origin)
+WideBoxRay::WideBoxRay(const Ray& ray, const Aabb& bounds)
+    : reach_((bounds.lo - ray.origin)
                  .cwiseAbs()
                  .cwiseMax((bounds.hi - ray.origin).cwiseAbs())
                  .maxCoeff() /
              ray.dir.cwiseAbs().maxCoeff()) {
+  tnear0_ = floatBelow(ray.tmin - (std::abs(ray.tmin) + reach_) * kWiden);
   constexpr std::uint32_t kLo = offsetof(WideBvh::Node, lo), kHi = offsetof(WideBvh::Node, hi);
   for (int k = 0; k < 3; ++k) {
     // Adding +0 turns -0 into +0, so a zero component gives +inf and counts as positive (see
@@ -204,104 +202,40 @@ WideRay<M>::WideRay(const Ray& ray, bool cull_backfaces, const Aabb& bounds)
   }
 }
 
+// The four-wide test's arithmetic on one box.
+bool WideBoxRay::enters(const float lo[3], const float hi[3], float cull) const {
+  constexpr std::uint32_t kLo = offsetof(WideBvh::Node, lo);
+  float tnear = tnear0_, tfar = std::numeric_limits<float>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    const bool positive = near_offset_[k] == kLo + k * WideBvh::kWidth * sizeof(float);
+    const float t0 = ((positive ? lo : hi)[k] - origin_near_[k]) * inv_dir_[k];
+    const float t1 = ((positive ? hi : lo)[k] - origin_far_[k]) * inv_dir_[k];
+    tnear = t0 > tnear ? t0 : tnear;  // NaN never replaces tnear
+    tfar = t1 < tfar ? t1 : tfar;     // nor tfar
+  }
+  tfar *= kWidenExit;
+  return tnear <= (tfar < cull ? tfar : cull);
+}
+
 template <TriangleMethod M>
 bool WideRay<M>::closestHit(const WideBvh& bvh, WideBvh::Ref start, const float* start_lo,
                             const float* start_hi, double* tmax,
                             std::optional<MeshHit>* best) const {
-  if (start.isEmpty()) return false;
+  if (start.isEmpty() || !box_.enters(start_lo, start_hi, box_.cullLimit(*tmax))) return false;
   const Bvh& binary = bvh.binary();
   const auto& slots = binary.triangleVertices();
   const auto& ids = binary.triangleIds();
-  // Boxes are culled against [tmin, tmax] widened as BvhT::traverse does (see there): a hit's t and
-  // its box's entry and exit round differently.
-  constexpr double kWiden = 64 * std::numeric_limits<double>::epsilon();
-  const float tnear0 = floatBelow(tmin_ - (std::abs(tmin_) + reach_) * kWiden);
-  float cull = floatAbove(*tmax + (std::abs(*tmax) + reach_) * kWiden);
-  constexpr float kWidenExit = 1 + 2 * roundingGamma<float>(3);
-  constexpr std::uint32_t kLo = offsetof(WideBvh::Node, lo);
-
-  // The start box, scalar, with the same arithmetic as the four-wide test below.
-  {
-    float tnear = tnear0, tfar = std::numeric_limits<float>::infinity();
-    for (int k = 0; k < 3; ++k) {
-      const bool positive = near_offset_[k] == kLo + k * WideBvh::kWidth * sizeof(float);
-      const float t0 = ((positive ? start_lo : start_hi)[k] - origin_near_[k]) * inv_dir_[k];
-      const float t1 = ((positive ? start_hi : start_lo)[k] - origin_far_[k]) * inv_dir_[k];
-      tnear = t0 > tnear ? t0 : tnear;  // NaN never replaces tnear
-      tfar = t1 < tfar ? t1 : tfar;     // nor tfar
-    }
-    tfar *= kWidenExit;
-    if (!(tnear <= (tfar < cull ? tfar : cull))) return false;
-  }
-
-  const __m128 tnear0_ps = _mm_set1_ps(tnear0), widen = _mm_set1_ps(kWidenExit);
-  __m128 origin_near[3], origin_far[3], inv_dir[3];
-  for (int k = 0; k < 3; ++k) {
-    origin_near[k] = _mm_set1_ps(origin_near_[k]);
-    origin_far[k] = _mm_set1_ps(origin_far_[k]);
-    inv_dir[k] = _mm_set1_ps(inv_dir_[k]);
-  }
-  struct Entry {
-    WideBvh::Ref ref;
-    float t_entry;
-  };
-  Entry stack[64 * (WideBvh::kWidth - 1) + 1];
-  int top = 0;
-  stack[top++] = Entry{start, tnear0};
   bool improved = false;
-  const WideBvh::Node* nodes = bvh.nodes().data();
-  while (top > 0) {
-    const Entry entry = stack[--top];
-    if (entry.t_entry > cull) continue;
-    if (entry.ref.isLeaf()) {
-      const std::uint32_t end = entry.ref.index + entry.ref.count;
-      for (std::uint32_t slot = entry.ref.index; slot < end; ++slot) {
-        const auto& tri = slots[slot];
-        const auto hit = prepared_.intersect(tri[0], tri[1], tri[2], *tmax);
-        if (!hit) continue;
-        const std::uint32_t id = ids[slot];
-        if (*best && !(hit->t < (*best)->t || ((*best)->t == hit->t && id < (*best)->triangle))) {
-          continue;
-        }
-        *best = MeshHit{hit->t, hit->u, hit->v, id};
-        improved = true;
-        *tmax = hit->t;
-        cull = floatAbove(*tmax + (std::abs(*tmax) + reach_) * kWiden);
-      }
-      continue;
-    }
-    // The four children at once: entry through the near planes, exit through the far ones.
-    const WideBvh::Node& node = nodes[entry.ref.index];
-    const char* base = reinterpret_cast<const char*>(&node);
-    __m128 tnear = tnear0_ps;
-    __m128 tfar = _mm_set1_ps(std::numeric_limits<float>::infinity());
-    for (int k = 0; k < 3; ++k) {
-      const __m128 near_plane = _mm_load_ps(reinterpret_cast<const float*>(base + near_offset_[k]));
-      const __m128 far_plane = _mm_load_ps(reinterpret_cast<const float*>(base + far_offset_[k]));
-      // maxps/minps return their second operand when either is NaN (a ray lying in a slab plane):
-      // it never narrows the interval, as in slabTest.
-      tnear = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near_plane, origin_near[k]), inv_dir[k]), tnear);
-      tfar = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far_plane, origin_far[k]), inv_dir[k]), tfar);
-    }
-    tfar = _mm_min_ps(_mm_mul_ps(tfar, widen), _mm_set1_ps(cull));
-    int mask = _mm_movemask_ps(_mm_cmple_ps(tnear, tfar)) & node.presentMask();
-    if (!mask) continue;
-    alignas(16) float t_entry[4];
-    _mm_store_ps(t_entry, tnear);
-    // Push the children met, farthest first, so that the nearest is visited next.
-    int order[4], n = 0;
-    while (mask) {
-      const int k = __builtin_ctz(static_cast<unsigned>(mask));
-      mask &= mask - 1;
-      int j = n++;
-      for (; j > 0 && t_entry[order[j - 1]] < t_entry[k]; --j) order[j] = order[j - 1];
-      order[j] = k;
-    }
-    for (int j = 0; j < n; ++j) {
-      const int k = order[j];
-      stack[top++] = Entry{WideBvh::Ref{node.index[k], node.count[k]}, t_entry[k]};
-    }
-  }
+  traceWide(bvh, start, box_, tmax, [&](std::uint32_t slot) {
+    const auto& tri = slots[slot];
+    const auto hit = prepared_.intersect(tri[0], tri[1], tri[2], *tmax);
+    if (!hit) return;
+    const std::uint32_t id = ids[slot];
+    if (*best && !(hit->t < (*best)->t || ((*best)->t == hit->t && id < (*best)->triangle))) return;
+    *best = MeshHit{hit->t, hit->u, hit->v, id};
+    improved = true;
+    *tmax = hit->t;
+  });
   return improved;
 }
 

@@ -69,12 +69,11 @@ class BeamSet {
   const float* directionY(int row) const { return &direction_y_[row * padded_cols_]; }
   float directionZ(int row) const { return direction_z_[row]; }
 
-  // Each beam as a ray in the frame of the body being walked, built once per (beam, body walk):
-  // every test of the beam against the body's triangles uses this one ray (see WideRay). A walk
-  // takes a fresh stamp; the rays of other walks are rebuilt when asked for.
+  // Each beam as a ray in the frame of the body being walked, for box tests, built once per (beam,
+  // body walk). A walk takes a fresh stamp; the rays of other walks are rebuilt when asked for.
   std::uint32_t newWalkStamp() { return walk_stamp_.fetch_add(1) + 1; }
-  template <TriangleMethod M, class Make>
-  const WideRay<M>& bodyRay(int row, int col, std::uint32_t stamp, Make&& make);
+  template <class Make>
+  const WideBoxRay& boxRay(int row, int col, std::uint32_t stamp, Make&& make);
 
   // Offers a hit (t, body, triangle) to the beam at (row, col); normal() gives its unit normal in
   // the sensor frame, asked only if the hit is kept and normals are wanted. True if kept.
@@ -115,12 +114,7 @@ class BeamSet {
   int padded_cols_ = 0;
   std::vector<float> direction_x_, direction_y_, direction_z_;
 
-  template <TriangleMethod M>
-  using RayCache = std::vector<std::optional<WideRay<M>>>;
-  std::variant<RayCache<TriangleMethod::kSeedPlane>, RayCache<TriangleMethod::kSeedUv>,
-               RayCache<TriangleMethod::kCramer>, RayCache<TriangleMethod::kMollerTrumbore>,
-               RayCache<TriangleMethod::kWatertight>>
-      rays_;
+  std::vector<WideBoxRay> box_rays_;
   std::vector<std::uint32_t> ray_stamp_;      // the walk each cached ray was built for
   std::atomic<std::uint32_t> walk_stamp_{0};  // walks of several threads take stamps
   std::vector<int> beam_of_row_;              // the ring of each row
@@ -162,15 +156,14 @@ void BeamSet::forEachChildRect(const NodeViews& views, int k, const BeamRect& wi
   forEachRect(view, within, f);
 }
 
-template <TriangleMethod M, class Make>
-const WideRay<M>& BeamSet::bodyRay(int row, int col, std::uint32_t stamp, Make&& make) {
+template <class Make>
+const WideBoxRay& BeamSet::boxRay(int row, int col, std::uint32_t stamp, Make&& make) {
   const int i = beam(row, col);
-  auto& rays = std::get<RayCache<M>>(rays_);
   if (ray_stamp_[i] != stamp) {
-    rays[i].emplace(make(direction(row, col)));
+    box_rays_[i] = make(direction(row, col));
     ray_stamp_[i] = stamp;
   }
-  return *rays[i];
+  return box_rays_[i];
 }
 
 template <class Normal>

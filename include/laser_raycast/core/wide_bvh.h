@@ -121,36 +121,126 @@ class WideBvh {
   std::uint32_t root_triangles_ = 0;
 };
 
-// A ray prepared for the wide BVH's box tests (the origin rounded both ways, the reciprocal
-// direction) together with the exact triangle test. Every test of one ray against one mesh goes
-// through the same PreparedRay, whether it is reached by closestHit or by the caster's window walk
-// (body_traversal.h), so that a ray exactly on a shared edge is decided the same way everywhere.
+// A ray prepared for the wide BVH's conservative box tests: the origin rounded to float both ways,
+// the reciprocal direction, and the ray's reach (the farthest a coordinate of the mesh's bounds is
+// from the origin, in units of t), which scales the widening of the cull limit.
+class WideBoxRay {
+ public:
+  WideBoxRay() = default;
+  // bounds: the box of everything the ray will be tested against (a mesh's).
+  WideBoxRay(const Ray& ray, const Aabb& bounds);
+
+  // The box cull limit for a far limit tmax: widened as BvhT::traverse does (a hit's t and its
+  // box's entry and exit round differently).
+  float cullLimit(double tmax) const {
+    return floatAbove(tmax + (std::abs(tmax) + reach_) * kWiden);
+  }
+  // The children of node that the ray enters at or before `cull` (bit k for child k), and where
+  // (t_entry[k]; meaningful for the children entered).
+  int enter(const WideBvh::Node& node, float cull, float t_entry[4]) const {
+    const char* base = reinterpret_cast<const char*>(&node);
+    __m128 tnear = _mm_set1_ps(tnear0_);
+    __m128 tfar = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    for (int k = 0; k < 3; ++k) {
+      const __m128 near_plane = _mm_load_ps(reinterpret_cast<const float*>(base + near_offset_[k]));
+      const __m128 far_plane = _mm_load_ps(reinterpret_cast<const float*>(base + far_offset_[k]));
+      const __m128 inv = _mm_set1_ps(inv_dir_[k]);
+      // maxps/minps return their second operand when either is NaN (a ray lying in a slab plane):
+      // it never narrows the interval, as in slabTest.
+      tnear =
+          _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near_plane, _mm_set1_ps(origin_near_[k])), inv), tnear);
+      tfar = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far_plane, _mm_set1_ps(origin_far_[k])), inv), tfar);
+    }
+    tfar = _mm_min_ps(_mm_mul_ps(tfar, _mm_set1_ps(kWidenExit)), _mm_set1_ps(cull));
+    _mm_storeu_ps(t_entry, tnear);
+    return _mm_movemask_ps(_mm_cmple_ps(tnear, tfar)) & node.presentMask();
+  }
+  // The same test for one box given by its float corners.
+  bool enters(const float lo[3], const float hi[3], float cull) const;
+
+ private:
+  static constexpr double kWiden = 64 * std::numeric_limits<double>::epsilon();
+  static constexpr float kWidenExit = 1 + 2 * roundingGamma<float>(3);
+
+  double reach_ = 0;
+  float tnear0_ = 0;  // the entry limit: tmin, widened like the cull limit
+  // Per axis, the slab plane the ray meets first (near) and last (far), chosen by the sign of the
+  // direction: byte offsets into a Node's lo/hi arrays, and the origin rounded the way that moves
+  // each plane outward (the near plane nearer, the far plane farther).
+  std::uint32_t near_offset_[3] = {0, 0, 0}, far_offset_[3] = {0, 0, 0};
+  float origin_near_[3] = {0, 0, 0}, origin_far_[3] = {0, 0, 0}, inv_dir_[3] = {0, 0, 0};
+};
+
+// Walks the subtree `start` for one ray, nearest box first, and calls leaf(slot) for every triangle
+// slot of each leaf the ray enters before the cull limit of *tmax. leaf may lower *tmax (an
+// improving hit), which culls the boxes beyond. The start's own box is not tested.
+template <class Leaf>
+void traceWide(const WideBvh& bvh, WideBvh::Ref start, const WideBoxRay& ray, double* tmax,
+               Leaf&& leaf) {
+  if (start.isEmpty()) return;
+  struct Entry {
+    WideBvh::Ref ref;
+    float t_entry;
+  };
+  Entry stack[64 * (WideBvh::kWidth - 1) + 1];
+  int top = 0;
+  stack[top++] = Entry{start, -std::numeric_limits<float>::infinity()};
+  float cull = ray.cullLimit(*tmax);
+  const WideBvh::Node* nodes = bvh.nodes().data();
+  while (top > 0) {
+    const Entry entry = stack[--top];
+    if (entry.t_entry > cull) continue;
+    if (entry.ref.isLeaf()) {
+      const double before = *tmax;
+      for (std::uint32_t slot = entry.ref.index; slot < entry.ref.index + entry.ref.count; ++slot) {
+        leaf(slot);
+      }
+      if (*tmax != before) cull = ray.cullLimit(*tmax);
+      continue;
+    }
+    const WideBvh::Node& node = nodes[entry.ref.index];
+    alignas(16) float t_entry[4];
+    int mask = ray.enter(node, cull, t_entry);
+    // Push the children entered, farthest first, so that the nearest is visited next.
+    int order[4], n = 0;
+    while (mask) {
+      const int k = __builtin_ctz(static_cast<unsigned>(mask));
+      mask &= mask - 1;
+      int j = n++;
+      for (; j > 0 && t_entry[order[j - 1]] < t_entry[k]; --j) order[j] = order[j - 1];
+      order[j] = k;
+    }
+    for (int j = 0; j < n; ++j) {
+      const int k = order[j];
+      stack[top++] = Entry{node.child(k), t_entry[k]};
+    }
+  }
+}
+
+// A ray prepared for the wide BVH (WideBoxRay) together with the exact triangle test. Every test of
+// one ray against one mesh goes through the same PreparedRay, so that a ray exactly on a shared
+// edge is decided the same way everywhere.
 template <TriangleMethod M>
 class WideRay {
  public:
   // bounds: the box of everything the ray will be tested against (a mesh's), for the reach.
-  WideRay(const Ray& ray, bool cull_backfaces, const Aabb& bounds);
+  WideRay(const Ray& ray, bool cull_backfaces, const Aabb& bounds)
+      : prepared_(ray, cull_backfaces), box_(ray, bounds) {}
 
   const PreparedRay<double, M>& prepared() const { return prepared_; }
+  const WideBoxRay& box() const { return box_; }
 
   // Nearest hit with t in [ray.tmin, *tmax] in the subtree `start` whose box is start_box (float
   // corners lo[3], hi[3], rounded outward), skipping triangles that do not improve *best: a hit
   // improves it if it is nearer, or as near with a smaller triangle index (so the result does not
   // depend on the order the tree is walked in). Shrinks *tmax to each improving hit. Returns true
-  // if *best changed. The ray's reach (see BvhT::traverse) is taken from the bounds the ray was
-  // made with.
+  // if *best changed.
   bool closestHit(const WideBvh& bvh, WideBvh::Ref start, const float* start_lo,
                   const float* start_hi, double* tmax, std::optional<MeshHit>* best) const;
 
  private:
   PreparedRay<double, M> prepared_;
-  double tmin_;
-  double reach_;  // the farthest a box coordinate is from the origin, in units of t
-  // Per axis, the slab plane the ray meets first (near) and last (far), chosen by the sign of the
-  // direction: byte offsets into a Node's lo/hi arrays, and the origin rounded the way that moves
-  // each plane outward (the near plane nearer, the far plane farther).
-  std::uint32_t near_offset_[3], far_offset_[3];
-  float origin_near_[3], origin_far_[3], inv_dir_[3];
+  WideBoxRay box_;
 };
 
 }  // namespace core
