@@ -17,13 +17,21 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
   std::iota(beam_of_row_.begin(), beam_of_row_.end(), 0);
   std::stable_sort(beam_of_row_.begin(), beam_of_row_.end(),
                    [&](int a, int b) { return elevations[a] < elevations[b]; });
-  row_elevation_.clear();
-  for (const int ring : beam_of_row_) row_elevation_.push_back(elevations[ring]);
+  col_start_ = pattern.angleMin();
+  col_inv_increment_ = 1 / pattern.angleIncrement();
+  col_turn_ = 2 * M_PI * col_inv_increment_;
+  const double span = (pattern.azimuthCount() - 1) * pattern.angleIncrement();
+  one_turn_ = span <= 2 * M_PI && col_turn_ < 1e9;
+  // The rounding of the few operations from an angle to a column index, with room to spare.
+  col_pad_ = 64 * std::numeric_limits<double>::epsilon() * (col_turn_ + cols() + 8);
   tiles_.reset(&result->range, &beam_of_row_, rows(), cols());
   const std::size_t beams = pattern.directions().size();
   box_rays_.resize(beams);
   if (ray_stamp_.size() != beams) ray_stamp_.assign(beams, 0);
   prepareSensorRays(config);
+  // resetResult left every range +inf (or NaN for a sensor pose that is not valid, and then
+  // nothing is cast): the farthest hit a beam keeps is tmax.
+  range_above_.assign(direction_x_.size(), floatAbove(config.tmax));
 }
 
 void BeamSet::prepareSensorRays(const CastConfig& config) {
@@ -52,6 +60,7 @@ void BeamSet::prepareSensorRays(const CastConfig& config) {
     sensor_rays_ = std::move(rays);
   });
   padded_cols_ = (cols() + 3) / 4 * 4;
+  prepareRows();
   direction_x_.assign(static_cast<std::size_t>(rows()) * padded_cols_, 0.0f);
   direction_y_.assign(direction_x_.size(), 0.0f);
   direction_z_.assign(rows(), 0.0f);
@@ -66,36 +75,68 @@ void BeamSet::prepareSensorRays(const CastConfig& config) {
 
 bool BeamSet::anyOpen(const BeamRect& rect, double near) {
   if (!occlusion_culling_) return !rect.empty();
-  // Reading up to this many beams directly is about as cheap as the tiles, and exact.
-  constexpr long long kDirect = 32;
+  // Reading up to this many beams directly, four at a time, is about as cheap as the tiles.
+  constexpr long long kDirect = 128;
   if (rect.beams() > kDirect) return tiles_.anyOpen(rect, near);
+  // The float ranges are rounded up and near down: a beam counts as closed only if it certainly is
+  // (and a NaN range is open).
+  const __m128 limit = _mm_set1_ps(floatBelow(near));
+  const int first = rect.col_lo & ~3;
   for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-    for (int col = rect.col_lo; col <= rect.col_hi; ++col) {
-      if (!(range(row, col) < near)) return true;
+    const float* r = rangeAbove(row);
+    for (int base = first; base <= rect.col_hi; base += 4) {
+      int open = _mm_movemask_ps(_mm_cmpnlt_ps(_mm_loadu_ps(r + base), limit));
+      if (base < rect.col_lo) open &= 0xF << (rect.col_lo - base);
+      if (base + 3 > rect.col_hi) open &= 0xF >> (base + 3 - rect.col_hi);
+      if (open) return true;
     }
   }
   return false;
 }
 
-void BeamSet::rowsReached(const View& view, int* lo, int* hi) const {
-  if (planar_) {
-    *lo = view.crosses ? 0 : 1;
-    *hi = 0;
-    return;
-  }
-  *lo = static_cast<int>(
-      std::lower_bound(row_elevation_.begin(), row_elevation_.end(), view.elevation_lo) -
-      row_elevation_.begin());
-  *hi = static_cast<int>(
-            std::upper_bound(row_elevation_.begin(), row_elevation_.end(), view.elevation_hi) -
-            row_elevation_.begin()) -
+void RowTable::build(std::vector<double> values) {
+  values_ = std::move(values);
+  const double lo = values_.front(), hi = values_.back();
+  const double span = std::max(hi - lo, std::abs(lo) * 1e-6 + 1e-9);
+  base_ = static_cast<float>(lo - span / kBins);
+  scale_ = static_cast<float>(kBins / (span * (1 + 2.0 / kBins)));
+  first_at_or_above_.resize(kBins + 1);
+  last_at_or_below_.resize(kBins + 1);
+  for (int b = 0; b <= kBins; ++b) {
+    const double bin_lo = base_ + b / double(scale_), bin_hi = base_ + (b + 1) / double(scale_);
+    first_at_or_above_[b] = static_cast<int>(
+        std::lower_bound(values_.begin(), values_.end(), bin_lo) - values_.begin());
+    last_at_or_below_[b] =
+        static_cast<int>(std::upper_bound(values_.begin(), values_.end(), bin_hi) -
+                         values_.begin()) -
         1;
+  }
 }
 
-long long BeamSet::beamsReached(const View& view) const {
-  long long n = 0;
-  forEachRect(view, all(), [&](const BeamRect& rect) { n += rect.beams(); });
-  return n;
+void BeamSet::prepareRows() {
+  std::vector<double> elevations, tangents;
+  column_raster_ = true;
+  row_cos_.clear();
+  row_sin_.clear();
+  smallest_row_cos_ = 1;
+  for (const int ring : beam_of_row_) {
+    const double e = pattern_->elevations()[ring];
+    elevations.push_back(e);
+    column_raster_ = column_raster_ && std::abs(e) <= kMaxColumnRasterElevation;
+    tangents.push_back(
+        std::tan(std::max(-kMaxColumnRasterElevation, std::min(kMaxColumnRasterElevation, e))));
+    row_cos_.push_back(static_cast<float>(std::cos(e)));
+    row_sin_.push_back(static_cast<float>(std::sin(e)));
+    smallest_row_cos_ = std::min(smallest_row_cos_, row_cos_.back());
+  }
+  row_elevation_.build(std::move(elevations));
+  row_tan_.build(std::move(tangents));
+  column_cos_.assign(padded_cols_, 0.0f);
+  column_sin_.assign(padded_cols_, 0.0f);
+  for (int col = 0; col < cols(); ++col) {
+    column_cos_[col] = static_cast<float>(std::cos(pattern_->azimuth(col)));
+    column_sin_[col] = static_cast<float>(std::sin(pattern_->azimuth(col)));
+  }
 }
 
 }  // namespace core

@@ -4,8 +4,10 @@
 #include <cmath>
 #include <optional>
 
+#include "laser_raycast/core/column_raster.h"
 #include "laser_raycast/core/edge_filter.h"
 #include "laser_raycast/core/fan_slicer.h"
+#include "laser_raycast/core/primitive_cast.h"
 #include "laser_raycast/core/wide_bvh.h"
 
 namespace laser_raycast {
@@ -248,24 +250,31 @@ class MeshWalk {
     }
   }
 
-  // Each triangle of the leaf against the open beams of the leaf's window: four beams at a time
-  // through a conservative float test of the three edge planes (through the sensor and an edge
-  // each), then the exact test for the beams that pass.
+  // Each triangle of the leaf against the open beams of the leaf's window: column by column
+  // through a conservative float test of its edge planes and its plane (ColumnRaster), or for
+  // patterns too steep for it row by row (EdgeFilter), then the exact test for the beams let
+  // through.
   void rasterLeaf(const Entry& e) {
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
       const SensorTriangle s = sensorTriangle(slot);
-      const EdgeFilter filter(s.a, s.b, s.c);
       const std::uint32_t triangle = ids_[slot];
+      auto test = [&](int row, int col) {
+        const double range = beams_.range(row, col);
+        if (!(range >= e.near)) return;
+        const auto hit = beams_.template sensorRay<M>(row, col).intersect(
+            s.a, s.b, s.c, std::min(config_.tmax, range));
+        if (!hit) return;
+        beams_.offer(row, col, hit->t, active_.index, static_cast<int>(triangle),
+                     [&] { return sensorNormal(triangle); });
+      };
+      if (beams_.columnRaster()) {
+        ColumnRaster(beams_, s.a, s.b, s.c).forEachCandidate(beams_, e.rect, test);
+        continue;
+      }
+      const EdgeFilter filter(s.a, s.b, s.c);
       for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
-        filter.forEachCandidate(beams_, row, e.rect.col_lo, e.rect.col_hi, [&](int col) {
-          const double range = beams_.range(row, col);
-          if (!(range >= e.near)) return;
-          const auto hit = beams_.template sensorRay<M>(row, col).intersect(
-              s.a, s.b, s.c, std::min(config_.tmax, range));
-          if (!hit) return;
-          beams_.offer(row, col, hit->t, active_.index, static_cast<int>(triangle),
-                       [&] { return sensorNormal(triangle); });
-        });
+        filter.forEachCandidate(beams_, row, e.rect.col_lo, e.rect.col_hi,
+                                [&](int col) { test(row, col); });
       }
     }
   }
@@ -321,34 +330,6 @@ class MeshWalk {
   int top_ = 0;
 };
 
-// A primitive: each open beam of the window that passes within its bounding sphere, analytically.
-void castPrimitive(BeamSet& beams, const Body& body, const Caster::ActiveBody& a,
-                   const CastConfig& config, const BeamRect& rect) {
-  const double slack = kWindowSlack * (a.center.squaredNorm() + a.radius * a.radius);
-  for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-    for (int col = rect.col_lo; col <= rect.col_hi; ++col) {
-      const double range = beams.range(row, col);
-      if (!(range >= a.view.near)) continue;
-      const Eigen::Vector3d& d = beams.direction(row, col);
-      const double along = d.dot(a.center);
-      if ((a.center - along * d).squaredNorm() - a.radius * a.radius > slack) continue;
-      Ray ray;
-      ray.origin = a.sensor_in_body;
-      ray.dir = a.body_from_sensor_rot * d;
-      ray.tmin = config.tmin;
-      ray.tmax = std::min(config.tmax, range);
-      std::optional<PrimitiveHit> hit;
-      if (const auto* box = std::get_if<Box>(&body.shape)) hit = intersect(ray, *box);
-      if (const auto* cylinder = std::get_if<Cylinder>(&body.shape))
-        hit = intersect(ray, *cylinder);
-      if (const auto* sphere = std::get_if<Sphere>(&body.shape)) hit = intersect(ray, *sphere);
-      if (!hit) continue;
-      beams.offer(row, col, hit->t, a.index, -1,
-                  [&] { return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal); });
-    }
-  }
-}
-
 }  // namespace
 
 void castBody(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& active,
@@ -356,7 +337,7 @@ void castBody(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& acti
   const Body& body = scene.bodies()[active.index];
   const auto* mesh = std::get_if<std::shared_ptr<const Mesh>>(&body.shape);
   if (!mesh) {
-    castPrimitive(beams, body, active, config, within);
+    castPrimitive(beams, scene, active, config, within);
     return;
   }
   dispatchTriangleMethod(config.method, [&](auto method) {

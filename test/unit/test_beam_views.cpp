@@ -15,6 +15,7 @@
 #include "fan_specs.h"
 #include "laser_raycast/core/aabb.h"
 #include "laser_raycast/core/beam_set.h"
+#include "laser_raycast/core/column_raster.h"
 #include "laser_raycast/core/edge_filter.h"
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/core/node_views.h"
@@ -63,16 +64,24 @@ std::vector<core::ScanPattern> patterns() {
   return out;
 }
 
+// A beam set over a pattern with no hits yet, as a cast starts it.
+struct FreshBeams {
+  core::ScanResult result;
+  core::BeamSet beams;
+  FreshBeams(const core::ScanPattern& pattern, const core::CastConfig& config) {
+    result.range.assign(pattern.size(), kInf);
+    result.body.assign(pattern.size(), -1);
+    result.triangle.assign(pattern.size(), -1);
+    beams.reset(pattern, config, &result);
+  }
+};
+
 TEST(NodeViews, EveryBeamThatEntersAChildBoxIsInItsWindow) {
   Rng rng(21);
   long long checked = 0, inside = 0;
   for (const core::ScanPattern& pattern : patterns()) {
-    core::ScanResult result;
-    result.range.assign(pattern.size(), kInf);
-    result.body.assign(pattern.size(), -1);
-    result.triangle.assign(pattern.size(), -1);
-    core::BeamSet beams;
-    beams.reset(pattern, core::CastConfig{}, &result);
+    FreshBeams fresh(pattern, core::CastConfig{});
+    core::BeamSet& beams = fresh.beams;
     for (int scene = 0; scene < 8; ++scene) {
       const Soup s = scene % 2 ? clusteredSoup(rng, 400) : spreadSoup(rng, 400);
       const core::Mesh mesh(s.vertices, s.triangles);
@@ -120,10 +129,8 @@ TEST(BoxView, EveryBeamThatEntersTheBoxIsInItsWindow) {
   Rng rng(23);
   long long inside = 0;
   for (const core::ScanPattern& pattern : patterns()) {
-    core::ScanResult result;
-    result.range.assign(pattern.size(), kInf);
-    core::BeamSet beams;
-    beams.reset(pattern, core::CastConfig{}, &result);
+    FreshBeams fresh(pattern, core::CastConfig{});
+    core::BeamSet& beams = fresh.beams;
     for (int i = 0; i < 400; ++i) {
       const Eigen::Vector3d center = uniformInCube(rng, 8);
       const Eigen::Vector3d half(uniform(rng, 0.01, 3), uniform(rng, 0.01, 3),
@@ -156,43 +163,104 @@ TEST(BoxView, EveryBeamThatEntersTheBoxIsInItsWindow) {
   EXPECT_GT(inside, 10000);
 }
 
-TEST(EdgeFilter, LetsThroughEveryBeamTheExactTestHits) {
+// Random triangles near the sensor and far, large and tiny, some through the sensor's axis; each
+// beam given a random current range (a third of them none): the beams whose exact hit could be
+// kept, t <= range and t <= tmax.
+struct FilterCase {
+  Eigen::Vector3d a, b, c;
+};
+
+FilterCase randomTriangle(Rng& rng) {
+  const double scale = std::pow(10.0, uniform(rng, -1, 1.5));
+  const Eigen::Vector3d c = scale * randomUnitVector(rng);
+  const double size = scale * uniform(rng, 0.001, 1.5);
+  return FilterCase{c + size * randomUnitVector(rng), c + size * randomUnitVector(rng),
+                    c + size * randomUnitVector(rng)};
+}
+
+// Casts nothing: sets the beams' ranges through offer(), as the walk does.
+void setRandomRanges(Rng& rng, core::BeamSet* beams) {
+  for (int row = 0; row < beams->rows(); ++row) {
+    for (int col = 0; col < beams->cols(); ++col) {
+      if (rng() % 3 == 0) continue;
+      beams->offer(row, col, uniform(rng, 0.05, 40), 0, 0, [] { return Eigen::Vector3d(); });
+    }
+  }
+}
+
+// The candidates a filter gave, and the beams that must be among them.
+template <class Candidates>
+void expectEveryKeptHitACandidate(Rng& rng, const core::ScanPattern& pattern, Candidates&& run,
+                                  long long* hits) {
+  core::CastConfig config;
+  config.tmax = 25;
+  FreshBeams fresh(pattern, config);
+  core::BeamSet& beams = fresh.beams;
+  setRandomRanges(rng, &beams);
+  long long passed = 0, tested = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const FilterCase t = randomTriangle(rng);
+    std::vector<char> candidate(pattern.size(), 0);
+    run(beams, t, [&](int row, int col) { candidate[beams.beam(row, col)] = 1; });
+    for (int row = 0; row < beams.rows(); ++row) {
+      for (int col = 0; col < beams.cols(); ++col) {
+        ++tested;
+        passed += candidate[beams.beam(row, col)];
+        core::Ray ray;
+        ray.dir = beams.direction(row, col);
+        ray.tmax = std::min(config.tmax, beams.range(row, col));
+        if (!core::intersectTriangle<core::TriangleMethod::kWatertight>(ray, t.a, t.b, t.c)) {
+          continue;
+        }
+        ++*hits;
+        EXPECT_TRUE(candidate[beams.beam(row, col)])
+            << "triangle " << i << " row " << row << " col " << col;
+      }
+    }
+    if (::testing::Test::HasFailure()) return;
+  }
+  EXPECT_LT(passed, tested / 4);  // and it does filter
+}
+
+TEST(EdgeFilter, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
   Rng rng(29);
   const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 360),
                                   std::vector<double>{-0.5, -0.2, 0.0, 0.1, 0.4});
-  core::ScanResult result;
-  result.range.assign(pattern.size(), kInf);
-  core::BeamSet beams;
-  core::CastConfig config;
-  beams.reset(pattern, config, &result);
-  long long hits = 0, passed = 0, tested = 0;
-  for (int i = 0; i < 3000; ++i) {
-    // Triangles near the sensor and far, large and tiny, some through the sensor's axis.
-    const double scale = std::pow(10.0, uniform(rng, -1, 1.5));
-    const Eigen::Vector3d c = scale * randomUnitVector(rng);
-    const double size = scale * uniform(rng, 0.001, 1.5);
-    const Eigen::Vector3d a = c + size * randomUnitVector(rng),
-                          b = c + size * randomUnitVector(rng),
-                          d = c + size * randomUnitVector(rng);
-    const core::EdgeFilter filter(a, b, d);
-    for (int row = 0; row < beams.rows(); ++row) {
-      std::vector<char> candidate(beams.cols(), 0);
-      filter.forEachCandidate(beams, row, 0, beams.cols() - 1,
-                              [&](int col) { candidate[col] = 1; });
-      for (int col = 0; col < beams.cols(); ++col) {
-        ++tested;
-        passed += candidate[col];
-        core::Ray ray;
-        ray.dir = beams.direction(row, col);
-        if (!core::intersectTriangle<core::TriangleMethod::kWatertight>(ray, a, b, d)) continue;
-        ++hits;
-        EXPECT_TRUE(candidate[col]) << "triangle " << i << " row " << row << " col " << col;
-      }
-    }
-    if (HasFailure()) return;
+  long long hits = 0;
+  expectEveryKeptHitACandidate(
+      rng, pattern,
+      [](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
+        const core::EdgeFilter filter(t.a, t.b, t.c);
+        for (int row = 0; row < beams.rows(); ++row) {
+          filter.forEachCandidate(beams, row, 0, beams.cols() - 1,
+                                  [&](int col) { mark(row, col); });
+        }
+      },
+      &hits);
+  EXPECT_GT(hits, 1000);
+}
+
+// The same for the column raster, on a lidar's rings and on rings up to its steepest elevation.
+TEST(ColumnRaster, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
+  Rng rng(43);
+  std::vector<double> lidar, steep;
+  for (int r = 0; r < 32; ++r) lidar.push_back(-0.27 + 0.54 * r / 31);
+  for (int r = 0; r < 9; ++r) {
+    steep.push_back(-core::BeamSet::kMaxColumnRasterElevation * (1 - r / 4.0));
   }
-  EXPECT_GT(hits, 2000);
-  EXPECT_LT(passed, tested / 4);  // and it does filter
+  for (const auto& rings : {lidar, steep}) {
+    const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 512), rings);
+    long long hits = 0;
+    expectEveryKeptHitACandidate(
+        rng, pattern,
+        [](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
+          ASSERT_TRUE(beams.columnRaster());
+          core::ColumnRaster(beams, t.a, t.b, t.c)
+              .forEachCandidate(beams, beams.all(), [&](int row, int col) { mark(row, col); });
+        },
+        &hits);
+    EXPECT_GT(hits, 1000);
+  }
 }
 
 TEST(OcclusionTiles, AWindowWithAnOpenBeamIsNeverClosed) {
@@ -227,6 +295,38 @@ TEST(OcclusionTiles, AWindowWithAnOpenBeamIsNeverClosed) {
       if (open) ASSERT_TRUE(tiles.anyOpen(rect, near)) << "step " << step;
     }
   }
+}
+
+// The same for the beam set's own test, which reads small windows beam by beam (four at a time, in
+// float) and larger ones through its tiles; and it does close windows.
+TEST(BeamSet, AWindowWithAnOpenBeamIsNeverClosed) {
+  Rng rng(47);
+  const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 301),
+                                  std::vector<double>{0.3, -0.2, 0.1, -0.4, 0.0, 0.2, -0.1});
+  FreshBeams fresh(pattern, core::CastConfig{});
+  core::BeamSet& beams = fresh.beams;
+  long long closed = 0;
+  for (int step = 0; step < 20000; ++step) {
+    const int row = static_cast<int>(uniform(rng, 0, beams.rows())),
+              col = static_cast<int>(uniform(rng, 0, beams.cols()));
+    beams.offer(row, col, std::min(beams.range(row, col), uniform(rng, 0, 10)), 0, 0,
+                [] { return Eigen::Vector3d(); });
+    core::BeamRect rect;
+    rect.row_lo = static_cast<int>(uniform(rng, 0, beams.rows()));
+    rect.row_hi = std::min(beams.rows() - 1, rect.row_lo + static_cast<int>(uniform(rng, 0, 3)));
+    rect.col_lo = static_cast<int>(uniform(rng, 0, beams.cols()));
+    rect.col_hi =
+        std::min(beams.cols() - 1, rect.col_lo + static_cast<int>(logUniform(rng, 0, 2.5)));
+    const double near = uniform(rng, 0, 10);
+    bool open = false;
+    for (int r = rect.row_lo; r <= rect.row_hi; ++r) {
+      for (int c = rect.col_lo; c <= rect.col_hi; ++c) open |= !(beams.range(r, c) < near);
+    }
+    const bool said = beams.anyOpen(rect, near);
+    if (open) ASSERT_TRUE(said) << "step " << step;
+    closed += !said;
+  }
+  EXPECT_GT(closed, 1000);
 }
 
 }  // namespace

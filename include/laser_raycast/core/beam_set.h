@@ -27,8 +27,46 @@
 namespace laser_raycast {
 namespace core {
 
+// Sorted values (the rows' elevations, or their tangents) and the index range of those in an
+// interval, through a table of bins and a short exact step.
+class RowTable {
+ public:
+  void build(std::vector<double> values);
+  // The first and last index whose value lies in [lo, hi] (last < first if none; NaN: none).
+  void find(double lo, double hi, int* first, int* last) const {
+    // The bin indices in float, one bin further out on each side than rounded (the table is exact
+    // for its own bin ends: the float rounding moves an index by far less than a bin), then the
+    // exact step: the table's answer is at most a value or two wide of it.
+    const int n = static_cast<int>(values_.size());
+    const float x_lo = clampBin((static_cast<float>(lo) - base_) * scale_);
+    const float x_hi = clampBin((static_cast<float>(hi) - base_) * scale_);
+    const int b_lo = static_cast<int>(x_lo + 1.0f) - 2;  // floor(x_lo) - 1 (x_lo >= -1)
+    const int b_hi = static_cast<int>(x_hi + 1.0f);      // floor(x_hi) + 1
+    int f = b_lo < 0 ? 0 : first_at_or_above_[b_lo];
+    int l = b_hi > kBins ? n - 1 : last_at_or_below_[b_hi];
+    while (f < n && values_[f] < lo) ++f;
+    while (l >= 0 && values_[l] > hi) --l;
+    *first = f;
+    *last = lo <= hi ? l : -1;  // NaN or empty: none
+  }
+
+ private:
+  static constexpr int kBins = 1024;  // fine enough that a bin rarely holds two boundaries
+  // x clamped to [-1, kBins]; NaN to -1.
+  static float clampBin(float x) {
+    return x > -1.0f ? (x < float(kBins) ? x : float(kBins)) : -1.0f;
+  }
+  std::vector<double> values_;
+  std::vector<int> first_at_or_above_, last_at_or_below_;  // of each bin's lower/upper end
+  float base_ = 0, scale_ = 0;
+};
+
 class BeamSet {
  public:
+  // Patterns whose rows all lie within this elevation (rad, 80 degrees) can be rasterised column
+  // by column (ColumnRaster divides by cos E); steeper ones use the row scan of EdgeFilter.
+  static constexpr double kMaxColumnRasterElevation = 1.3962634015954636;
+
   // Starts a scan: every beam open (result's ranges as resetResult left them).
   void reset(const ScanPattern& pattern, const CastConfig& config, ScanResult* result);
 
@@ -50,8 +88,6 @@ class BeamSet {
   // The same for child k of a wide node's views.
   template <class F>
   void forEachChildRect(const NodeViews& views, int k, const BeamRect& within, F&& f) const;
-  // How many beams of the whole pattern the view can reach.
-  long long beamsReached(const View& view) const;
 
   // False only if every beam of rect has hit something nearer than `near` (small rects are read
   // beam by beam, larger ones through the occlusion tiles).
@@ -68,6 +104,22 @@ class BeamSet {
   const float* directionX(int row) const { return &direction_x_[row * padded_cols_]; }
   const float* directionY(int row) const { return &direction_y_[row * padded_cols_]; }
   float directionZ(int row) const { return direction_z_[row]; }
+  // The farthest hit each beam can still keep (its current range, or tmax) rounded up to float,
+  // one row at a time, padded like the directions.
+  const float* rangeAbove(int row) const { return &range_above_[row * padded_cols_]; }
+
+  // For ColumnRaster: whether the pattern allows it, the columns' cos and sin of the azimuth and
+  // the rows' cos and sin of the elevation (float, columns padded to a multiple of four), the
+  // smallest cos of an elevation, and the rows whose tan of the elevation lies in [lo, hi].
+  bool columnRaster() const { return column_raster_; }
+  const float* columnCos() const { return column_cos_.data(); }
+  const float* columnSin() const { return column_sin_.data(); }
+  float rowCos(int row) const { return row_cos_[row]; }
+  float rowSin(int row) const { return row_sin_[row]; }
+  float smallestRowCos() const { return smallest_row_cos_; }
+  void rowsWithTan(double lo, double hi, int* row_lo, int* row_hi) const {
+    row_tan_.find(lo, hi, row_lo, row_hi);
+  }
 
   // Each beam as a ray in the frame of the body being walked, for box tests, built once per (beam,
   // body walk). A walk takes a fresh stamp; the rays of other walks are rebuilt when asked for.
@@ -81,7 +133,24 @@ class BeamSet {
   bool offer(int row, int col, double t, int body, int triangle, Normal&& normal);
 
  private:
-  void rowsReached(const View& view, int* lo, int* hi) const;
+  void rowsReached(const View& view, int* lo, int* hi) const {
+    rowsOf(view.elevation_lo, view.elevation_hi, lo, hi);
+    if (planar_ && !view.crosses) *lo = 1;  // the one row lies in the plane the view misses
+  }
+  // The rows whose elevation lies in [lo, hi].
+  void rowsOf(double lo, double hi, int* row_lo, int* row_hi) const {
+    if (planar_) {
+      *row_lo = *row_hi = 0;
+    } else {
+      row_elevation_.find(lo, hi, row_lo, row_hi);
+    }
+  }
+  void prepareRows();
+  // Calls f(first, last) for the column ranges an azimuth window (centre, half width, rad) can
+  // reach; the same ranges as forEachBeamRange or more, computed without wrapping angles for fans
+  // of at most a turn.
+  template <class F>
+  void forEachColumnRange(double center, double half, F&& f) const;
 
   const ScanPattern* pattern_ = nullptr;
   ScanResult* result_ = nullptr;
@@ -113,14 +182,48 @@ class BeamSet {
       sensor_rays_;
   int padded_cols_ = 0;
   std::vector<float> direction_x_, direction_y_, direction_z_;
+  std::vector<float> range_above_;
 
   std::vector<WideBoxRay> box_rays_;
   std::vector<std::uint32_t> ray_stamp_;      // the walk each cached ray was built for
   std::atomic<std::uint32_t> walk_stamp_{0};  // walks of several threads take stamps
   std::vector<int> beam_of_row_;              // the ring of each row
-  std::vector<double> row_elevation_;         // ascending
+  RowTable row_elevation_, row_tan_;          // of the rows, ascending
+  bool column_raster_ = false;
+  std::vector<float> column_cos_, column_sin_, row_cos_, row_sin_;
+  float smallest_row_cos_ = 1;
+  // Columns: the fan's start, increment and the index pad for rounding; one_turn_: the fan spans
+  // at most a turn, so forEachColumnRange needs at most the turns before and after.
+  double col_start_ = 0, col_inv_increment_ = 0, col_turn_ = 0, col_pad_ = 0;
+  bool one_turn_ = false;
   OcclusionTiles tiles_;
 };
+
+template <class F>
+void BeamSet::forEachColumnRange(double center, double half, F&& f) const {
+  if (!one_turn_) {
+    forEachBeamRange(*pattern_, wrapToTurn(center - half - col_start_), 2 * half, f);
+    return;
+  }
+  // In units of columns from the first beam; the window is [s, s + w], s reduced into [0, turn).
+  double s = (center - half - col_start_) * col_inv_increment_;
+  const double w = 2 * half * col_inv_increment_;
+  s -= col_turn_ * floorToInt(s / col_turn_);
+  const int last_col = cols() - 1;
+  // The turn before (a window starting just below a whole turn, reduced to just above 0).
+  if (s <= col_pad_) {
+    const int before = std::max(0, ceilToInt(s - col_pad_ + col_turn_));
+    if (before <= last_col) f(before, last_col);
+  }
+  const int first = std::max(0, ceilToInt(s - col_pad_));
+  const int last = std::min(last_col, floorToInt(std::min(s + w + col_pad_, col_turn_ + cols())));
+  if (first <= last) f(first, last);
+  // The turn after (a window past the fan's end that wraps to its start).
+  if (s + w + col_pad_ >= col_turn_) {
+    const int wrapped = std::min(last_col, floorToInt(s + w + col_pad_ - col_turn_));
+    if (wrapped >= 0) f(0, wrapped);
+  }
+}
 
 template <class F>
 void BeamSet::forEachRect(const View& view, const BeamRect& within, F&& f) const {
@@ -142,18 +245,20 @@ void BeamSet::forEachRect(const View& view, const BeamRect& within, F&& f) const
 
 template <class F>
 void BeamSet::forEachChildRect(const NodeViews& views, int k, const BeamRect& within, F&& f) const {
-  View view;
-  view.near = views.near[k];
-  view.crosses = true;  // NodeViews::mask already holds the plane test
-  view.azimuth_limited = views.az_half[k] >= 0;
-  if (view.azimuth_limited) {
-    view.azimuth_start =
-        wrapToTurn(double(views.az_center[k]) - views.az_half[k] - pattern_->angleMin());
-    view.azimuth_width = 2.0 * views.az_half[k];
+  int row_lo = 0, row_hi = 0;
+  if (!planar_) rowsOf(views.el_lo[k], views.el_hi[k], &row_lo, &row_hi);
+  row_lo = std::max(row_lo, within.row_lo);
+  row_hi = std::min(row_hi, within.row_hi);
+  if (row_lo > row_hi) return;
+  if (!(views.az_half[k] >= 0)) {
+    f(BeamRect{row_lo, row_hi, within.col_lo, within.col_hi});
+    return;
   }
-  view.elevation_lo = planar_ ? -M_PI / 2 : views.el_lo[k];
-  view.elevation_hi = planar_ ? M_PI / 2 : views.el_hi[k];
-  forEachRect(view, within, f);
+  forEachColumnRange(views.az_center[k], views.az_half[k], [&](int first, int last) {
+    const BeamRect rect{row_lo, row_hi, std::max(first, within.col_lo),
+                        std::min(last, within.col_hi)};
+    if (!rect.empty()) f(rect);
+  });
 }
 
 template <class Make>
@@ -180,6 +285,7 @@ bool BeamSet::offer(int row, int col, double t, int body, int triangle, Normal&&
   hit_body = body;
   hit_triangle = triangle;
   if (with_normals_) result_->normal[i] = normal();
+  range_above_[row * padded_cols_ + col] = floatAbove(t);
   tiles_.touched(row, col);
   return true;
 }

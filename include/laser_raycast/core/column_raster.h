@@ -1,0 +1,104 @@
+// Which beams of a rectangle of the beam grid may hit one triangle, column by column: the cost
+// grows with the columns and the beams inside, not with the rectangle's area.
+//
+// Every beam starts at the sensor, so beam d passes through triangle (a, b, c) (sensor frame)
+// exactly where m.d >= 0 for the three edge planes through the sensor, m = b x c, c x a, a x b
+// (oriented inwards). A beam of elevation E and azimuth A is d = (cos E cos A, cos E sin A, sin E);
+// dividing m.d by cos E > 0 leaves h(A) + m_z tan E with h(A) = m_x cos A + m_y sin A, linear in
+// tan E. So in each column every edge bounds tan E from one side, and the beams inside are the rows
+// whose tan E lies between the bounds: two look-ups per column. All of it is in float with a
+// margin far above its rounding (the normals are scaled to |m|_1 = 1), so every beam the exact
+// test could hit is let through, and the exact test decides.
+//
+// A beam is also held back when its current range is clearly nearer than the triangle's plane
+// along it (t = |n.a| / |n.d| for the plane's normal n): such a hit could not be kept.
+#pragma once
+
+#include <emmintrin.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "laser_raycast/core/beam_set.h"
+
+namespace laser_raycast {
+namespace core {
+
+class ColumnRaster {
+ public:
+  // a, b, c in the sensor frame. The pattern's rows must allow it (BeamSet::columnRaster()).
+  ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+               const Eigen::Vector3d& c);
+
+  // Calls f(row, col) for every beam of rect that may hit the triangle nearer than its current
+  // range, column by column.
+  template <class F>
+  void forEachCandidate(const BeamSet& beams, const BeamRect& rect, F&& f) const;
+
+ private:
+  // The margin of every float test, relative to the scaled normals: the rounding of a dot
+  // product of float normals and float directions is a few 1e-7, tan E's up to tan 80 degrees
+  // (BeamSet::kMaxColumnRasterElevation) a few times that.
+  static constexpr float kMargin = 1e-5f;
+
+  bool all_ = false;  // seen edge-on, or too small for float: every beam of the rect is a candidate
+  // Per edge: (m_x, m_y) scaled, and what the bound on tan E does: lower (m_z > 0), upper
+  // (m_z < 0) or nothing (m_z = 0: the edge decides by h(A) alone).
+  __m128 mx_[3], my_[3], inv_mz_[3], lower_[3], upper_[3], flat_[3];
+  __m128 edge_margin_;  // the margin over the smallest cos E of the pattern
+  // The plane: normal (scaled), |n.a| rounded down.
+  __m128 nx_, ny_;
+  float nz_, plane_distance_;
+};
+
+template <class F>
+void ColumnRaster::forEachCandidate(const BeamSet& beams, const BeamRect& rect, F&& f) const {
+  if (all_) {
+    for (int col = rect.col_lo; col <= rect.col_hi; ++col) {
+      for (int row = rect.row_lo; row <= rect.row_hi; ++row) f(row, col);
+    }
+    return;
+  }
+  const float* cos_a = beams.columnCos();
+  const float* sin_a = beams.columnSin();
+  const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  for (int base = rect.col_lo & ~3; base <= rect.col_hi; base += 4) {
+    const __m128 ca = _mm_loadu_ps(cos_a + base), sa = _mm_loadu_ps(sin_a + base);
+    __m128 lo = _mm_sub_ps(_mm_setzero_ps(), inf), hi = inf;
+    for (int k = 0; k < 3; ++k) {
+      const __m128 h = _mm_add_ps(_mm_mul_ps(mx_[k], ca), _mm_mul_ps(my_[k], sa));
+      // h + m_z tan E >= -margin  <=>  tan E >= or <= (-margin - h) / m_z.
+      const __m128 bound =
+          _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_setzero_ps(), edge_margin_), h), inv_mz_[k]);
+      lo = _mm_max_ps(lo, _mm_or_ps(_mm_and_ps(lower_[k], bound), _mm_andnot_ps(lower_[k], lo)));
+      hi = _mm_min_ps(hi, _mm_or_ps(_mm_and_ps(upper_[k], bound), _mm_andnot_ps(upper_[k], hi)));
+      // A flat edge (m_z = 0) keeps a column only if h >= -margin.
+      const __m128 out =
+          _mm_and_ps(flat_[k], _mm_cmplt_ps(h, _mm_sub_ps(_mm_setzero_ps(), edge_margin_)));
+      lo = _mm_or_ps(_mm_and_ps(out, inf), _mm_andnot_ps(out, lo));
+    }
+    alignas(16) float lo_v[4], hi_v[4], hn_v[4];
+    _mm_store_ps(lo_v, lo);
+    _mm_store_ps(hi_v, hi);
+    _mm_store_ps(hn_v, _mm_add_ps(_mm_mul_ps(nx_, ca), _mm_mul_ps(ny_, sa)));
+    const int first = std::max(base, rect.col_lo), last = std::min(base + 3, rect.col_hi);
+    for (int col = first; col <= last; ++col) {
+      const int j = col - base;
+      if (!(lo_v[j] <= hi_v[j])) continue;
+      int row_lo, row_hi;
+      beams.rowsWithTan(lo_v[j], hi_v[j], &row_lo, &row_hi);
+      row_lo = std::max(row_lo, rect.row_lo);
+      row_hi = std::min(row_hi, rect.row_hi);
+      for (int row = row_lo; row <= row_hi; ++row) {
+        // Written so that a NaN range (a beam that could not be cast) is never held back.
+        const float along =
+            std::abs(beams.rowCos(row) * hn_v[j] + nz_ * beams.rowSin(row)) + kMargin;
+        if (plane_distance_ > beams.rangeAbove(row)[col] * along) continue;
+        f(row, col);
+      }
+    }
+  }
+}
+
+}  // namespace core
+}  // namespace laser_raycast

@@ -1,0 +1,18 @@
+// A URDF primitive (box, cylinder, sphere) against the open beams of a rectangle of the scan: four
+// beams at a time through a conservative float test on the primitive's box, then the analytic
+// test (primitives.h) for the beams let through.
+#pragma once
+
+#include "laser_raycast/core/beam_set.h"
+#include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/scene.h"
+
+namespace laser_raycast {
+namespace core {
+
+// Casts the open beams of rect against the primitive body active.index of scene.
+void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& active,
+                   const CastConfig& config, const BeamRect& rect);
+
+}  // namespace core
+}  // namespace laser_raycast
