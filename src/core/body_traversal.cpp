@@ -62,8 +62,7 @@ class MeshWalk {
                               beams_.pattern().angleMin(), !planar_);
     if (!(view.near <= config_.tmax)) return;
     top_ = 0;
-    const Entry root{wide_.root(), BeamRect{}, static_cast<float>(view.near),
-                     wide_.rootTriangles()};
+    const Entry root{wide_.root(), BeamRect{}, floatBelow(view.near), wide_.rootTriangles()};
     beams_.forEachRect(view, within, [&](const BeamRect& rect) {
       Entry e = root;
       e.rect = rect;

@@ -229,7 +229,53 @@ float floatAtMost(double x) {
 }
 float floatAtLeast(double x) { return -floatAtMost(-x); }
 
+// The builder's tree as BvhT stores it: inner nodes depth first, each holding its children's boxes
+// (rounded outward to float); the two children of a node get adjacent indices.
+template <typename T>
+typename BvhT<T>::Tree writeTree(const std::vector<BuildNode>& tree) {
+  using Child = typename BvhT<T>::Child;
+  typename BvhT<T>::Tree out;
+  out.bounds = castBounds<T>(tree[0].bounds);
+  if (tree[0].count > 0) {
+    out.root = Child{tree[0].first, tree[0].count};
+    return out;
+  }
+  out.nodes.reserve(tree.size() / 2);
+  out.nodes.emplace_back();
+  out.root = Child{0, 0};
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> todo{{0, 0}};  // (build node, node)
+  while (!todo.empty()) {
+    const auto [from, to] = todo.back();
+    todo.pop_back();
+    for (int k = 0; k < 2; ++k) {
+      const std::uint32_t build_child = tree[from].first + k;
+      const BuildNode& child = tree[build_child];
+      Child ref{child.first, child.count};
+      if (child.count == 0) {
+        ref.index = static_cast<std::uint32_t>(out.nodes.size());
+        out.nodes.emplace_back();
+        todo.emplace_back(build_child, ref.index);
+      }
+      auto& node = out.nodes[to];
+      node.child[k] = ref;
+      for (int a = 0; a < 3; ++a) {
+        node.lo[k][a] = floatAtMost(child.bounds.lo[a]);
+        node.hi[k][a] = floatAtLeast(child.bounds.hi[a]);
+      }
+    }
+  }
+  return out;
+}
+
 }  // namespace
+
+template <typename T>
+void BvhT<T>::adoptTree(Tree tree, int depth) {
+  nodes_ = std::move(tree.nodes);
+  root_ = tree.root;
+  bounds_ = tree.bounds;
+  depth_ = depth;
+}
 
 void BvhConfig::validate() const {
   std::ostringstream msg;
@@ -283,39 +329,7 @@ BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
   }
   Builder builder(build_tris, config, build_groups);
   builder.run();
-  bvh.depth_ = builder.depth();
-  const std::vector<BuildNode>& tree = builder.nodes();
-  bvh.bounds_ = castBounds<T>(tree[0].bounds);
-  // Inner nodes depth first, each holding its children's boxes; the two children of a node get
-  // adjacent indices.
-  if (tree[0].count > 0) {
-    bvh.root_ = Child{tree[0].first, tree[0].count};
-  } else {
-    bvh.nodes_.reserve(tree.size() / 2);
-    bvh.nodes_.emplace_back();
-    bvh.root_ = Child{0, 0};
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> todo{{0, 0}};  // (build node, node)
-    while (!todo.empty()) {
-      const auto [from, to] = todo.back();
-      todo.pop_back();
-      for (int k = 0; k < 2; ++k) {
-        const std::uint32_t build_child = tree[from].first + k;
-        const BuildNode& child = tree[build_child];
-        Child ref{child.first, child.count};
-        if (child.count == 0) {
-          ref.index = static_cast<std::uint32_t>(bvh.nodes_.size());
-          bvh.nodes_.emplace_back();
-          todo.emplace_back(build_child, ref.index);
-        }
-        Node& node = bvh.nodes_[to];
-        node.child[k] = ref;
-        for (int a = 0; a < 3; ++a) {
-          node.lo[k][a] = floatAtMost(child.bounds.lo[a]);
-          node.hi[k][a] = floatAtLeast(child.bounds.hi[a]);
-        }
-      }
-    }
-  }
+  bvh.adoptTree(writeTree<T>(builder.nodes()), builder.depth());
   bvh.triangle_ids_.reserve(build_tris.size());
   bvh.vertices_.reserve(build_tris.size());
   for (const std::uint32_t i : builder.order()) {
@@ -324,6 +338,25 @@ BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
     bvh.vertices_.push_back(
         {vertices[tri[0]].cast<T>(), vertices[tri[1]].cast<T>(), vertices[tri[2]].cast<T>()});
   }
+  return bvh;
+}
+
+template <typename T>
+BvhT<T> BvhT<T>::buildOverBoxes(const std::vector<Aabb>& boxes, const BvhConfig& config) {
+  config.validate();
+  std::vector<BuildTriangle> items;
+  std::vector<std::uint32_t> kept;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    if (boxes[i].empty()) continue;
+    items.push_back(BuildTriangle{boxes[i], boxes[i].center()});
+    kept.push_back(static_cast<std::uint32_t>(i));
+  }
+  BvhT<T> bvh;
+  if (items.empty()) return bvh;
+  Builder builder(items, config, {});
+  builder.run();
+  bvh.adoptTree(writeTree<T>(builder.nodes()), builder.depth());
+  for (const std::uint32_t i : builder.order()) bvh.triangle_ids_.push_back(kept[i]);
   return bvh;
 }
 

@@ -10,6 +10,7 @@
 #include "laser_raycast/core/beam_window.h"
 #include "laser_raycast/core/body_traversal.h"
 #include "laser_raycast/core/pose.h"
+#include "laser_raycast/core/scene_walk.h"
 #include "laser_raycast/core/thread_pool.h"
 
 namespace laser_raycast {
@@ -94,7 +95,7 @@ const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
               config.compute_incidence);
   if (!sensor_ok) return result_;
 
-  prepareBodies(scene, key, pattern, config);
+  placeGroups(scene, key, pattern);
   castBodies(scene, pattern, config);
   if (config.compute_incidence) computeIncidence(pattern);
   previous_ = std::move(key);
@@ -141,71 +142,39 @@ void Caster::resetResult(int beams, int bodies, bool sensor_ok, bool with_normal
   result_.stats.bodies = bodies;
 }
 
-// Each body's pose relative to the sensor, then culled by its bounding sphere against the search
-// interval and by its box's view against the scan plane (planar fans) and the pattern's beams; the
-// rest sorted nearest first.
-void Caster::prepareBodies(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,
-                           const CastConfig& config) {
-  const bool planar = pattern.planar();
-  const auto& bodies = scene.bodies();
-  active_.clear();
-  for (std::size_t b = 0; b < bodies.size(); ++b) {
-    const Body& body = bodies[b];
-    if (!key.valid[body.frame]) {
-      ++result_.stats.bodies_skipped;
-      continue;
-    }
-    const int index = static_cast<int>(b);
-    const Eigen::Isometry3d sensor_from_body =
-        key.sensor_from_frame[body.frame] * body.frame_from_body;
-    // The sphere first: a cheap answer for bodies out of range.
-    const Eigen::Vector3d center = sensor_from_body * scene.sphereCenter(index);
-    const double radius = scene.sphereRadius(index);
-    const double dist = center.norm();
-    const double slack = kWindowSlack * (dist + radius + config.tmax);
-    if (dist - radius > config.tmax + slack || dist + radius < config.tmin - slack) {
-      ++result_.stats.bodies_culled;
-      continue;
-    }
-    const Eigen::Matrix3d& rot = sensor_from_body.linear();
-    const View view = boxView(scene.boxCenter(index), scene.boxHalf(index), rot, rot.cwiseAbs(),
-                              sensor_from_body.translation(), pattern.angleMin(), !planar);
-    bool culled = !(view.near <= config.tmax) || (planar && !view.crosses);
-    if (!culled && view.azimuth_limited) {
-      bool any = false;
-      forEachBeamRange(pattern, view.azimuth_start, view.azimuth_width,
-                       [&](int, int) { any = true; });
-      culled = !any;
-    }
-    if (culled) {
-      ++result_.stats.bodies_culled;
-      continue;
-    }
-    ActiveBody a;
-    a.index = index;
-    a.sensor_from_body = sensor_from_body;
-    a.body_from_sensor_rot = rot.transpose();
-    a.sensor_in_body = -(a.body_from_sensor_rot * sensor_from_body.translation());
-    a.center = center;
-    a.radius = radius;
-    a.view = view;
-    active_.push_back(a);
+// Where each frame's body tree is this scan, nearest first; the bodies of frames without a pose
+// are skipped.
+void Caster::placeGroups(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern) {
+  if (!index_ || index_->sceneVersion() != scene.version()) {
+    index_ = std::make_unique<SceneIndex>(scene);
   }
-  // Nearest first: a beam that has already hit something nearer than a body can be skips it, so
-  // bodies hidden behind nearer ones cost a comparison per beam of their window.
-  std::sort(active_.begin(), active_.end(),
-            [](const ActiveBody& x, const ActiveBody& y) { return x.view.near < y.view.near; });
+  placed_.clear();
+  for (const auto& group : index_->groups()) {
+    if (!key.valid[group->frame]) {
+      result_.stats.bodies_skipped += static_cast<int>(group->bodies.size());
+      continue;
+    }
+    const Eigen::Isometry3d& pose = key.sensor_from_frame[group->frame];
+    const Aabb& bounds = group->tree.bounds();
+    const View view =
+        boxView(bounds.center(), bounds.extent() * 0.5, pose.linear(), pose.linear().cwiseAbs(),
+                pose.translation(), pattern.angleMin(), !pattern.planar());
+    placed_.push_back(PlacedGroup{group.get(), &pose, view.near});
+  }
+  std::stable_sort(placed_.begin(), placed_.end(),
+                   [](const PlacedGroup& a, const PlacedGroup& b) { return a.near < b.near; });
 }
 
-// Every active body, nearest first, against the open beams of its window (body_traversal.h); with
-// threads, each thread takes pieces of the pattern's columns (all rows) in turn.
+// Every frame's bodies, nearest frame first, against the open beams of the pattern; with threads,
+// each thread takes pieces of the pattern's columns (all rows) in turn.
 void Caster::castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config) {
   beams_->reset(pattern, config, &result_);
+  const std::size_t bodies = scene.bodies().size();
+  if (cast_.size() != bodies) cast_ = std::vector<std::atomic<char>>(bodies);
+  for (auto& mark : cast_) mark.store(0, std::memory_order_relaxed);
   auto castWithin = [&](const BeamRect& within) {
-    for (const ActiveBody& a : active_) {
-      beams_->forEachRect(a.view, within, [&](const BeamRect& rect) {
-        if (beams_->anyOpen(rect, a.view.near)) castBody(*beams_, scene, a, config, rect);
-      });
+    for (const PlacedGroup& p : placed_) {
+      castGroup(*beams_, scene, *p.group, *p.sensor_from_frame, config, within, &cast_);
     }
   };
   int threads = config.threads;
@@ -214,18 +183,21 @@ void Caster::castBodies(const Scene& scene, const ScanPattern& pattern, const Ca
   threads = std::max(1, std::min(threads, pattern.size() / kMinBeamsPerThread));
   if (threads == 1) {
     castWithin(beams_->all());
-    return;
+  } else {
+    if (!pool_ || pool_->threads() != threads) pool_ = std::make_unique<ThreadPool>(threads);
+    const int columns = pattern.azimuthCount();
+    const int width = chunkColumns(columns, threads);
+    const int pieces = (columns + width - 1) / width;
+    pool_->run(pieces, [&](int i) {
+      BeamRect piece = beams_->all();
+      piece.col_lo = i * width;
+      piece.col_hi = std::min(columns - 1, piece.col_lo + width - 1);
+      castWithin(piece);
+    });
   }
-  if (!pool_ || pool_->threads() != threads) pool_ = std::make_unique<ThreadPool>(threads);
-  const int columns = pattern.azimuthCount();
-  const int width = chunkColumns(columns, threads);
-  const int pieces = (columns + width - 1) / width;
-  pool_->run(pieces, [&](int i) {
-    BeamRect piece = beams_->all();
-    piece.col_lo = i * width;
-    piece.col_hi = std::min(columns - 1, piece.col_lo + width - 1);
-    castWithin(piece);
-  });
+  int cast = 0;
+  for (const auto& mark : cast_) cast += mark.load(std::memory_order_relaxed);
+  result_.stats.bodies_culled = static_cast<int>(bodies) - result_.stats.bodies_skipped - cast;
 }
 
 void Caster::computeIncidence(const ScanPattern& pattern) {

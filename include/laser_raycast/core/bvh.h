@@ -76,6 +76,11 @@ class BvhT {
                     const std::vector<TriangleIndices>& triangles, const BvhConfig& config = {},
                     const std::vector<std::uint32_t>& groups = {});
 
+  // A tree over boxes instead of triangles (the bodies of a frame, the segments of a slice): the
+  // same build; triangleIds() holds the boxes' indices in leaf order and triangleVertices() is
+  // empty, so only visit() and the node arrays apply. Empty boxes are left out.
+  static BvhT buildOverBoxes(const std::vector<Aabb>& boxes, const BvhConfig& config = {});
+
   // The inner nodes, depth first (a parent before its children); the tree starts at root().
   const std::vector<Node>& nodes() const { return nodes_; }
   Child root() const { return root_; }
@@ -85,7 +90,7 @@ class BvhT {
   const std::vector<std::array<Vec3<T>, 3>>& triangleVertices() const { return vertices_; }
   // The exact bounds of every stored vertex.
   const AabbT<T>& bounds() const { return bounds_; }
-  bool empty() const { return vertices_.empty(); }
+  bool empty() const { return triangle_ids_.empty(); }
   int depth() const { return depth_; }
 
   // Nearest hit with t in [ray.tmin, ray.tmax], by method M.
@@ -105,6 +110,17 @@ class BvhT {
  private:
   template <TriangleMethod M, bool kAnyHit>
   std::optional<MeshHitT<T>> traverse(const RayT<T>& ray, bool cull_backfaces) const;
+
+ public:
+  // The nodes, root and bounds a build produces (bvh.cpp).
+  struct Tree {
+    std::vector<Node> nodes;
+    Child root{0, 0};
+    AabbT<T> bounds;
+  };
+
+ private:
+  void adoptTree(Tree tree, int depth);
 
   std::vector<Node> nodes_;
   Child root_{0, 0};

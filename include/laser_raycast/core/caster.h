@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -13,6 +14,7 @@
 #include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scene.h"
+#include "laser_raycast/core/scene_index.h"
 #include "laser_raycast/core/triangle.h"
 
 namespace laser_raycast {
@@ -43,7 +45,9 @@ struct CastConfig {
 struct CastStats {
   int bodies = 0;          // bodies in the scene
   int bodies_skipped = 0;  // frame pose unknown this scan
-  int bodies_culled = 0;   // bounding sphere beyond range, outside the fan, or off the scan plane
+  // Bodies not cast against: beyond the range, outside the pattern's windows, off the scan plane
+  // (planar fans), or hidden behind nearer hits.
+  int bodies_culled = 0;
   bool reused = false;  // nothing moved relative to the sensor: the previous geometry was returned
 };
 
@@ -116,16 +120,24 @@ class Caster {
                           const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
                           const CastConfig& config) const;
   void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals);
-  void prepareBodies(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,
-                     const CastConfig& config);
+  // The scene's frames with bodies this scan, nearest first, each with its pose in the sensor
+  // frame; the bodies on unknown frames are counted as skipped.
+  struct PlacedGroup {
+    const SceneIndex::Group* group;
+    const Eigen::Isometry3d* sensor_from_frame;
+    double near;
+  };
+  void placeGroups(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern);
   void castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config);
   void computeIncidence(const ScanPattern& pattern);
 
   ScanResult result_;
-  std::vector<ActiveBody> active_;
-  std::unique_ptr<BeamSet> beams_;    // the walk's per-scan state, kept to reuse its memory
-  std::unique_ptr<ThreadPool> pool_;  // for CastConfig::threads > 1, kept between casts
-  std::optional<ReuseKey> previous_;  // the inputs of result_, if it is complete
+  std::unique_ptr<SceneIndex> index_;  // the scene's body trees, rebuilt when the scene changes
+  std::vector<PlacedGroup> placed_;
+  std::vector<std::atomic<char>> cast_;  // per body: cast against this scan (for the stats)
+  std::unique_ptr<BeamSet> beams_;       // the walk's per-scan state, kept to reuse its memory
+  std::unique_ptr<ThreadPool> pool_;     // for CastConfig::threads > 1, kept between casts
+  std::optional<ReuseKey> previous_;     // the inputs of result_, if it is complete
 };
 
 }  // namespace core
