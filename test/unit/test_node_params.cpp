@@ -287,7 +287,7 @@ TEST(NodeParams, OutOfRangeValuesNameTheParameterAndTheValue) {
 }
 
 TEST(NodeParams, TheLimitsThemselvesAreAccepted) {
-  expectAccepted(values({{"rate", NodeParams::kMaxRate}}));
+  expectAccepted(values({{"rate", laser_raycast::SensorParams::kMaxRate}}));
   expectAccepted(values({{"tf_timeout", NodeParams::kMaxTfTimeout}}));
   expectAccepted(values({{"tf_timeout", 0}}));
   expectAccepted(values({{"threads", 0}}));  // every core
