@@ -227,6 +227,19 @@ po::options_description flags(Args* args) {
   return options;
 }
 
+// A message of the core's validate() under the flag it is about: the core's messages start with
+// the field's name, and the flag that sets a field is named after it (range_min: --range-min). One
+// that starts with no flag's field goes under beams_from, the flag the beam count came from (""
+// for the default): the core's "give exactly one of angle_increment and samples" for a 0, which
+// FanSpec reads as unset, and the beam count of all rings together.
+std::string underItsFlag(const std::string& message, const std::string& beams_from) {
+  std::string flag = message.substr(0, message.find_first_of(" (["));
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  Args unused;
+  if (!flags(&unused).find_nothrow(flag, false)) flag = beams_from;
+  return flag.empty() ? message : "--" + flag + ": " + message;
+}
+
 // Throws ArgError.
 Args parseArgs(int argc, char** argv, bool* help) {
   Args args;
@@ -238,13 +251,12 @@ Args parseArgs(int argc, char** argv, bool* help) {
   if (!values.count("sensor")) throw ArgError("--sensor is required");
   if (has_samples && has_increment) throw ArgError("give --samples or --angle-increment, not both");
   if (!has_samples && !has_increment) args.scan.fan.samples = 360;
-  if (!(args.scan.output.range_min >= 0)) throw ArgError("--range-min must be >= 0");
-  if (!(args.scan.output.range_max > args.scan.output.range_min))
-    throw ArgError("--range-max must be greater than --range-min");
+  // The angles, the beam count, the range limits and the elevations: checked once, by the core.
+  const char* beams_from = has_samples ? "samples" : has_increment ? "angle-increment" : "";
   try {
     args.scan.validate();
   } catch (const std::invalid_argument& e) {
-    throw ArgError(e.what());
+    throw ArgError(underItsFlag(e.what(), beams_from));
   }
   return args;
 }

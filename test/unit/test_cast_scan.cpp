@@ -401,13 +401,16 @@ TEST(CastScan, BadArgumentsExitTwo) {
   expectBadArguments(model + "--sensor 0,0,0", "--sensor");
   expectBadArguments(model + "--sensor 0,0,0,0,0,nan", "--sensor");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --bogus 1", "--bogus");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples 1", "samples");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples 1", "--samples: samples");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples ten", "--samples");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples 10 --angle-increment 0.1", "not both");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-increment -0.1", "angle_increment");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-min 1 --angle-max 0", "angle_max");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min 2 --range-max 1", "--range-max");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min -1", "--range-min");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-increment -0.1",
+                     "--angle-increment: angle_increment");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-min 1 --angle-max 0",
+                     "--angle-max: angle_max");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min 2 --range-max 1",
+                     "--range-max: range_max (1 m)");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min -1", "--range-min: range_min");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --geometry hull", "--geometry");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --method fast", "--method");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint elbow=1", "elbow");
@@ -422,7 +425,8 @@ TEST(CastScan, BadArgumentsExitTwo) {
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,,0.2", "--elevations: ''");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,", "--elevations: ''");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,0.1", "distinct");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0,2", "elevations[1]");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0,2",
+                     "--elevations: elevations[1]");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0 --elevations 1", "--elevations");
 }
 
