@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "laser_raycast/core/scan_spec.h"
+#include "laser_raycast/loader/scene_loader.h"
 #include "run_command.h"
 
 namespace laser_raycast_test {
@@ -374,6 +376,38 @@ TEST(CastScan, HelpListsEveryFlag) {
         "--repeat", "--threads", "Exit status"}) {
     EXPECT_NE(run.out.find(flag), std::string::npos) << flag << "\n" << run.out;
   }
+}
+
+// "a|b|c": a name table's entries, as the synopsis lists a flag's choices.
+template <typename E, std::size_t N>
+std::string choices(const laser_raycast::core::EnumNames<E, N>& names) {
+  std::string out;
+  for (const auto& entry : names.entries())
+    out += (out.empty() ? "" : "|") + std::string(entry.second);
+  return out;
+}
+
+// The synopsis lists the choices of the core's and the loader's name tables, and the notes give
+// their defaults, so that neither can go stale when a table or a default changes.
+TEST(CastScan, HelpTakesChoicesAndDefaultsFromTheLibraries) {
+  const CliRun run = runCli("--help");
+  ASSERT_EQ(run.status, 0);
+  EXPECT_NE(run.out.find("[--method " + choices(laser_raycast::core::kTriangleMethodNames) + "]"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("[--geometry " + choices(laser_raycast::kGeometrySourceNames) + "]"),
+            std::string::npos)
+      << run.out;
+  const laser_raycast::core::ScanSpec defaults;
+  std::ostringstream ranges;
+  ranges << "ranges " << defaults.output.range_min << ".." << defaults.output.range_max << " m";
+  EXPECT_NE(run.out.find(ranges.str()), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(std::string("method ") + toString(defaults.method)), std::string::npos)
+      << run.out;
+  EXPECT_NE(
+      run.out.find(std::string("geometry ") + toString(laser_raycast::LoaderOptions().geometry)),
+      std::string::npos)
+      << run.out;
 }
 
 TEST(CastScan, ValuesAfterAnEqualsSign) {
