@@ -76,12 +76,15 @@ void readTfTimeout(ParamReader* r, NodeParams* p) {
   }
 }
 
-// ~threads: what core::CastConfig::threads accepts.
+// ~threads: core::CastConfig::validate() holds the bounds, and its message names the value.
 void readThreads(ParamReader* r, NodeParams* p) {
   p->threads = r->integer("threads", p->threads, "");
-  if (p->threads < 0 || p->threads > core::CastConfig::kMaxThreads) {
-    r->fail("threads", "must be in [0, " + std::to_string(core::CastConfig::kMaxThreads) +
-                           "] (0: every core), got " + std::to_string(p->threads));
+  core::CastConfig config;
+  config.threads = p->threads;
+  try {
+    config.validate();
+  } catch (const std::invalid_argument& e) {
+    r->fail("threads", e.what());
   }
 }
 

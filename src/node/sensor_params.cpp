@@ -15,8 +15,8 @@ namespace {
 
 // The beam count comes from exactly one of angle_increment and samples; with neither, from the
 // fallback fan (a preset's, or an entry's defaults) or else kDefaultSamples. The core checks the
-// angles and the beam count.
-void readFan(ParamReader* r, core::FanSpec* fan) {
+// angles and the beam count. Returns the name of the parameter the beam count came from.
+const char* readFan(ParamReader* r, core::FanSpec* fan) {
   fan->angle_min = r->number("angle_min", fan->angle_min, "rad");
   fan->angle_max = r->number("angle_max", fan->angle_max, "rad");
   const bool has_increment = r->has("angle_increment"), has_samples = r->has("samples");
@@ -29,22 +29,32 @@ void readFan(ParamReader* r, core::FanSpec* fan) {
   if (has_increment) {
     fan->angle_increment = r->number("angle_increment", 0.0, "rad");
     fan->samples = 0;
-    if (!(std::isfinite(fan->angle_increment) && fan->angle_increment > 0)) {
-      r->fail("angle_increment",
-              "must be finite and > 0 rad, got " + formatNumber(fan->angle_increment));
-    }
     r->note(r->prefix() + "samples unset (beams from " + r->prefix() + "angle_increment)");
   } else if (has_samples || fan->angle_increment == 0) {
     const int fallback = fan->samples > 0 ? fan->samples : SensorParams::kDefaultSamples;
     fan->samples = r->integer("samples", fallback, "beams");
     fan->angle_increment = 0;
-    if (fan->samples < 2) r->fail("samples", "must be >= 2, got " + std::to_string(fan->samples));
     r->note(r->prefix() + "angle_increment unset (beams from " + r->prefix() + "samples)");
   } else {
     // The fallback's spacing: a preset's (or, in an entry, the private namespace's).
     fan->angle_increment = r->number("angle_increment", fan->angle_increment, "rad");
     r->note(r->prefix() + "samples unset (beams from " + r->prefix() + "angle_increment)");
   }
+  return has_increment || fan->angle_increment != 0 ? "angle_increment" : "samples";
+}
+
+// A message of the core's validate() goes out under the parameter it is about: the core's
+// messages start with the field's name (with an index for one element of a list), and the
+// fields are named as the parameters are ("parameter ~samples: samples must be in [2, 10000000],
+// got 1"). One that starts with no parameter's name goes out under beams_from, the parameter the
+// beam count came from: the core's "give exactly one of angle_increment and samples" for a 0,
+// which FanSpec reads as unset, and the beam count of all rings together.
+void failWithCoreMessage(ParamReader* r, const std::string& message, const char* beams_from) {
+  const std::string field = message.substr(0, message.find_first_of(" ("));
+  const std::string name = field.substr(0, field.find('['));
+  const std::vector<std::string>& known = r->known();
+  const bool is_parameter = std::find(known.begin(), known.end(), name) != known.end();
+  r->fail(is_parameter ? field : beams_from, message);
 }
 
 // ~elevations: one fan per elevation (rad, any order); [0] is a planar scanner.
@@ -168,22 +178,18 @@ void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::st
   readSensorModel(r, s);
   s->frame_id = r->text("frame_id", s->frame_id);
   checkFrame(r, "frame_id", s->frame_id, false);
-  readFan(r, &s->scan.fan);
+  const char* beams_from = readFan(r, &s->scan.fan);
   readElevations(r, &s->scan);
   readOutput(r, &s->scan);
   readRate(r, s);
   readSweep(r, s, warnings);
   readPoseSource(r, s);
-  // The angles and beam count, elevations, ranges, noise and realism through the core's own
-  // validation, which names the field (the fields share the parameters' names).
+  // The angles and beam count, elevations, ranges, noise and realism: checked once, by the core.
   if (r->error().empty()) {
     try {
       s->scan.validate();
     } catch (const std::invalid_argument& e) {
-      const std::string& where = r->prefix();
-      r->failWith("bad parameter" +
-                  (where == "~" ? std::string() : " in " + where.substr(0, where.size() - 1)) +
-                  ": " + e.what());
+      failWithCoreMessage(r, e.what(), beams_from);
     }
   }
   if (s->organized && s->planar()) {

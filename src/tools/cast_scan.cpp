@@ -1,5 +1,5 @@
 // cast_scan: one simulated scan of URDF models from a sensor pose, printed as CSV. Needs no
-// roscore: package:// URIs are resolved through ROS_PACKAGE_PATH. See kSynopsis, flags() and the
+// roscore: package:// URIs are resolved through ROS_PACKAGE_PATH. See synopsis(), flags() and the
 // README.
 #include <algorithm>
 #include <chrono>
@@ -9,6 +9,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -31,21 +32,8 @@ namespace po = boost::program_options;
 constexpr int kExitBadArguments = 2;
 constexpr int kExitBadScene = 3;
 
-const char* const kSynopsis =
-    "usage: cast_scan --urdf PATH[@x,y,z,roll,pitch,yaw] [--urdf ...] --sensor "
-    "x,y,z,roll,pitch,yaw\n"
-    "                 [--angle-min RAD] [--angle-max RAD] [--samples N | --angle-increment RAD]\n"
-    "                 [--range-min M] [--range-max M] [--geometry visual|collision]\n"
-    "                 [--method seed_plane|seed_uv|cramer|moller_trumbore|watertight]\n"
-    "                 [--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n"
-    "                 [--threads N]\n";
-const char* const kNotes =
-    "Prints CSV 'index,angle,range,link' (REP 117: inf, -inf, nan); with --elevations\n"
-    "'index,ring,elevation,angle,range,link' (ring 0 the lowest).\n"
-    "Defaults: angles -pi..pi, 360 samples, ranges 0..30 m, geometry visual, method watertight,\n"
-    "1 thread.\n"
-    "Poses in metres and radians (URDF rpy). Exit status: 0 ok, 2 bad arguments, 3 bad scene\n"
-    "input.\n";
+// Beams when neither --samples nor --angle-increment is given: one a degree over the full turn.
+constexpr int kDefaultSamples = 360;
 
 struct Model {
   std::string path;
@@ -56,10 +44,10 @@ struct Args {
   std::vector<Model> models;
   Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
   core::ScanSpec scan;  // the fan, ranges and method; REP 117 with the default -inf policy
-  GeometrySource geometry = GeometrySource::kVisual;
+  GeometrySource geometry = laser_raycast::LoaderOptions().geometry;
   std::map<std::string, double> joints;
   int repeat = 0;
-  int threads = 1;     // CastConfig::threads: 0 every core
+  int threads = core::CastConfig().threads;  // 0: every core
   bool rings = false;  // --elevations given: one fan per elevation, and the ring columns
 };
 
@@ -200,7 +188,7 @@ po::options_description flags(Args* args) {
       "the longest valid range");
   add("geometry",
       single("NAME", [args](const std::string& v) { args->geometry = parseGeometry(v); }),
-      "visual or collision");
+      ("one of " + laser_raycast::kGeometrySourceNames.list()).c_str());
   add("method",
       single("NAME", [args](const std::string& v) { args->scan.method = parseMethod(v); }),
       "the triangle test");
@@ -222,9 +210,24 @@ po::options_description flags(Args* args) {
              [args](const std::string& v) {
                args->threads = laser_raycast::tools::parseThreads("--threads", v);
              }),
-      "threads a cast uses (default 1; 0: every core); the ranges are the same for any number");
+      ("threads a cast uses (default " + std::to_string(Args().threads) +
+       "; 0: every core); the ranges are the same for any number")
+          .c_str());
   add("help,h", "print this help");
   return options;
+}
+
+// A message of the core's validate() under the flag it is about: the core's messages start with
+// the field's name, and the flag that sets a field is named after it (range_min: --range-min). One
+// that starts with no flag's field goes under beams_from, the flag the beam count came from (""
+// for the default): the core's "give exactly one of angle_increment and samples" for a 0, which
+// FanSpec reads as unset, and the beam count of all rings together.
+std::string underItsFlag(const std::string& message, const std::string& beams_from) {
+  std::string flag = message.substr(0, message.find_first_of(" (["));
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  Args unused;
+  if (!flags(&unused).find_nothrow(flag, false)) flag = beams_from;
+  return flag.empty() ? message : "--" + flag + ": " + message;
 }
 
 // Throws ArgError.
@@ -237,14 +240,13 @@ Args parseArgs(int argc, char** argv, bool* help) {
   if (args.models.empty()) throw ArgError("give at least one --urdf");
   if (!values.count("sensor")) throw ArgError("--sensor is required");
   if (has_samples && has_increment) throw ArgError("give --samples or --angle-increment, not both");
-  if (!has_samples && !has_increment) args.scan.fan.samples = 360;
-  if (!(args.scan.output.range_min >= 0)) throw ArgError("--range-min must be >= 0");
-  if (!(args.scan.output.range_max > args.scan.output.range_min))
-    throw ArgError("--range-max must be greater than --range-min");
+  if (!has_samples && !has_increment) args.scan.fan.samples = kDefaultSamples;
+  // The angles, the beam count, the range limits and the elevations: checked once, by the core.
+  const char* beams_from = has_samples ? "samples" : has_increment ? "angle-increment" : "";
   try {
     args.scan.validate();
   } catch (const std::invalid_argument& e) {
-    throw ArgError(e.what());
+    throw ArgError(underItsFlag(e.what(), beams_from));
   }
   return args;
 }
@@ -255,6 +257,53 @@ std::string formatNumber(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.9g", value);
   return buffer;
+}
+
+// "a|b|c": the names of a table, as the synopsis lists the choices of a flag.
+template <typename E, std::size_t N>
+std::string choices(const core::EnumNames<E, N>& names) {
+  std::string out;
+  for (const auto& entry : names.entries())
+    out += (out.empty() ? "" : "|") + std::string(entry.second);
+  return out;
+}
+
+// An angle of the help text: pi, -pi, or the number.
+std::string formatAngle(double rad) {
+  return rad == M_PI ? "pi" : rad == -M_PI ? "-pi" : formatNumber(rad);
+}
+
+// The usage lines: each flag's choices from its name table.
+std::string synopsis() {
+  const char* const indent = "                 ";
+  std::ostringstream out;
+  out << "usage: cast_scan --urdf PATH[@x,y,z,roll,pitch,yaw] [--urdf ...] "
+      << "--sensor x,y,z,roll,pitch,yaw\n"
+      << indent << "[--angle-min RAD] [--angle-max RAD] [--samples N | --angle-increment RAD]\n"
+      << indent << "[--range-min M] [--range-max M] [--geometry "
+      << choices(laser_raycast::kGeometrySourceNames) << "]\n"
+      << indent << "[--method " << choices(core::kTriangleMethodNames) << "]\n"
+      << indent << "[--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n"
+      << indent << "[--threads N]\n";
+  return out.str();
+}
+
+// The output, the defaults (Args': a ScanSpec's, and kDefaultSamples) and the exit statuses.
+std::string notes() {
+  const Args defaults;
+  const core::ScanSpec& scan = defaults.scan;
+  std::ostringstream out;
+  out << "Prints CSV 'index,angle,range,link' (REP 117: inf, -inf, nan); with --elevations\n"
+      << "'index,ring,elevation,angle,range,link' (ring 0 the lowest).\n"
+      << "Defaults: angles " << formatAngle(scan.fan.angle_min) << ".."
+      << formatAngle(scan.fan.angle_max) << ", " << kDefaultSamples << " samples, ranges "
+      << formatNumber(scan.output.range_min) << ".." << formatNumber(scan.output.range_max)
+      << " m, geometry " << laser_raycast::toString(defaults.geometry) << ", method "
+      << core::toString(scan.method) << ",\n"
+      << defaults.threads << (defaults.threads == 1 ? " thread" : " threads") << ".\n"
+      << "Poses in metres and radians (URDF rpy). Exit status: 0 ok, 2 bad arguments, 3 bad scene\n"
+      << "input.\n";
+  return out.str();
 }
 
 // The models, loaded and placed, with their joints at the given values.
@@ -357,12 +406,12 @@ int main(int argc, char** argv) {
   try {
     args = parseArgs(argc, argv, &help);
   } catch (const ArgError& e) {
-    std::cerr << "cast_scan: " << e.what() << "\n" << kSynopsis << kNotes;
+    std::cerr << "cast_scan: " << e.what() << "\n" << synopsis() << notes();
     return kExitBadArguments;
   }
   if (help) {
     Args unused;
-    std::cout << kSynopsis << "\n" << flags(&unused) << "\n" << kNotes;
+    std::cout << synopsis() << "\n" << flags(&unused) << "\n" << notes();
     return 0;
   }
   LoadedScene loaded;

@@ -53,8 +53,9 @@ void smoke(const std::string& harness, long runs, int duration,
   fs::remove_all(work);
   fs::create_directories(work / "corpus");
   std::string command =
-      kFuzzers + "/" + harness + " -seed=" + std::to_string(seed) + " -runs=" +
-      std::to_string(runs) + " -max_total_time=" + std::to_string(duration) + " -timeout=30 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=" + work.string() +
+      kFuzzers + "/" + harness + " -seed=" + std::to_string(seed) +
+      " -runs=" + std::to_string(runs) + " -max_total_time=" + std::to_string(duration) +
+      " -timeout=30 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=" + work.string() +
       "/ " + (work / "corpus").string();
   for (const std::string& seed : seeds) command += " " + seed;
   // Leaks of libraries outside the package that the harnesses reach (lsan.supp says which).

@@ -1,5 +1,5 @@
-// Where the BVH may differ from brute force (test_bvh, the core fuzz harness): the one documented
-// exception to "the BVH returns exactly what testing every triangle returns".
+// Where the BVH may differ from brute force (the BVH tests, the core fuzz harness): the one
+// documented exception to "the BVH returns exactly what testing every triangle returns".
 #pragma once
 
 #include <algorithm>

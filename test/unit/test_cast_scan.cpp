@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "laser_raycast/core/scan_spec.h"
+#include "laser_raycast/loader/scene_loader.h"
 #include "run_command.h"
 
 namespace laser_raycast_test {
@@ -376,6 +378,38 @@ TEST(CastScan, HelpListsEveryFlag) {
   }
 }
 
+// "a|b|c": a name table's entries, as the synopsis lists a flag's choices.
+template <typename E, std::size_t N>
+std::string choices(const laser_raycast::core::EnumNames<E, N>& names) {
+  std::string out;
+  for (const auto& entry : names.entries())
+    out += (out.empty() ? "" : "|") + std::string(entry.second);
+  return out;
+}
+
+// The synopsis lists the choices of the core's and the loader's name tables, and the notes give
+// their defaults, so that neither can go stale when a table or a default changes.
+TEST(CastScan, HelpTakesChoicesAndDefaultsFromTheLibraries) {
+  const CliRun run = runCli("--help");
+  ASSERT_EQ(run.status, 0);
+  EXPECT_NE(run.out.find("[--method " + choices(laser_raycast::core::kTriangleMethodNames) + "]"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("[--geometry " + choices(laser_raycast::kGeometrySourceNames) + "]"),
+            std::string::npos)
+      << run.out;
+  const laser_raycast::core::ScanSpec defaults;
+  std::ostringstream ranges;
+  ranges << "ranges " << defaults.output.range_min << ".." << defaults.output.range_max << " m";
+  EXPECT_NE(run.out.find(ranges.str()), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(std::string("method ") + toString(defaults.method)), std::string::npos)
+      << run.out;
+  EXPECT_NE(
+      run.out.find(std::string("geometry ") + toString(laser_raycast::LoaderOptions().geometry)),
+      std::string::npos)
+      << run.out;
+}
+
 TEST(CastScan, ValuesAfterAnEqualsSign) {
   const CliRun spaced = runCli("--urdf " + kData + "cli_joints.urdf --sensor 0,0,0,0,0,0" + kFour);
   const CliRun joined = runCli("--urdf=" + kData +
@@ -401,13 +435,16 @@ TEST(CastScan, BadArgumentsExitTwo) {
   expectBadArguments(model + "--sensor 0,0,0", "--sensor");
   expectBadArguments(model + "--sensor 0,0,0,0,0,nan", "--sensor");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --bogus 1", "--bogus");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples 1", "samples");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples 1", "--samples: samples");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples ten", "--samples");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --samples 10 --angle-increment 0.1", "not both");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-increment -0.1", "angle_increment");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-min 1 --angle-max 0", "angle_max");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min 2 --range-max 1", "--range-max");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min -1", "--range-min");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-increment -0.1",
+                     "--angle-increment: angle_increment");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --angle-min 1 --angle-max 0",
+                     "--angle-max: angle_max");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min 2 --range-max 1",
+                     "--range-max: range_max (1 m)");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --range-min -1", "--range-min: range_min");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --geometry hull", "--geometry");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --method fast", "--method");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --joint elbow=1", "elbow");
@@ -422,7 +459,8 @@ TEST(CastScan, BadArgumentsExitTwo) {
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,,0.2", "--elevations: ''");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,", "--elevations: ''");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0.1,0.1", "distinct");
-  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0,2", "elevations[1]");
+  expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0,2",
+                     "--elevations: elevations[1]");
   expectBadArguments(model + "--sensor 0,0,0,0,0,0 --elevations 0 --elevations 1", "--elevations");
 }
 

@@ -273,11 +273,12 @@ TEST(NodeParams, OutOfRangeValuesNameTheParameterAndTheValue) {
       {"default_reflectivity", kInf, {"~default_reflectivity", "got inf"}},
       {"reflectivity", values({{"wall", -1}}), {"~reflectivity/wall", "got -1"}},
       {"reflectivity", values({{"wall", kNan}}), {"~reflectivity/wall", "got nan"}},
-      {"angle_increment", 0.0, {"~angle_increment", "> 0", "got 0"}},
+      // Checked by the core, which names its fields as the parameters are named. FanSpec reads
+      // an angle_increment or samples of 0 as unset, and asks for exactly one of the two.
+      {"angle_increment", 0.0, {"~angle_increment", "angle_increment 0 rad"}},
       {"angle_increment", -0.01, {"~angle_increment", "got -0.01"}},
-      {"samples", 1, {"~samples", ">= 2", "got 1"}},
-      {"samples", 0, {"~samples", "got 0"}},
-      // Checked by the core, which names its fields as the parameters are named.
+      {"samples", 1, {"~samples", "[2, 10000000]", "got 1"}},
+      {"samples", 0, {"~samples", "samples 0)"}},
       {"range_max", -1.0, {"range_max", "-1"}},
       {"range_min", -0.5, {"range_min", "-0.5"}},
       {"noise_stddev", -0.01, {"noise_stddev", "-0.01"}},
@@ -287,7 +288,7 @@ TEST(NodeParams, OutOfRangeValuesNameTheParameterAndTheValue) {
 }
 
 TEST(NodeParams, TheLimitsThemselvesAreAccepted) {
-  expectAccepted(values({{"rate", NodeParams::kMaxRate}}));
+  expectAccepted(values({{"rate", laser_raycast::SensorParams::kMaxRate}}));
   expectAccepted(values({{"tf_timeout", NodeParams::kMaxTfTimeout}}));
   expectAccepted(values({{"tf_timeout", 0}}));
   expectAccepted(values({{"threads", 0}}));  // every core

@@ -3,9 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 
 #include "pose_history.h"
+#include "random.h"
 #include "scan_queue.h"
 #include "tf_timing.h"
 
@@ -45,12 +45,11 @@ TEST(FrameAvailability, TheFourCases) {
 // Whatever the newest data of a transform, a scan waits for it no longer than tf_timeout past its
 // last beam's time: by then it is covered or stale.
 TEST(FrameAvailability, NoWaitOutlastsTheTimeout) {
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> u(0, 2);
+  Rng rng(7);
   for (int i = 0; i < 1000; ++i) {
-    const ros::Time needed = at(1000 + u(rng));
-    const ros::Time latest = at(999 + u(rng));
-    const ros::Duration timeout = secs(u(rng));
+    const ros::Time needed = at(1000 + uniform(rng, 0, 2));
+    const ros::Time latest = at(999 + uniform(rng, 0, 2));
+    const ros::Duration timeout = secs(uniform(rng, 0, 2));
     const ros::Time deadline = needed + timeout + secs(1e-9);
     EXPECT_NE(frameAvailability(latest, needed, deadline, timeout), FrameAvailability::kWaiting)
         << "latest " << latest << " needed " << needed << " timeout " << timeout;

@@ -62,7 +62,7 @@ TEST(MinRangePolicy, StringRoundTrip) {
        {MinRangePolicy::kNegInf, MinRangePolicy::kPassThrough, MinRangePolicy::kNan}) {
     MinRangePolicy parsed =
         p == MinRangePolicy::kNan ? MinRangePolicy::kNegInf : MinRangePolicy::kNan;
-    EXPECT_TRUE(parseMinRangePolicy(toString(p), &parsed)) << toString(p);
+    EXPECT_TRUE(kMinRangePolicyNames.parse(toString(p), &parsed)) << toString(p);
     EXPECT_EQ(parsed, p);
   }
   EXPECT_STREQ(toString(MinRangePolicy::kNegInf), "-inf");
@@ -70,7 +70,7 @@ TEST(MinRangePolicy, StringRoundTrip) {
   EXPECT_STREQ(toString(MinRangePolicy::kNan), "nan");
   MinRangePolicy untouched = MinRangePolicy::kPassThrough;
   for (const char* bad : {"", "inf", "NaN", "pass-through", "-Inf", " nan"}) {
-    EXPECT_FALSE(parseMinRangePolicy(bad, &untouched)) << bad;
+    EXPECT_FALSE(kMinRangePolicyNames.parse(bad, &untouched)) << bad;
     EXPECT_EQ(untouched, MinRangePolicy::kPassThrough);
   }
 }

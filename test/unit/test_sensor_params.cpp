@@ -167,7 +167,7 @@ TEST(SensorParams, BadSensorsEntriesNameTheEntry) {
   expectRefused(two(sensor({{"frame_id", "b"}, {"elevations", list({})}})),
                 {"~sensors[1]/elevations", "empty"});
   expectRefused(two(sensor({{"frame_id", "b"}, {"range_min", 5}, {"range_max", 1}})),
-                {"in ~sensors[1]", "range_max", "1"});
+                {"~sensors[1]/range_max", "(1 m)", "(5 m)"});
   expectRefused(two(sensor({{"frame_id", "b"}, {"name", "b/c"}})), {"~sensors[1]/name", "'b/c'"});
   expectRefused(two(XmlRpcValue("b")), {"~sensors[1]", "'b'", "a dict"});
   expectRefused(values({{"sensors", list({})}}), {"~sensors", "non-empty list"});

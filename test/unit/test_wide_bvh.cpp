@@ -71,7 +71,9 @@ TEST(WideBvh, EverySlotOnceInsideItsBoxes) {
       }
     });
     for (std::size_t slot = 0; slot < seen.size(); ++slot) EXPECT_EQ(seen[slot], 1) << slot;
-    if (n > 100) EXPECT_LT(w.nodes().size(), seen.size());  // four-wide: fewer nodes than slots
+    if (n > 100) {
+      EXPECT_LT(w.nodes().size(), seen.size());  // four-wide: fewer nodes than slots
+    }
   }
 }
 
@@ -221,9 +223,9 @@ TEST(WideRay, LongDirectionsNeverEnterEmptyChildren) {
   const Soup s = spreadSoup(rng, 300);
   const core::Mesh mesh(s.vertices, s.triangles);
   const auto& nodes = mesh.wideBvh().nodes();
-  ASSERT_TRUE(std::any_of(nodes.begin(), nodes.end(),
-                          [](const WideBvh::Node& n) { return n.presentMask() != 0xF; }))
-      << "the case needs a node with an empty child";
+  ASSERT_TRUE(std::any_of(nodes.begin(), nodes.end(), [](const WideBvh::Node& n) {
+    return n.presentMask() != 0xF;
+  })) << "the case needs a node with an empty child";
   int hits = 0;
   for (int i = 0; i < 400; ++i) {
     core::Ray ray;

@@ -5,7 +5,6 @@
 
 #include <cstdint>
 #include <random>
-#include <string>
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
@@ -27,9 +26,6 @@ inline const EnumNames<MinRangePolicy, 3> kMinRangePolicyNames{{{
     {MinRangePolicy::kNan, "nan"},
 }}};
 inline const char* toString(MinRangePolicy policy) { return kMinRangePolicyNames.name(policy); }
-inline bool parseMinRangePolicy(const std::string& name, MinRangePolicy* policy) {
-  return kMinRangePolicyNames.parse(name, policy);
-}
 
 struct EncoderConfig {
   double range_min = 0.0;   // m, >= 0
@@ -89,7 +85,6 @@ class ScanEncoder {
   // A new configuration for the next encode() (e.g. from dynamic_reconfigure): validates it, and
   // restarts both random sequences if noise_seed changed; otherwise they continue.
   void setConfig(const EncoderConfig& config);
-  const EncoderConfig& config() const { return config_; }
 
   // reflectivity is indexed by label (missing entries count as 1); intensity needs
   // result.cos_incidence.

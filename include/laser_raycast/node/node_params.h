@@ -86,8 +86,6 @@ struct SensorParams {
 };
 
 struct NodeParams {
-  static constexpr int kDefaultSamples = SensorParams::kDefaultSamples;
-  static constexpr double kMaxRate = SensorParams::kMaxRate;
   // ~tf_timeout above this is taken for a slip (milliseconds given as seconds): it is how old a
   // scan may be when it is cast, and the TF buffer keeps 10 s.
   static constexpr double kMaxTfTimeout = 10.0;  // s

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <variant>
 
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scene.h"
@@ -19,10 +21,22 @@ TEST(Downstream, UsesTheCore) {
   EXPECT_EQ(pattern.size(), 5);
 }
 
+// SceneLoader::addUrdfString is defined in the loader's library (parseGeometrySource alone is an
+// inline function of its header, which links without the library).
 TEST(Downstream, UsesTheLoader) {
-  laser_raycast::GeometrySource source;
-  EXPECT_TRUE(laser_raycast::parseGeometrySource("collision", &source));
-  EXPECT_EQ(source, laser_raycast::GeometrySource::kCollision);
+  laser_raycast::LoaderOptions options;
+  EXPECT_TRUE(laser_raycast::parseGeometrySource("collision", &options.geometry));
+  EXPECT_EQ(options.geometry, laser_raycast::GeometrySource::kCollision);
+  const std::string urdf =
+      "<robot name=\"r\"><link name=\"l\"><visual><geometry><box size=\"1 1 1\"/></geometry>"
+      "</visual><collision><geometry><sphere radius=\"2\"/></geometry></collision></link></robot>";
+  laser_raycast::SceneLoader loader(nullptr);
+  laser_raycast::core::Scene scene;
+  EXPECT_EQ(loader.addUrdfString(urdf, "", options, &scene).bodies, 1u);
+  ASSERT_EQ(scene.bodies().size(), 1u);
+  const auto* sphere = std::get_if<laser_raycast::core::Sphere>(&scene.bodies()[0].shape);
+  ASSERT_NE(sphere, nullptr);  // the collision element, as options.geometry asks
+  EXPECT_EQ(sphere->radius, 2.0);
 }
 
 // Meshes are read by laser_raycast's importer executable, which the loader finds beside its own
