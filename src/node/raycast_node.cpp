@@ -26,7 +26,7 @@ RaycastNode::~RaycastNode() {
 
 bool RaycastNode::init() {
   std::string error;
-  if (!readNodeParams(pnh_, &params_, &error)) {
+  if (!readNodeParams(nh_, pnh_, &params_, &error)) {
     ROS_FATAL_STREAM(error);
     return false;
   }

@@ -174,6 +174,40 @@ TEST(SensorParams, BadSensorsEntriesNameTheEntry) {
   expectRefused(values({{"sensors", "front"}}), {"~sensors", "non-empty list"});
 }
 
+// Topics are compared as the node advertises them, resolved in its namespace: "scan" and "/scan"
+// are one topic in the root namespace, not in /robot, where "scan" is "/robot/scan".
+TEST(SensorParams, DuplicateTopicsAreFoundAfterResolving) {
+  const auto two = [](const std::string& a, const std::string& b) {
+    return values({{"sensors", list({sensor({{"frame_id", "a"}, {"topic", a}}),
+                                     sensor({{"frame_id", "b"}, {"topic", b}})})}});
+  };
+  expectRefused(two("scan", "/scan"), {"~sensors[1]/topic", "'/scan' publishes on /scan",
+                                       "as ~sensors[0] does ('scan')"});
+  expectRefused(two("/scan", "scan"), {"~sensors[1]/topic", "'scan' publishes on /scan"});
+  expectRefused(two("a//scan/", "/a/scan"), {"~sensors[1]/topic", "/a/scan"});
+  expectAccepted(two("scan", "/scan"), "/robot");
+  expectRefused(two("scan", "/robot/scan"), {"publishes on /robot/scan", "namespace /robot"},
+                "/robot");
+  // The labels' topics too: "/a_labels" is sensor a's labels topic.
+  expectRefused(two("a", "/a_labels"),
+                {"~sensors[1]/topic", "'/a_labels' publishes on /a_labels", "('a_labels')"});
+  // A default topic (a/scan: <name>/scan) against an explicit global one.
+  expectRefused(values({{"sensors", list({sensor({{"frame_id", "a"}}),
+                                          sensor({{"frame_id", "b"}, {"topic", "/a/scan"}})})}}),
+                {"~sensors[1]/topic", "'/a/scan' publishes on /a/scan", "('a/scan')"});
+  EXPECT_THROW(parse(values({}), "robot"), std::invalid_argument);
+}
+
+// A NodeHandle refuses private names: such a topic would stop the node with an exception at
+// start-up, not with a message naming the parameter.
+TEST(SensorParams, PrivateTopicNamesAreRefused) {
+  expectRefused(values({{"sensors", list({sensor({{"frame_id", "a"}, {"topic", "~scan"}})})}}),
+                {"~sensors[0]/topic", "'~scan'", "private"});
+  expectRefused(values({{"pose_topic", "~pose"}}), {"~pose_topic", "'~pose'", "private"});
+  expectRefused(values({{"sensors", list({sensor({{"frame_id", "a"}, {"pose_topic", "~p"}})})}}),
+                {"~sensors[0]/pose_topic", "'~p'", "private"});
+}
+
 TEST(SensorParams, SensorsEntriesWarnAboutUnknownKeysButNotTheirLiveParameters) {
   const Parsed parsed =
       parse(values({{"sensors", list({sensor({{"frame_id", "a"}, {"sampels", 5}})})},
