@@ -115,7 +115,11 @@ bool CastThread::sensorPoses(Sensor& sensor, const ScanJob& job, bool quiet,
   for (std::size_t j = 0; j < job.times.size(); ++j) {
     std::string why;
     bool from_tf;
-    if (!sensor.poseAt(job.times[j], *context_.tf, &(*poses)[j], &why, &from_tf)) {
+    std::uint64_t failures = 0;
+    const bool ok =
+        sensor.poseAt(job.times[j], *context_.tf, &(*poses)[j], &why, &from_tf, &failures);
+    sensor.monitor().lookupFailures(failures);
+    if (!ok) {
       using Skip = SensorMonitor::Skip;
       sensor.monitor().skipped(quiet     ? Skip::kWaiting
                                : from_tf ? Skip::kNoTransform
@@ -157,6 +161,7 @@ void CastThread::castSensor(Sensor& sensor, const ScanJob& job) {
   if (!sensorPoses(sensor, job, quiet, &poses)) return;
   // Looked up once per time for every sensor whose scan needs it.
   const LinkPosesAt links = link_poses_.at(job.times);
+  sensor.monitor().lookupFailures(links.failures);
   if (!acceptMissing(sensor, job, quiet, links)) return;
   sensor.castAndPublish(*context_.scene, *context_.reflectivity, job.times, links.frames, poses,
                         links.missing.size());

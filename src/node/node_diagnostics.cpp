@@ -72,7 +72,7 @@ void NodeDiagnostics::scanStatus(const Sensor& sensor, const SensorStats& previo
   stat.add("Scans skipped: pose topic stale or non-finite", s.skipped.stale_pose);
   stat.add("Scans skipped: waiting for the first transforms", s.skipped.waiting);
   stat.add("Scans skipped: cast thread behind", s.skipped.behind);
-  stat.add("TF look-up failures", s.skipped.no_transform + s.missing_links);
+  stat.add("TF look-up failures", s.tf_failures);
   stat.add("Links left out for want of a transform", s.missing_links);
   // Skips after the start-up wait since the previous report.
   const auto lasting = [](const SensorStats& x) {

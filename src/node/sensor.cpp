@@ -112,17 +112,20 @@ void Sensor::applyLive() {
 }
 
 bool Sensor::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose,
-                    std::string* why, bool* from_tf) {
+                    std::string* why, bool* from_tf, std::uint64_t* tf_failures) {
   // Without a pose topic the sensor is a TF frame like any other; with one, the topic gives the
   // pose of pose_frame, and TF (usually a static mount) the sensor relative to it.
   Eigen::Isometry3d world_from_pose_frame = Eigen::Isometry3d::Identity();
   *from_tf = false;
-  if (pose_topic_ && !pose_topic_->poseAt(t, tf, &world_from_pose_frame, why)) return false;
+  if (pose_topic_ && !pose_topic_->poseAt(t, tf, &world_from_pose_frame, why, tf_failures)) {
+    return false;
+  }
   *from_tf = true;
   const auto [target, source] = tfChain();
   Eigen::Isometry3d target_from_sensor;
   std::string error;
   if (!tf.lookup(target, source, t, &target_from_sensor, &error)) {
+    ++*tf_failures;
     std::ostringstream s;
     s << "no transform from '" << source << "' to '" << target << "' at t = " << std::fixed
       << std::setprecision(3) << t.toSec() << " (" << error << ")";

@@ -7,6 +7,7 @@
 #include <ros/ros.h>
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -58,9 +59,10 @@ class Sensor {
   std::string setLive(const Live& live);
 
   // The sensor pose in fixed_frame at t; false with the reason in *why and whether TF (rather than
-  // the pose topic) lacked it in *from_tf.
+  // the pose topic) lacked it in *from_tf. The TF look-ups it made that failed (its chain, and with
+  // a pose topic the messages' frame) are added to *tf_failures.
   bool poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose, std::string* why,
-              bool* from_tf);
+              bool* from_tf, std::uint64_t* tf_failures);
   // Casts the scan whose pose samples are at `times`, from the frames and sensor poses at each,
   // and publishes it. missing_links: link transforms left out of it.
   void castAndPublish(const core::Scene& scene, const std::vector<double>& reflectivity,

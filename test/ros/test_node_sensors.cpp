@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -222,17 +223,24 @@ TEST(NodeSensors, ARotatingScannerMovingAwayFromAWall) {
   EXPECT_GT(on_wall, 100);
 }
 
-// The status of `name` ("<node>: <task>") in the newest diagnostics that have it.
+// The status whose name ("<node>: <task>") ends in `suffix`, or nullptr.
+const diagnostic_msgs::DiagnosticStatus* statusIn(const diagnostic_msgs::DiagnosticArray& array,
+                                                  const std::string& suffix) {
+  for (const auto& s : array.status) {
+    if (s.name.size() >= suffix.size() &&
+        s.name.compare(s.name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      return &s;
+    }
+  }
+  return nullptr;
+}
+
+// The status of `name` in the newest diagnostics that have it.
 const diagnostic_msgs::DiagnosticStatus* findStatus(
     const std::vector<diagnostic_msgs::DiagnosticArray::ConstPtr>& arrays,
     const std::string& suffix) {
   for (auto a = arrays.rbegin(); a != arrays.rend(); ++a) {
-    for (const auto& s : (*a)->status) {
-      if (s.name.size() >= suffix.size() &&
-          s.name.compare(s.name.size() - suffix.size(), suffix.size(), suffix) == 0) {
-        return &s;
-      }
-    }
+    if (const auto* s = statusIn(**a, suffix)) return s;
   }
   return nullptr;
 }
@@ -278,6 +286,62 @@ TEST(NodeSensors, DiagnosticsPerSensorAndTheIdleOneIsNotCast) {
   const auto* idle = findStatus(arrays, "idle scan rate");
   EXPECT_EQ(idle->message, "not cast: nobody subscribes");
   EXPECT_EQ(values(*idle)["Events since startup"], "0");
+}
+
+// A diagnostics value as a number (NaN with a failure if absent).
+double number(const diagnostic_msgs::DiagnosticStatus& s, const std::string& key) {
+  for (const auto& kv : s.values) {
+    if (kv.key == key) return std::stod(kv.value);
+  }
+  ADD_FAILURE() << s.name << ": no '" << key << "'";
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// The sensors that are cast (someone subscribes), in the closed room.
+const std::vector<std::string> kCast = {"front", "vlp", "spinner"};
+
+// Once the diagnostics' rate window (5 s) is full, each cast sensor achieves its rate within 10 %,
+// and every beam hits (they face the room's walls all round: share 1). Front's transform is
+// static: once it publishes, none of its look-ups fails.
+TEST(NodeSensors, DiagnosticsShowTheRatesMetAndEveryBeamHit) {
+  const auto full = [](const diagnostic_msgs::DiagnosticArray& a) {
+    for (const std::string& sensor : kCast) {
+      const auto* rate = statusIn(a, sensor + " scan rate");
+      if (!rate) return false;
+      for (const auto& kv : rate->values) {
+        if (kv.key == "Duration of window (s)" && std::stod(kv.value) < 4.9) return false;
+      }
+    }
+    return true;
+  };
+  const auto array = rig->waitFor<diagnostic_msgs::DiagnosticArray>(&rig->diagnostics, full, 60.0);
+  ASSERT_TRUE(array) << "no diagnostics with a full rate window for every cast sensor";
+  for (const std::string& sensor : kCast) {
+    const auto* rate = statusIn(*array, sensor + " scan rate");
+    const auto* scans = statusIn(*array, sensor + " scans");
+    ASSERT_TRUE(rate && scans) << sensor;
+    const double actual = number(*rate, "Actual frequency (Hz)");
+    const double target = number(*rate, "Target frequency (Hz)");
+    std::cout << sensor << ": " << actual << " Hz of " << target << " Hz over "
+              << number(*rate, "Duration of window (s)") << " s; share of beams hit "
+              << number(*scans, "Beams hit in the last scan (share)") << "\n";
+    EXPECT_NEAR(actual, target, 0.1 * target) << sensor;
+    EXPECT_EQ(rate->level, diagnostic_msgs::DiagnosticStatus::OK)
+        << sensor << ": " << rate->message;
+    EXPECT_NEAR(number(*scans, "Beams hit in the last scan (share)"), 1.0, 1e-9) << sensor;
+  }
+  EXPECT_EQ(number(*statusIn(*array, "front scan rate"), "Target frequency (Hz)"), 20.0);
+
+  // Two reports later, front has no new failed look-up.
+  const double failures = number(*statusIn(*array, "front scans"), "TF look-up failures");
+  const ros::Time later = array->header.stamp + ros::Duration(2.0);
+  const auto next = rig->waitFor<diagnostic_msgs::DiagnosticArray>(
+      &rig->diagnostics,
+      [&](const diagnostic_msgs::DiagnosticArray& a) { return a.header.stamp >= later; }, 10.0);
+  ASSERT_TRUE(next) << "no diagnostics 2 s later";
+  const auto* front_then = statusIn(*next, "front scans");
+  ASSERT_TRUE(front_then);
+  EXPECT_EQ(number(*front_then, "TF look-up failures"), failures);
 }
 
 // Sets front's range_max through dynamic_reconfigure; returns the values the node replied with.
