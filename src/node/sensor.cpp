@@ -4,15 +4,12 @@
 #include <sensor_msgs/PointCloud2.h>
 
 #include <chrono>
-#include <cmath>
 #include <iomanip>
 #include <sstream>
-#include <stdexcept>
 
 #include "laser_raycast/ScanLabels.h"
 #include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/node/point_cloud.h"
-#include "param_reader.h"
 #include "tf_timing.h"
 
 namespace laser_raycast {
@@ -67,35 +64,14 @@ std::vector<ros::Time> Sensor::sampleTimes(const ros::Time& stamp) const {
 
 Sensor::Live Sensor::live() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return Live{params_.scan.output, params_.rate};
+  return liveParams(params_);
 }
 
 std::string Sensor::setLive(const Live& live) {
-  SensorParams next;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    next = params_;
-  }
-  next.scan.output = live.output;
-  next.rate = live.rate;
-  if (!(std::isfinite(live.rate) && live.rate > 0 && live.rate <= SensorParams::kMaxRate)) {
-    return "rate must be in (0, " + formatNumber(SensorParams::kMaxRate) + "] Hz, got " +
-           formatNumber(live.rate);
-  }
-  if (next.sweep == Sweep::kRotating && next.scan_time > 1.0 / next.rate) {
-    return "rate " + formatNumber(next.rate) + " Hz is too fast for scan_time " +
-           formatNumber(next.scan_time) +
-           " s (a head turns once a scan; scan_time needs a restart)";
-  }
-  try {
-    next.scan.output.validate();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
   std::lock_guard<std::mutex> lock(mutex_);
-  params_ = next;
-  pending_ = live;
-  return "";
+  const std::string error = applyLiveParams(live, &params_);
+  if (error.empty()) pending_ = live;
+  return error;
 }
 
 void Sensor::applyLive() {

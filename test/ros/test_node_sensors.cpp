@@ -3,137 +3,24 @@
 // scanner against hand-computed ranges, a VLP-16 cloud whose every point is checked against the
 // room's planes, a rotating scanner moving at 1 m/s away from a wall, a sensor nobody subscribes to
 // (not cast), the diagnostics, and a live reconfiguration taking effect from the next scan.
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
-#include <sensor_msgs/LaserScan.h>
-#include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
-#include <tf2_ros/static_transform_broadcaster.h>
-#include <tf2_ros/transform_broadcaster.h>
 
-#include <Eigen/Geometry>
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <limits>
 #include <map>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include "scan_access.h"
+#include "sensors_rig.h"
 
 namespace laser_raycast_test {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
-// Ranges are floats: 1e-7 relative, well below this at 10 m.
-constexpr double kTolerance = 1e-4;  // m
-// The spinner's path (node_sensors.test): x = -3 + v (t - t0) along a 6 s ramp, then again.
-constexpr double kSpeed = 1.0;  // m/s
-constexpr double kRamp = 6.0;   // s
-
-geometry_msgs::TransformStamped transform(const ros::Time& stamp, const std::string& child,
-                                          const Eigen::Vector3d& t, double yaw) {
-  geometry_msgs::TransformStamped m;
-  m.header.stamp = stamp;
-  m.header.frame_id = "world";
-  m.child_frame_id = child;
-  m.transform.translation.x = t.x();
-  m.transform.translation.y = t.y();
-  m.transform.translation.z = t.z();
-  m.transform.rotation.z = std::sin(yaw / 2);
-  m.transform.rotation.w = std::cos(yaw / 2);
-  return m;
-}
-
-// The distance from p (inside the room) along unit direction d to the room's inner faces.
-double roomDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
-  const Eigen::Vector3d lo(-5, -4, 0), hi(5, 4, 4);
-  double t = kInf;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (d[axis] > 0) t = std::min(t, (hi[axis] - p[axis]) / d[axis]);
-    if (d[axis] < 0) t = std::min(t, (lo[axis] - p[axis]) / d[axis]);
-  }
-  return t;
-}
-
-// The sensor poses and what the node publishes, recorded from the spinner's threads.
-class Rig {
- public:
-  const Eigen::Vector3d front{0, 0, 1}, vlp{0.5, -0.3, 1.2};
-  const double vlp_yaw = 0.3;
-
-  Rig() {
-    start_ = ros::Time::now();
-    const ros::Time now = ros::Time::now();
-    statics_.sendTransform({transform(now, "front", front, 0), transform(now, "vlp", vlp, vlp_yaw),
-                            transform(now, "idle", front, 0)});
-    front_sub_ = nh_.subscribe("/front/scan", 100, &Rig::onFront, this);
-    vlp_sub_ = nh_.subscribe("/vlp/points", 5, &Rig::onVlp, this);
-    spinner_sub_ = nh_.subscribe("/spinner/scan", 20, &Rig::onSpinner, this);
-    diagnostics_sub_ = nh_.subscribe("/diagnostics", 20, &Rig::onDiagnostics, this);
-    timer_ = nh_.createTimer(ros::Duration(0.01), &Rig::publishSpinner, this);
-  }
-
-  // The spinner's x at time t (its y is 0, its height 1 m, no rotation).
-  double spinnerX(const ros::Time& t) const {
-    return -3 + kSpeed * std::fmod((t - start_).toSec(), kRamp);
-  }
-  // Whether [from, to] lies within one ramp of the path, away from its ends (the TF samples
-  // around a jump are interpolated across it).
-  bool withinOneRamp(const ros::Time& from, const ros::Time& to) const {
-    const double a = (from - start_).toSec() - 0.05, b = (to - start_).toSec() + 0.05;
-    return a > 0 && std::floor(a / kRamp) == std::floor(b / kRamp);
-  }
-
-  // Waits (wall time) for the first message in `slot` satisfying ok; nullptr after `seconds`.
-  template <class M, class F>
-  typename M::ConstPtr waitFor(std::vector<typename M::ConstPtr>* slot, F ok, double seconds) {
-    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(seconds);
-    std::size_t seen = 0;
-    while (ros::ok() && ros::WallTime::now() < give_up) {
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        for (; seen < slot->size(); ++seen) {
-          if (ok(*(*slot)[seen])) return (*slot)[seen];
-        }
-      }
-      ros::WallDuration(0.01).sleep();
-    }
-    return nullptr;
-  }
-
-  std::vector<sensor_msgs::LaserScan::ConstPtr> front_scans, spinner_scans;
-  std::vector<sensor_msgs::PointCloud2::ConstPtr> clouds;
-  std::vector<diagnostic_msgs::DiagnosticArray::ConstPtr> diagnostics;
-
- private:
-  template <class M>
-  void store(std::vector<M>* slot, const M& m) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    slot->push_back(m);
-  }
-  void onFront(const sensor_msgs::LaserScan::ConstPtr& m) { store(&front_scans, m); }
-  void onSpinner(const sensor_msgs::LaserScan::ConstPtr& m) { store(&spinner_scans, m); }
-  void onVlp(const sensor_msgs::PointCloud2::ConstPtr& m) { store(&clouds, m); }
-  void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
-    store(&diagnostics, m);
-  }
-  void publishSpinner(const ros::TimerEvent&) {
-    const ros::Time now = ros::Time::now();
-    broadcaster_.sendTransform(transform(now, "spinner", {spinnerX(now), 0, 1}, 0));
-  }
-
-  ros::NodeHandle nh_;
-  ros::Time start_;
-  tf2_ros::StaticTransformBroadcaster statics_;
-  tf2_ros::TransformBroadcaster broadcaster_;
-  ros::Subscriber front_sub_, vlp_sub_, spinner_sub_, diagnostics_sub_;
-  ros::Timer timer_;
-  std::mutex mutex_;
-};
 
 Rig* rig = nullptr;
 
@@ -223,34 +110,6 @@ TEST(NodeSensors, ARotatingScannerMovingAwayFromAWall) {
   EXPECT_GT(on_wall, 100);
 }
 
-// The status whose name ("<node>: <task>") ends in `suffix`, or nullptr.
-const diagnostic_msgs::DiagnosticStatus* statusIn(const diagnostic_msgs::DiagnosticArray& array,
-                                                  const std::string& suffix) {
-  for (const auto& s : array.status) {
-    if (s.name.size() >= suffix.size() &&
-        s.name.compare(s.name.size() - suffix.size(), suffix.size(), suffix) == 0) {
-      return &s;
-    }
-  }
-  return nullptr;
-}
-
-// The status of `name` in the newest diagnostics that have it.
-const diagnostic_msgs::DiagnosticStatus* findStatus(
-    const std::vector<diagnostic_msgs::DiagnosticArray::ConstPtr>& arrays,
-    const std::string& suffix) {
-  for (auto a = arrays.rbegin(); a != arrays.rend(); ++a) {
-    if (const auto* s = statusIn(**a, suffix)) return s;
-  }
-  return nullptr;
-}
-
-std::map<std::string, std::string> values(const diagnostic_msgs::DiagnosticStatus& s) {
-  std::map<std::string, std::string> out;
-  for (const auto& kv : s.values) out[kv.key] = kv.value;
-  return out;
-}
-
 TEST(NodeSensors, DiagnosticsPerSensorAndTheIdleOneIsNotCast) {
   // Wait until the front sensor has published in two reports.
   const auto array = rig->waitFor<diagnostic_msgs::DiagnosticArray>(
@@ -286,15 +145,6 @@ TEST(NodeSensors, DiagnosticsPerSensorAndTheIdleOneIsNotCast) {
   const auto* idle = findStatus(arrays, "idle scan rate");
   EXPECT_EQ(idle->message, "not cast: nobody subscribes");
   EXPECT_EQ(values(*idle)["Events since startup"], "0");
-}
-
-// A diagnostics value as a number (NaN with a failure if absent).
-double number(const diagnostic_msgs::DiagnosticStatus& s, const std::string& key) {
-  for (const auto& kv : s.values) {
-    if (kv.key == key) return std::stod(kv.value);
-  }
-  ADD_FAILURE() << s.name << ": no '" << key << "'";
-  return std::numeric_limits<double>::quiet_NaN();
 }
 
 // The sensors that are cast (someone subscribes), in the closed room.
@@ -344,17 +194,38 @@ TEST(NodeSensors, DiagnosticsShowTheRatesMetAndEveryBeamHit) {
   EXPECT_EQ(number(*front_then, "TF look-up failures"), failures);
 }
 
-// Sets front's range_max through dynamic_reconfigure; returns the values the node replied with.
-std::map<std::string, double> setFront(const std::string& name, double value) {
+// Sets one of front's live parameters through dynamic_reconfigure; returns the configuration the
+// node replied with.
+dynamic_reconfigure::Config reconfigureFront(const dynamic_reconfigure::Config& change) {
   dynamic_reconfigure::Reconfigure srv;
+  srv.request.config = change;
+  EXPECT_TRUE(ros::service::call("/laser_raycast/front/set_parameters", srv));
+  return srv.response.config;
+}
+
+// A double parameter of front; returns the doubles the node replied with.
+std::map<std::string, double> setFront(const std::string& name, double value) {
+  dynamic_reconfigure::Config change;
   dynamic_reconfigure::DoubleParameter p;
   p.name = name;
   p.value = value;
-  srv.request.config.doubles.push_back(p);
-  EXPECT_TRUE(ros::service::call("/laser_raycast/front/set_parameters", srv));
+  change.doubles.push_back(p);
   std::map<std::string, double> out;
-  for (const auto& d : srv.response.config.doubles) out[d.name] = d.value;
+  for (const auto& d : reconfigureFront(change).doubles) out[d.name] = d.value;
   return out;
+}
+
+// A string parameter of front; returns the value of that parameter the node replied with.
+std::string setFront(const std::string& name, const std::string& value) {
+  dynamic_reconfigure::Config change;
+  dynamic_reconfigure::StrParameter p;
+  p.name = name;
+  p.value = value;
+  change.strs.push_back(p);
+  for (const auto& v : reconfigureFront(change).strs) {
+    if (v.name == name) return v.value;
+  }
+  return "<not in the reply>";
 }
 
 TEST(NodeSensors, AReconfigureAppliesToTheNextScan) {
@@ -382,6 +253,63 @@ TEST(NodeSensors, AReconfigureAppliesToTheNextScan) {
       10.0);
   ASSERT_TRUE(scan) << "no scan after the second reconfiguration";
   EXPECT_NEAR(rangeOf(*scan, 4), 5.0, kTolerance);
+}
+
+// front's scans stamped after `after`: `count` of them, consecutive, `period` apart on the grid
+// of that period, each saying scan_time = period.
+void expectScansEvery(const ros::Time& after, double period, std::size_t count) {
+  const auto scans = rig->waitForSome<sensor_msgs::LaserScan>(
+      &rig->front_scans, [&](const sensor_msgs::LaserScan& s) { return s.header.stamp > after; },
+      count, 10 + count * period);
+  ASSERT_EQ(scans.size(), count) << "scans after t = " << after << " at " << period << " s";
+  const auto grid = static_cast<std::uint64_t>(std::llround(period * 1e9));
+  for (std::size_t i = 0; i < count; ++i) {
+    EXPECT_EQ(scans[i]->header.stamp.toNSec() % grid, 0u) << scans[i]->header.stamp;
+    EXPECT_NEAR(scans[i]->scan_time, period, 1e-6);
+    if (i > 0) {
+      EXPECT_NEAR((scans[i]->header.stamp - scans[i - 1]->header.stamp).toSec(), period, 1e-6)
+          << "scan " << i << " at t = " << scans[i]->header.stamp;
+    }
+  }
+}
+
+// A live rate restarts the timer on the new period's grid: from 20 Hz to 5 Hz and back.
+TEST(NodeSensors, ALiveRateChangesThePeriod) {
+  ASSERT_TRUE(ros::service::waitForService("/laser_raycast/front/set_parameters", 30000));
+  // Scans queued before a change are stamped at most one old period after it.
+  ros::Time changed = ros::Time::now();
+  EXPECT_EQ(setFront("rate", 5.0)["rate"], 5.0);
+  expectScansEvery(changed + ros::Duration(1.0 / 20), 1.0 / 5, 4);
+  changed = ros::Time::now();
+  EXPECT_EQ(setFront("rate", 20.0)["rate"], 20.0);
+  expectScansEvery(changed + ros::Duration(1.0 / 5), 1.0 / 20, 6);
+}
+
+// Intensity switched on while the node runs: from the next scan, the links' reflectivity (1, the
+// default) times |cos| of the incidence angle: 1 for the beams along the room's axes, which meet
+// the walls head-on, cos 45 deg for the diagonals (on the y walls, 4 m being nearer than 5).
+// Switched off: no intensities.
+TEST(NodeSensors, ALiveIntensityToggle) {
+  ASSERT_TRUE(ros::service::waitForService("/laser_raycast/front/set_parameters", 30000));
+  EXPECT_EQ(setFront("intensity", "reflectivity"), "reflectivity");
+  const ros::Time on = ros::Time::now() + ros::Duration(1.0 / 20);
+  auto scan = rig->waitFor<sensor_msgs::LaserScan>(
+      &rig->front_scans, [&](const sensor_msgs::LaserScan& s) { return s.header.stamp >= on; },
+      10.0);
+  ASSERT_TRUE(scan) << "no scan after switching intensity on";
+  ASSERT_EQ(scan->intensities.size(), 8u);
+  for (int i = 0; i < 8; ++i) {
+    EXPECT_NEAR(scan->intensities[i], i % 2 == 0 ? 1.0 : std::sqrt(0.5), 1e-6) << "beam " << i;
+  }
+  EXPECT_NEAR(rangeOf(*scan, 0), 5.0, kTolerance);  // the ranges stay
+
+  EXPECT_EQ(setFront("intensity", "off"), "off");
+  const ros::Time off = ros::Time::now() + ros::Duration(1.0 / 20);
+  scan = rig->waitFor<sensor_msgs::LaserScan>(
+      &rig->front_scans, [&](const sensor_msgs::LaserScan& s) { return s.header.stamp >= off; },
+      10.0);
+  ASSERT_TRUE(scan) << "no scan after switching intensity off";
+  EXPECT_TRUE(scan->intensities.empty());
 }
 
 }  // namespace
