@@ -57,16 +57,18 @@ inline double roomDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
 // The sensor poses and what the node publishes, recorded from the spinner's threads.
 class Rig {
  public:
-  const Eigen::Vector3d front{0, 0, 1}, vlp{0.5, -0.3, 1.2};
-  const double vlp_yaw = 0.3;
+  const Eigen::Vector3d front{0, 0, 1}, vlp{0.5, -0.3, 1.2}, sweep3d{1.0, 0.5, 1.0};
+  const double vlp_yaw = 0.3, sweep3d_yaw = 0.4;
 
   Rig() {
     start_ = ros::Time::now();
     const ros::Time now = ros::Time::now();
     statics_.sendTransform({transform(now, "front", front, 0), transform(now, "vlp", vlp, vlp_yaw),
+                            transform(now, "sweep3d", sweep3d, sweep3d_yaw),
                             transform(now, "idle", front, 0)});
     front_sub_ = nh_.subscribe("/front/scan", 100, &Rig::onFront, this);
     vlp_sub_ = nh_.subscribe("/vlp/points", 5, &Rig::onVlp, this);
+    sweep3d_sub_ = nh_.subscribe("/sweep3d/points", 5, &Rig::onSweep3d, this);
     spinner_sub_ = nh_.subscribe("/spinner/scan", 20, &Rig::onSpinner, this);
     diagnostics_sub_ = nh_.subscribe("/diagnostics", 20, &Rig::onDiagnostics, this);
     timer_ = nh_.createTimer(ros::Duration(0.01), &Rig::publishSpinner, this);
@@ -121,7 +123,7 @@ class Rig {
   }
 
   std::vector<sensor_msgs::LaserScan::ConstPtr> front_scans, spinner_scans;
-  std::vector<sensor_msgs::PointCloud2::ConstPtr> clouds;
+  std::vector<sensor_msgs::PointCloud2::ConstPtr> clouds, sweep3d_clouds;
   std::vector<diagnostic_msgs::DiagnosticArray::ConstPtr> diagnostics;
 
  private:
@@ -133,6 +135,7 @@ class Rig {
   void onFront(const sensor_msgs::LaserScan::ConstPtr& m) { store(&front_scans, m); }
   void onSpinner(const sensor_msgs::LaserScan::ConstPtr& m) { store(&spinner_scans, m); }
   void onVlp(const sensor_msgs::PointCloud2::ConstPtr& m) { store(&clouds, m); }
+  void onSweep3d(const sensor_msgs::PointCloud2::ConstPtr& m) { store(&sweep3d_clouds, m); }
   void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
     store(&diagnostics, m);
   }
@@ -145,7 +148,7 @@ class Rig {
   ros::Time start_;
   tf2_ros::StaticTransformBroadcaster statics_;
   tf2_ros::TransformBroadcaster broadcaster_;
-  ros::Subscriber front_sub_, vlp_sub_, spinner_sub_, diagnostics_sub_;
+  ros::Subscriber front_sub_, vlp_sub_, sweep3d_sub_, spinner_sub_, diagnostics_sub_;
   ros::Timer timer_;
   std::mutex mutex_;
 };

@@ -1,8 +1,9 @@
-// rostest node_sensors.test: four sensors from one node over one scene (test/data/
+// rostest node_sensors.test: five sensors from one node over one scene (test/data/
 // sensors_room.urdf, a closed room with inner faces x = +-5, y = +-4, z = 0 and 4): a planar
 // scanner against hand-computed ranges, a VLP-16 cloud whose every point is checked against the
-// room's planes, a rotating scanner moving at 1 m/s away from a wall, a sensor nobody subscribes to
-// (not cast), the diagnostics, and a live reconfiguration taking effect from the next scan.
+// room's planes, a rotating scanner moving at 1 m/s away from a wall, a rotating 3D lidar's
+// organized cloud (per-column times, NaN points for no return), a sensor nobody subscribes to (not
+// cast), the diagnostics, and live reconfiguration taking effect from the next scan.
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -110,6 +111,75 @@ TEST(NodeSensors, ARotatingScannerMovingAwayFromAWall) {
   EXPECT_GT(on_wall, 100);
 }
 
+// "sweep3d" (node_sensors.test): rings at -0.3, 0 and 0.3 rad (given unsorted), 361 azimuths over
+// the full turn, range_max 4.5 m, rotating at 10 Hz: the head turns in 0.1 s, so column c is taken
+// c * time_increment after the stamp, time_increment = (2 pi / 360) * 0.1 s / (2 pi).
+constexpr double kSweepElevations[3] = {-0.3, 0.0, 0.3};  // ring 0 lowest
+constexpr int kSweepAzimuths = 361;
+constexpr double kSweepRangeMax = 4.5;             // m
+constexpr double kSweepTimeIncrement = 0.1 / 360;  // s
+
+// Beam (ring, column) of sweep3d: its direction in the sensor frame, and the room's distance along
+// it from where the rig put the sensor.
+Eigen::Vector3d sweepDirection(int ring, int column) {
+  const double e = kSweepElevations[ring], a = -M_PI + column * (2 * M_PI / 360);
+  return {std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)};
+}
+double sweepDistance(int ring, int column) {
+  const Eigen::AngleAxisd yaw(rig->sweep3d_yaw, Eigen::Vector3d::UnitZ());
+  return roomDistance(rig->sweep3d, yaw * sweepDirection(ring, column));
+}
+// How many of sweep3d's beams meet the room within range_max.
+int sweepReturns() {
+  int n = 0;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < kSweepAzimuths; ++c) n += sweepDistance(r, c) <= kSweepRangeMax;
+  }
+  return n;
+}
+
+// The organized cloud of a rotating 3D lidar: every beam a point, row r ring r, each point's time
+// that of its column; a beam whose wall is beyond range_max is a NaN point, so is_dense is false.
+TEST(NodeSensors, ARotatingOrganizedCloudHasColumnTimesAndNanForNoReturn) {
+  const auto cloud = rig->waitFor<sensor_msgs::PointCloud2>(
+      &rig->sweep3d_clouds, [](const sensor_msgs::PointCloud2&) { return true; }, 30.0);
+  ASSERT_TRUE(cloud) << "no cloud from sensor sweep3d";
+  EXPECT_EQ(cloud->header.frame_id, "sweep3d");
+  ASSERT_EQ(cloud->height, 3u);
+  ASSERT_EQ(cloud->width, static_cast<std::uint32_t>(kSweepAzimuths));
+  ASSERT_EQ(cloud->data.size(), std::size_t{cloud->row_step} * cloud->height);
+  EXPECT_FALSE(cloud->is_dense);
+  sensor_msgs::PointCloud2ConstIterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
+  sensor_msgs::PointCloud2ConstIterator<float> intensity(*cloud, "intensity"), time(*cloud, "time");
+  sensor_msgs::PointCloud2ConstIterator<std::uint16_t> ring(*cloud, "ring");
+  int bad = 0, nan = 0, valid = 0;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < kSweepAzimuths; ++c, ++x, ++y, ++z, ++intensity, ++time, ++ring) {
+      const double expected = sweepDistance(r, c);
+      const Eigen::Vector3d p(*x, *y, *z);
+      bool ok = *ring == r && std::abs(*time - c * kSweepTimeIncrement) <= 1e-7;
+      if (expected > kSweepRangeMax) {
+        ++nan;
+        ok = ok && std::isnan(*x) && std::isnan(*y) && std::isnan(*z) && std::isnan(*intensity);
+      } else {
+        ++valid;
+        ok = ok && (p - expected * sweepDirection(r, c)).norm() < kTolerance;
+      }
+      if (!ok && ++bad <= 5) {
+        ADD_FAILURE() << "ring " << r << " column " << c << ": point " << p.transpose()
+                      << ", ring field " << *ring << ", time " << *time << " (expected "
+                      << c * kSweepTimeIncrement << " s); the room at " << expected << " m";
+      }
+    }
+  }
+  EXPECT_EQ(bad, 0);
+  std::cout << "sweep3d: " << valid << " returns, " << nan << " NaN points of "
+            << 3 * kSweepAzimuths << "; last column at " << kSweepTimeIncrement * 360 << " s\n";
+  EXPECT_GT(nan, 100);
+  EXPECT_GT(valid, 100);
+  EXPECT_EQ(valid, sweepReturns());
+}
+
 TEST(NodeSensors, DiagnosticsPerSensorAndTheIdleOneIsNotCast) {
   // Wait until the front sensor has published in two reports.
   const auto array = rig->waitFor<diagnostic_msgs::DiagnosticArray>(
@@ -127,7 +197,7 @@ TEST(NodeSensors, DiagnosticsPerSensorAndTheIdleOneIsNotCast) {
       30.0);
   ASSERT_TRUE(array) << "no diagnostics with front's scans";
   const std::vector<diagnostic_msgs::DiagnosticArray::ConstPtr> arrays = {array};
-  for (const std::string sensor : {"front", "vlp", "spinner", "idle"}) {
+  for (const std::string sensor : {"front", "vlp", "spinner", "sweep3d", "idle"}) {
     const auto* rate = findStatus(arrays, sensor + " scan rate");
     const auto* scans = findStatus(arrays, sensor + " scans");
     ASSERT_TRUE(rate && scans) << "no diagnostics for sensor " << sensor;
@@ -148,11 +218,11 @@ TEST(NodeSensors, DiagnosticsPerSensorAndTheIdleOneIsNotCast) {
 }
 
 // The sensors that are cast (someone subscribes), in the closed room.
-const std::vector<std::string> kCast = {"front", "vlp", "spinner"};
+const std::vector<std::string> kCast = {"front", "vlp", "spinner", "sweep3d"};
 
 // Once the diagnostics' rate window (5 s) is full, each cast sensor achieves its rate within 10 %,
-// and every beam hits (they face the room's walls all round: share 1). Front's transform is
-// static: once it publishes, none of its look-ups fails.
+// and every beam hits (they face the room's walls all round: share 1) except sweep3d's beyond its
+// range_max of 4.5 m. Front's transform is static: once it publishes, none of its look-ups fails.
 TEST(NodeSensors, DiagnosticsShowTheRatesMetAndEveryBeamHit) {
   const auto full = [](const diagnostic_msgs::DiagnosticArray& a) {
     for (const std::string& sensor : kCast) {
@@ -178,7 +248,9 @@ TEST(NodeSensors, DiagnosticsShowTheRatesMetAndEveryBeamHit) {
     EXPECT_NEAR(actual, target, 0.1 * target) << sensor;
     EXPECT_EQ(rate->level, diagnostic_msgs::DiagnosticStatus::OK)
         << sensor << ": " << rate->message;
-    EXPECT_NEAR(number(*scans, "Beams hit in the last scan (share)"), 1.0, 1e-9) << sensor;
+    const double share = sensor == "sweep3d" ? sweepReturns() / (3.0 * kSweepAzimuths) : 1.0;
+    // Printed with 6 significant digits; one beam of sweep3d's is 1 / 1083.
+    EXPECT_NEAR(number(*scans, "Beams hit in the last scan (share)"), share, 1e-5) << sensor;
   }
   EXPECT_EQ(number(*statusIn(*array, "front scan rate"), "Target frequency (Hz)"), 20.0);
 
