@@ -5,6 +5,7 @@
 #include <ros/node_handle.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -152,6 +153,18 @@ void readScene(ParamReader* r, NodeParams* p) {
   p->ignore_links = r->textList("ignore_links");
 }
 
+// The default name of an entry: its frame_id made a valid name without '/' (it names the namespace
+// of the sensor's live parameters): every character other than a letter, a digit or '_' becomes
+// '_', and "sensor_" goes in front if it does not start with a letter ("r1/laser": "r1_laser").
+std::string defaultName(const std::string& frame_id) {
+  std::string name = frame_id;
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') c = '_';
+  }
+  if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0]))) name = "sensor_" + name;
+  return name;
+}
+
 // The default topic of a sensor: relative to the node's namespace, under its name for an entry.
 std::string defaultTopic(const SensorParams& s, bool entry) {
   const std::string type = s.planar() ? "scan" : "points";
@@ -179,7 +192,10 @@ bool readSensorEntry(ParamReader* r, int i, const XmlRpc::XmlRpcValue& e, const 
     return false;
   }
   std::string why;
-  if (s->name.empty()) s->name = s->frame_id;
+  if (s->name.empty()) {
+    s->name = defaultName(s->frame_id);
+    r->note(r->prefix() + where + "/name unset: '" + s->name + "' (from frame_id)");
+  }
   if (!ros::names::validate(s->name, why) || s->name.find('/') != std::string::npos) {
     r->fail(where + "/name", "'" + s->name + "' is not a valid name without '/' (it names the " +
                                  "sensor's namespace): " + why);

@@ -56,8 +56,10 @@ struct SensorParams {
   static constexpr double kMaxRate = 1000.0;  // Hz
 
   // Entries of ~sensors: its name (in the log, the diagnostics, and the namespace of its live
-  // parameters), default frame_id; and its topic, default <name>/scan or <name>/points. The
-  // shorthand: frame_id, and scan or points (relative to the node's namespace).
+  // parameters), default frame_id made a valid name ('/' and other characters a name may not hold
+  // become '_', "sensor_" in front if it does not start with a letter); and its topic, default
+  // <name>/scan or <name>/points. The shorthand: frame_id, and scan or points (relative to the
+  // node's namespace).
   std::string name;
   std::string topic;
   std::string sensor_model;        // a preset (core::kSensorModelNames), "" for none
