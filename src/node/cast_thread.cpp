@@ -161,6 +161,7 @@ void CastThread::castSensor(Sensor& sensor, const ScanJob& job) {
   if (!sensorPoses(sensor, job, quiet, &poses)) return;
   // Looked up once per time for every sensor whose scan needs it.
   const LinkPosesAt links = link_poses_.at(job.times);
+  link_lookups_ = link_poses_.lookups();
   sensor.monitor().lookupFailures(links.failures);
   if (!acceptMissing(sensor, job, quiet, links)) return;
   sensor.castAndPublish(*context_.scene, *context_.reflectivity, job.times, links.frames, poses,

@@ -8,7 +8,9 @@
 
 #include <ros/ros.h>
 
+#include <atomic>
 #include <condition_variable>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -43,6 +45,9 @@ class CastThread {
   void schedule(int sensor, const std::vector<ros::Time>& times);
   // At most this many jobs wait; beyond, the oldest is dropped (counted as skipped by its sensors).
   void setCapacity(std::size_t capacity);
+  // TF look-ups of link poses so far: one per link frame and scan time, for every sensor due then
+  // (LinkPoses::lookups). Any thread.
+  std::uint64_t linkLookups() const { return link_lookups_; }
 
  private:
   // Which transforms the front job still waits for; reset when another job comes to the front.
@@ -78,6 +83,7 @@ class CastThread {
   bool stop_ = false;
   Wait wait_;             // the cast thread's own
   LinkPoses link_poses_;  // the cast thread's own
+  std::atomic<std::uint64_t> link_lookups_{0};
   ros::WallTime last_link_warning_;
   std::thread thread_;
 };

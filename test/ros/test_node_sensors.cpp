@@ -14,6 +14,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -264,6 +265,51 @@ TEST(NodeSensors, DiagnosticsShowTheRatesMetAndEveryBeamHit) {
   const auto* front_then = statusIn(*next, "front scans");
   ASSERT_TRUE(front_then);
   EXPECT_EQ(number(*front_then, "TF look-up failures"), failures);
+}
+
+// The scan times of one second that need link poses, from the sensors' configuration
+// (node_sensors.test): front's 20 Hz stamps (vlp's 10 Hz ones among them), and the sample times of
+// the rotating spinner and sweep3d at 10 Hz: from each stamp to its last beam 0.1 s later, at most
+// 10 ms apart (Sensor::kSweepSampleSpacing), i.e. stamp + 0, 10, ..., 100 ms.
+std::size_t scanTimesPerSecond() {
+  std::set<std::int64_t> ms;
+  for (int k = 0; k < 20; ++k) ms.insert(50 * k);
+  for (int k = 0; k < 10; ++k) {
+    for (int j = 0; j <= 10; ++j) ms.insert((100 * k + 10 * j) % 1000);
+  }
+  return ms.size();
+}
+
+// The link poses are looked up once per scan time for every sensor due then: an instantaneous and
+// a rotating sensor at one stamp share it, and the 20 Hz stamps inside a sweep. The node counts its
+// link look-ups ("link poses"); over 5 s they must come to link frames x scan times, not more
+// (one look-up per job would make 130 a second here instead of 100).
+TEST(NodeSensors, LinkPosesAreLookedUpOncePerScanTime) {
+  const auto has = [](const diagnostic_msgs::DiagnosticArray& a) {
+    return statusIn(a, "link poses") != nullptr;
+  };
+  const ros::Time now = ros::Time::now();  // every sensor casts by now (the tests above)
+  const auto first = rig->waitFor<diagnostic_msgs::DiagnosticArray>(
+      &rig->diagnostics,
+      [&](const diagnostic_msgs::DiagnosticArray& a) { return has(a) && a.header.stamp >= now; },
+      30.0);
+  ASSERT_TRUE(first) << "no 'link poses' diagnostics";
+  const ros::Time later = first->header.stamp + ros::Duration(5.0);
+  const auto last = rig->waitFor<diagnostic_msgs::DiagnosticArray>(
+      &rig->diagnostics,
+      [&](const diagnostic_msgs::DiagnosticArray& a) { return has(a) && a.header.stamp >= later; },
+      20.0);
+  ASSERT_TRUE(last) << "no 'link poses' diagnostics 5 s later";
+  const double frames = number(*statusIn(*last, "link poses"), "Link frames");
+  const double lookups = number(*statusIn(*last, "link poses"), "Link pose look-ups") -
+                         number(*statusIn(*first, "link poses"), "Link pose look-ups");
+  const double seconds = (last->header.stamp - first->header.stamp).toSec();
+  const double expected = frames * scanTimesPerSecond();
+  std::cout << "link pose look-ups: " << lookups / seconds << " a second for " << frames
+            << " link frames and " << scanTimesPerSecond() << " scan times a second\n";
+  EXPECT_EQ(frames, 1.0);  // the room's links are merged into its root, "world"
+  EXPECT_EQ(scanTimesPerSecond(), 100u);
+  EXPECT_NEAR(lookups / seconds, expected, 0.05 * expected);
 }
 
 // Sets one of front's live parameters through dynamic_reconfigure; returns the configuration the
