@@ -3,7 +3,8 @@
 # summary, exit non-zero on any failure or if no test ran. .ci/run calls exactly this.
 #
 # Tests that use the real third-party scene in ../shared/data (beside the clone) run when it is present and
-# are skipped otherwise; LASER_RAYCAST_REQUIRE_SHARED_DATA=1 turns its absence into a failure.
+# are skipped otherwise; LASER_RAYCAST_REQUIRE_SHARED_DATA=1 turns its absence into a failure, as
+# LASER_RAYCAST_REQUIRE_FUZZ=1 does for the fuzz harnesses (built when clang is installed).
 set -euo pipefail
 
 usage() {
@@ -21,6 +22,8 @@ non-zero on any failure or if no test ran. CI (.ci/run) runs exactly this.
 
 Environment:
   LASER_RAYCAST_REQUIRE_SHARED_DATA=1  fail instead of skipping when ../shared/data is missing
+  LASER_RAYCAST_REQUIRE_FUZZ=1         fail instead of skipping when the fuzz harnesses were not
+                                       built (no clang; not with --sanitize, which leaves them out)
   LASER_RAYCAST_WS=DIR                 build in DIR instead of .ws/ (or the sanitize workspace;
                                        never inside the clone)
   LASER_RAYCAST_JOBS=N                 parallel build jobs (default: the number of CPUs)

@@ -7,7 +7,12 @@
 
 namespace laser_raycast {
 
-CastThread::CastThread(Context context) : context_(std::move(context)) {
+CastThread::CastThread(Context context)
+    : context_(std::move(context)),
+      link_poses_(*context_.scene, [this](const std::string& frame, const ros::Time& t,
+                                          Eigen::Isometry3d* pose, std::string* error) {
+        return context_.tf->lookup(context_.fixed_frame, frame, t, pose, error);
+      }) {
   thread_ = std::thread([this] { run(); });
 }
 
@@ -65,6 +70,9 @@ void CastThread::run() {
     lock.unlock();
     process(job);
     lock.lock();
+    // Times before the oldest stamp still queued (or this job's) are needed by no scan any more.
+    const std::optional<ros::Time> oldest = queue_.oldestStamp();
+    link_poses_.forgetBefore(oldest && *oldest < job.stamp() ? *oldest : job.stamp());
   }
 }
 
@@ -98,80 +106,66 @@ bool CastThread::ready(const ScanJob& job) {
 }
 
 void CastThread::process(const ScanJob& job) {
-  std::vector<core::FramePoses> frames;
-  std::vector<std::string> missing;
-  std::string first_error;
-  linkPoses(job.times, &frames, &missing, &first_error);
-  for (const int s : job.sensors) {
-    castSensor(*(*context_.sensors)[s], job, frames, missing, first_error);
-  }
+  for (const int s : job.sensors) castSensor(*(*context_.sensors)[s], job);
 }
 
-void CastThread::linkPoses(const std::vector<ros::Time>& times,
-                           std::vector<core::FramePoses>* frames, std::vector<std::string>* missing,
-                           std::string* first_error) {
-  const core::Scene& scene = *context_.scene;
-  frames->resize(times.size());
-  std::vector<char> lost(scene.frames().size(), 0);
-  for (std::size_t j = 0; j < times.size(); ++j) {
-    core::resolveFramePoses(
-        scene,
-        [&](const std::string& frame, Eigen::Isometry3d& pose) {
-          std::string error;
-          if (context_.tf->lookup(context_.fixed_frame, frame, times[j], &pose, &error)) {
-            return true;
-          }
-          if (first_error->empty()) *first_error = error;
-          return false;
-        },
-        &(*frames)[j]);
-    for (std::size_t f = 0; f < lost.size(); ++f) lost[f] |= !(*frames)[j].valid[f];
-  }
-  for (std::size_t f = 0; f < lost.size(); ++f) {
-    if (lost[f]) missing->push_back(scene.frames()[f]);
-  }
-}
-
-void CastThread::castSensor(Sensor& sensor, const ScanJob& job,
-                            const std::vector<core::FramePoses>& frames,
-                            const std::vector<std::string>& missing,
-                            const std::string& first_error) {
-  SensorMonitor& monitor = sensor.monitor();
-  const bool quiet = monitor.quiet(job.stamp());
-  std::vector<Eigen::Isometry3d> poses(job.times.size());
+bool CastThread::sensorPoses(Sensor& sensor, const ScanJob& job, bool quiet,
+                             std::vector<Eigen::Isometry3d>* poses) {
+  poses->resize(job.times.size());
   for (std::size_t j = 0; j < job.times.size(); ++j) {
     std::string why;
     bool from_tf;
-    if (!sensor.poseAt(job.times[j], *context_.tf, &poses[j], &why, &from_tf)) {
+    std::uint64_t failures = 0;
+    const bool ok =
+        sensor.poseAt(job.times[j], *context_.tf, &(*poses)[j], &why, &from_tf, &failures);
+    sensor.monitor().lookupFailures(failures);
+    if (!ok) {
       using Skip = SensorMonitor::Skip;
-      monitor.skipped(quiet     ? Skip::kWaiting
-                      : from_tf ? Skip::kNoTransform
-                                : Skip::kStalePose,
-                      job.stamp(), why);
-      return;
+      sensor.monitor().skipped(quiet     ? Skip::kWaiting
+                               : from_tf ? Skip::kNoTransform
+                                         : Skip::kStalePose,
+                               job.stamp(), why);
+      return false;
     }
   }
-  if (!missing.empty()) {
-    if (quiet) {
-      monitor.skipped(SensorMonitor::Skip::kWaiting, job.stamp(),
-                      std::to_string(missing.size()) + " link frames have no transform yet (" +
-                          joinFirst(missing, kLinksInWarning) + ")");
-      return;
-    }
-    const ros::WallTime now = ros::WallTime::now();
-    if (last_link_warning_.isZero() || (now - last_link_warning_).toSec() >= kWarnPeriod) {
-      last_link_warning_ = now;
-      ROS_WARN(
-          "%zu of %zu link frames have no transform to '%s' at t = %.3f; their geometry is "
-          "left out of this scan (a transform older than ~tf_timeout %.3f s is not waited "
-          "for): %s (%s)",
-          missing.size(), context_.scene->frames().size(), context_.fixed_frame.c_str(),
-          job.last().toSec(), context_.tf_timeout.toSec(),
-          joinFirst(missing, kLinksInWarning).c_str(), first_error.c_str());
-    }
+  return true;
+}
+
+bool CastThread::acceptMissing(Sensor& sensor, const ScanJob& job, bool quiet,
+                               const LinkPosesAt& links) {
+  if (links.missing.empty()) return true;
+  if (quiet) {
+    sensor.monitor().skipped(SensorMonitor::Skip::kWaiting, job.stamp(),
+                             std::to_string(links.missing.size()) +
+                                 " link frames have no transform yet (" +
+                                 joinFirst(links.missing, kLinksInWarning) + ")");
+    return false;
   }
-  sensor.castAndPublish(*context_.scene, *context_.reflectivity, job.times, frames, poses,
-                        missing.size());
+  const ros::WallTime now = ros::WallTime::now();
+  if (last_link_warning_.isZero() || (now - last_link_warning_).toSec() >= kWarnPeriod) {
+    last_link_warning_ = now;
+    ROS_WARN(
+        "%zu of %zu link frames have no transform to '%s' at t = %.3f; their geometry is "
+        "left out of this scan (a transform older than ~tf_timeout %.3f s is not waited "
+        "for): %s (%s)",
+        links.missing.size(), context_.scene->frames().size(), context_.fixed_frame.c_str(),
+        job.last().toSec(), context_.tf_timeout.toSec(),
+        joinFirst(links.missing, kLinksInWarning).c_str(), links.first_error.c_str());
+  }
+  return true;
+}
+
+void CastThread::castSensor(Sensor& sensor, const ScanJob& job) {
+  const bool quiet = sensor.monitor().quiet(job.stamp());
+  std::vector<Eigen::Isometry3d> poses;
+  if (!sensorPoses(sensor, job, quiet, &poses)) return;
+  // Looked up once per time for every sensor whose scan needs it.
+  const LinkPosesAt links = link_poses_.at(job.times);
+  link_lookups_ = link_poses_.lookups();
+  sensor.monitor().lookupFailures(links.failures);
+  if (!acceptMissing(sensor, job, quiet, links)) return;
+  sensor.castAndPublish(*context_.scene, *context_.reflectivity, job.times, links.frames, poses,
+                        links.missing.size());
 }
 
 }  // namespace laser_raycast

@@ -1,13 +1,16 @@
 // The node's cast thread. Sensor timers only queue scans (ScanQueue); this thread takes them in the
 // order their transforms become due, waits until TF covers each one's last beam (tf_timing.h: a
 // late transform is waited for up to ~tf_timeout, a dead one not at all), looks the link poses up
-// once for every sensor due at those times, and has each sensor cast and publish. So a wait for TF
-// never costs the timers their rate: scans queue up behind it and are cast as the transforms come.
+// once per time for every sensor due then (link_poses.h), and has each sensor cast and publish. So
+// a wait for TF never costs the timers their rate: scans queue up behind it and are cast as the
+// transforms come.
 #pragma once
 
 #include <ros/ros.h>
 
+#include <atomic>
 #include <condition_variable>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -16,6 +19,7 @@
 #include <vector>
 
 #include "laser_raycast/core/scene.h"
+#include "link_poses.h"
 #include "scan_queue.h"
 #include "sensor.h"
 #include "tf_source.h"
@@ -41,6 +45,9 @@ class CastThread {
   void schedule(int sensor, const std::vector<ros::Time>& times);
   // At most this many jobs wait; beyond, the oldest is dropped (counted as skipped by its sensors).
   void setCapacity(std::size_t capacity);
+  // TF look-ups of link poses so far: one per link frame and scan time, for every sensor due then
+  // (LinkPoses::lookups). Any thread.
+  std::uint64_t linkLookups() const { return link_lookups_; }
 
  private:
   // Which transforms the front job still waits for; reset when another job comes to the front.
@@ -54,12 +61,12 @@ class CastThread {
   // Whether every transform the job needs is covered, stale or missing (none still late).
   bool ready(const ScanJob& job);
   void process(const ScanJob& job);
-  // The link poses at each time (shared by the job's sensors); the names of links without a pose
-  // at some time in *missing.
-  void linkPoses(const std::vector<ros::Time>& times, std::vector<core::FramePoses>* frames,
-                 std::vector<std::string>* missing, std::string* first_error);
-  void castSensor(Sensor& sensor, const ScanJob& job, const std::vector<core::FramePoses>& frames,
-                  const std::vector<std::string>& missing, const std::string& first_error);
+  // The sensor's poses at the job's times; false (the scan counted as skipped) without one.
+  bool sensorPoses(Sensor& sensor, const ScanJob& job, bool quiet,
+                   std::vector<Eigen::Isometry3d>* poses);
+  // Whether the scan goes ahead without the links in links.missing (warned about, throttled).
+  bool acceptMissing(Sensor& sensor, const ScanJob& job, bool quiet, const LinkPosesAt& links);
+  void castSensor(Sensor& sensor, const ScanJob& job);
 
   // How often the front job's transforms are checked while it waits (wall time): short against
   // any scan period, long against a TF look-up (microseconds).
@@ -74,7 +81,9 @@ class CastThread {
   std::condition_variable wake_;
   ScanQueue queue_;
   bool stop_ = false;
-  Wait wait_;  // the cast thread's own
+  Wait wait_;             // the cast thread's own
+  LinkPoses link_poses_;  // the cast thread's own
+  std::atomic<std::uint64_t> link_lookups_{0};
   ros::WallTime last_link_warning_;
   std::thread thread_;
 };

@@ -7,9 +7,18 @@ namespace laser_raycast {
 using diagnostic_msgs::DiagnosticStatus;
 
 NodeDiagnostics::NodeDiagnostics(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
-                                 const std::vector<std::unique_ptr<Sensor>>& sensors)
+                                 const std::vector<std::unique_ptr<Sensor>>& sensors,
+                                 std::size_t link_frames,
+                                 std::function<std::uint64_t()> link_lookups)
     : updater_(nh, pnh), windows_(sensors.size()), previous_(sensors.size()) {
   updater_.setHardwareID(ros::this_node::getName());
+  // One look-up per link frame and scan time, however many sensors are due then.
+  updater_.add("link poses", [link_frames, link_lookups = std::move(link_lookups)](
+                                 diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    stat.add("Link frames", link_frames);
+    stat.add("Link pose look-ups", link_lookups());
+    stat.summary(DiagnosticStatus::OK, "ok");
+  });
   for (std::size_t i = 0; i < sensors.size(); ++i) {
     const Sensor* sensor = sensors[i].get();
     updater_.add(sensor->name() + " scan rate",
@@ -72,7 +81,7 @@ void NodeDiagnostics::scanStatus(const Sensor& sensor, const SensorStats& previo
   stat.add("Scans skipped: pose topic stale or non-finite", s.skipped.stale_pose);
   stat.add("Scans skipped: waiting for the first transforms", s.skipped.waiting);
   stat.add("Scans skipped: cast thread behind", s.skipped.behind);
-  stat.add("TF look-up failures", s.skipped.no_transform + s.missing_links);
+  stat.add("TF look-up failures", s.tf_failures);
   stat.add("Links left out for want of a transform", s.missing_links);
   // Skips after the start-up wait since the previous report.
   const auto lasting = [](const SensorStats& x) {

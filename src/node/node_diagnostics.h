@@ -1,12 +1,14 @@
 // The node's diagnostics (diagnostic_updater, on /diagnostics): per sensor, the scan rate against
 // the configured one (frequency status), and its scans: cast time, share of beams hit, TF look-up
-// failures, scans skipped and why.
+// failures, scans skipped and why; for the node, the link poses looked up in TF.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
+#include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -16,9 +18,11 @@ namespace laser_raycast {
 
 class NodeDiagnostics {
  public:
-  // The sensors must outlive this.
+  // The sensors must outlive this. link_frames: the scene's; link_lookups: the TF look-ups of link
+  // poses so far (CastThread::linkLookups).
   NodeDiagnostics(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
-                  const std::vector<std::unique_ptr<Sensor>>& sensors);
+                  const std::vector<std::unique_ptr<Sensor>>& sensors, std::size_t link_frames,
+                  std::function<std::uint64_t()> link_lookups);
   // Publishes the status of every sensor now (called every second).
   void publish();
 

@@ -5,8 +5,10 @@
 #include <ros/node_handle.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "laser_raycast/core/caster.h"
 #include "param_reader.h"
@@ -154,6 +156,18 @@ void readScene(ParamReader* r, NodeParams* p) {
   p->ignore_links = r->textList("ignore_links");
 }
 
+// The default name of an entry: its frame_id made a valid name without '/' (it names the namespace
+// of the sensor's live parameters): every character other than a letter, a digit or '_' becomes
+// '_', and "sensor_" goes in front if it does not start with a letter ("r1/laser": "r1_laser").
+std::string defaultName(const std::string& frame_id) {
+  std::string name = frame_id;
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') c = '_';
+  }
+  if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0]))) name = "sensor_" + name;
+  return name;
+}
+
 // The default topic of a sensor: relative to the node's namespace, under its name for an entry.
 std::string defaultTopic(const SensorParams& s, bool entry) {
   const std::string type = s.planar() ? "scan" : "points";
@@ -181,22 +195,32 @@ bool readSensorEntry(ParamReader* r, int i, const XmlRpc::XmlRpcValue& e, const 
     return false;
   }
   std::string why;
-  if (s->name.empty()) s->name = s->frame_id;
+  if (s->name.empty()) {
+    s->name = defaultName(s->frame_id);
+    r->note(r->prefix() + where + "/name unset: '" + s->name + "' (from frame_id)");
+  }
   if (!ros::names::validate(s->name, why) || s->name.find('/') != std::string::npos) {
     r->fail(where + "/name", "'" + s->name + "' is not a valid name without '/' (it names the " +
                                  "sensor's namespace): " + why);
     return false;
   }
   if (s->topic.empty()) s->topic = defaultTopic(*s, true);
-  if (!ros::names::validate(s->topic, why)) {
-    r->fail(where + "/topic", "'" + s->topic + "' is not a valid topic name: " + why);
-    return false;
-  }
-  return true;
+  return checkTopic(r, where + "/topic", s->topic);
 }
 
-// Two sensors with one name or one topic (scans or labels) would mix their messages.
-void checkDistinct(ParamReader* r, const std::vector<SensorParams>& sensors) {
+// Two sensors with one name or one topic (scans or labels) would mix their messages. Topics are
+// compared as the node advertises them, resolved in its namespace `ns` ("scan" and "/scan" are one
+// topic in the root namespace); remappings given to the node are not known here.
+void checkDistinct(ParamReader* r, const std::vector<SensorParams>& sensors,
+                   const std::string& ns) {
+  // Each sensor's topics as given and as resolved.
+  const auto topics = [&](const SensorParams& s) {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (const std::string& topic : {s.topic, s.labelsTopic()}) {
+      out.emplace_back(topic, ros::names::resolve(ns, topic, false));
+    }
+    return out;
+  };
   for (std::size_t i = 0; i < sensors.size(); ++i) {
     for (std::size_t j = 0; j < i; ++j) {
       const std::string here = "sensors[" + std::to_string(i) + "]";
@@ -204,9 +228,11 @@ void checkDistinct(ParamReader* r, const std::vector<SensorParams>& sensors) {
       if (sensors[i].name == sensors[j].name) {
         r->fail(here + "/name", "'" + sensors[i].name + "' is also the name of " + there);
       }
-      for (const std::string& a : {sensors[i].topic, sensors[i].labelsTopic()}) {
-        for (const std::string& b : {sensors[j].topic, sensors[j].labelsTopic()}) {
-          if (a == b) r->fail(here + "/topic", "'" + a + "' is also a topic of " + there);
+      for (const auto& [given, resolved] : topics(sensors[i])) {
+        for (const auto& [other, other_resolved] : topics(sensors[j])) {
+          if (resolved != other_resolved) continue;
+          r->fail(here + "/topic", "'" + given + "' publishes on " + resolved + " (in namespace " +
+                                       ns + "), as " + there + " does ('" + other + "')");
         }
       }
     }
@@ -215,7 +241,8 @@ void checkDistinct(ParamReader* r, const std::vector<SensorParams>& sensors) {
 
 // The sensors: the private namespace's sensor parameters describe one, or, with ~sensors, are the
 // defaults of each entry.
-void readSensors(ParamReader* r, NodeParams* p, std::vector<std::string>* warnings) {
+void readSensors(ParamReader* r, const std::string& ns, NodeParams* p,
+                 std::vector<std::string>* warnings) {
   SensorParams base;
   readSensor(r, &base, false, warnings);
   p->sensors.clear();
@@ -236,18 +263,19 @@ void readSensors(ParamReader* r, NodeParams* p, std::vector<std::string>* warnin
     if (!readSensorEntry(r, i, (*v)[i], base, &s, warnings)) return;
     p->sensors.push_back(s);
   }
-  checkDistinct(r, p->sensors);
+  checkDistinct(r, p->sensors, ns);
 }
 
 // Every group, in the order the log lists them: the node's own, then the sensors'.
-void readAll(ParamReader* r, NodeParams* p, std::vector<std::string>* warnings) {
+void readAll(ParamReader* r, const std::string& ns, NodeParams* p,
+             std::vector<std::string>* warnings) {
   p->fixed_frame = r->text("fixed_frame", p->fixed_frame);
   checkFrame(r, "fixed_frame", p->fixed_frame, false);
   readTfTimeout(r, p);
   readThreads(r, p);
   readScene(r, p);
   readReflectivity(r, p);
-  readSensors(r, p, warnings);
+  readSensors(r, ns, p, warnings);
   const bool any_intensity =
       std::any_of(p->sensors.begin(), p->sensors.end(),
                   [](const SensorParams& s) { return s.scan.output.intensity; });
@@ -263,11 +291,17 @@ std::string ModelSource::describe() const {
   return param.empty() ? "file " + file : "parameter " + param;
 }
 
-std::string parseNodeParams(const XmlRpc::XmlRpcValue& values, NodeParams* p, ParamReport* report) {
+std::string parseNodeParams(const XmlRpc::XmlRpcValue& values, const std::string& ns, NodeParams* p,
+                            ParamReport* report) {
   *p = NodeParams();
   *report = ParamReport();
   ParamReader r(values, "~");
-  readAll(&r, p, &report->warnings);
+  std::string why;
+  if (!ros::names::validate(ns, why) || ns.empty() || ns[0] != '/') {
+    // The caller's mistake, not the user's: the namespace comes from a NodeHandle.
+    throw std::invalid_argument("parseNodeParams: namespace '" + ns + "' is not a global name");
+  }
+  readAll(&r, ns, p, &report->warnings);
 
   for (const std::string& name : r.unknown()) {
     // dynamic_reconfigure keeps an entry's live parameters under ~<its name>.
@@ -288,16 +322,20 @@ std::vector<std::string> nodeParamNames() {
   ParamReader r(none, "~");
   NodeParams p;
   std::vector<std::string> warnings;
-  readAll(&r, &p, &warnings);
+  readAll(&r, "/", &p, &warnings);
   return r.known();
 }
 
-bool readNodeParams(const ros::NodeHandle& pnh, NodeParams* params, std::string* error) {
+bool readNodeParams(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, NodeParams* params,
+                    std::string* error) {
   // The whole private namespace in one struct (unset if nothing is set in it).
   XmlRpc::XmlRpcValue values;
   if (!pnh.getParam(pnh.getNamespace(), values)) values = XmlRpc::XmlRpcValue();
+  // The namespace nh resolves relative names in. Not nh.getNamespace(): a nodelet's handle for the
+  // root namespace has an empty one (roscpp then resolves in this node's namespace).
+  const std::string ns = ros::names::parentNamespace(nh.resolveName("topic", false));
   ParamReport report;
-  *error = parseNodeParams(values, params, &report);
+  *error = parseNodeParams(values, ns, params, &report);
   for (const std::string& line : report.values) ROS_INFO_STREAM(line);
   for (const std::string& warning : report.warnings) ROS_WARN_STREAM(warning);
   return error->empty();

@@ -76,10 +76,12 @@ void PoseTopic::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
 }
 
 bool PoseTopic::inFixedFrame(const PoseHistory::Entry& e, const TfSource& tf,
-                             Eigen::Isometry3d* pose, std::string* why) const {
+                             Eigen::Isometry3d* pose, std::string* why,
+                             std::uint64_t* tf_failures) const {
   Eigen::Isometry3d fixed_from_frame;
   std::string error;
   if (!tf.lookup(fixed_frame_, e.frame, e.stamp, &fixed_from_frame, &error)) {
+    ++*tf_failures;
     *why = "the pose on " + sub_.getTopic() + " is in '" + e.frame +
            "', which has no transform to '" + fixed_frame_ + "' at its stamp (" + error + ")";
     return false;
@@ -89,7 +91,7 @@ bool PoseTopic::inFixedFrame(const PoseHistory::Entry& e, const TfSource& tf,
 }
 
 bool PoseTopic::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose,
-                       std::string* why) {
+                       std::string* why, std::uint64_t* tf_failures) {
   PoseHistory::Query q;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -112,7 +114,10 @@ bool PoseTopic::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d
       break;
   }
   Eigen::Isometry3d a, b;
-  if (!inFixedFrame(q.a, tf, &a, why) || !inFixedFrame(q.b, tf, &b, why)) return false;
+  if (!inFixedFrame(q.a, tf, &a, why, tf_failures) ||
+      !inFixedFrame(q.b, tf, &b, why, tf_failures)) {
+    return false;
+  }
   *pose = core::interpolatePose(a, b, q.s);
   return true;
 }

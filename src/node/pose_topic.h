@@ -8,6 +8,7 @@
 #include <topic_tools/shape_shifter.h>
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <mutex>
 #include <string>
 
@@ -24,8 +25,10 @@ class PoseTopic {
             ros::Duration timeout, ros::Duration keep);
 
   // The pose the topic gives, in fixed_frame, at time t; false with the reason in *why (naming the
-  // topic, and the pose's age if it is stale).
-  bool poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose, std::string* why);
+  // topic, and the pose's age if it is stale). Failed TF look-ups (a message's frame to
+  // fixed_frame) are added to *tf_failures.
+  bool poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose, std::string* why,
+              std::uint64_t* tf_failures);
 
   std::string topic() const { return sub_.getTopic(); }
 
@@ -33,7 +36,7 @@ class PoseTopic {
   void onPose(const topic_tools::ShapeShifter::ConstPtr& msg);
   // An entry's pose in fixed_frame (TF at its stamp if it is given in another frame).
   bool inFixedFrame(const PoseHistory::Entry& e, const TfSource& tf, Eigen::Isometry3d* pose,
-                    std::string* why) const;
+                    std::string* why, std::uint64_t* tf_failures) const;
 
   // A wrong message type is a set-up error that does not go away by itself: reported this often.
   static constexpr double kErrorPeriod = 10.0;  // s

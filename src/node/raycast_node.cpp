@@ -26,7 +26,7 @@ RaycastNode::~RaycastNode() {
 
 bool RaycastNode::init() {
   std::string error;
-  if (!readNodeParams(pnh_, &params_, &error)) {
+  if (!readNodeParams(nh_, pnh_, &params_, &error)) {
     ROS_FATAL_STREAM(error);
     return false;
   }
@@ -51,7 +51,9 @@ bool RaycastNode::init() {
   context.tf_timeout = ros::Duration(params_.tf_timeout);
   cast_thread_ = std::make_unique<CastThread>(context);
   updateCapacity();
-  diagnostics_ = std::make_unique<NodeDiagnostics>(nh_, pnh_, sensors_);
+  diagnostics_ = std::make_unique<NodeDiagnostics>(
+      nh_, pnh_, sensors_, scene_.frames().size(),
+      [this] { return cast_thread_ ? cast_thread_->linkLookups() : 0; });
 
   align_timers_.resize(sensors_.size());
   timers_.resize(sensors_.size());

@@ -13,8 +13,16 @@ class RaycastNodelet : public nodelet::Nodelet {
  private:
   void onInit() override {
     node_ = std::make_unique<RaycastNode>(getNodeHandle(), getPrivateNodeHandle());
-    // The manager reports a nodelet whose onInit throws as failed to load.
-    if (!node_->init()) throw std::runtime_error("laser_raycast: bad configuration (see above)");
+    // The manager reports a nodelet whose onInit throws as failed to load, but logs the exception
+    // only at debug level: say what it was.
+    bool ok = false;
+    try {
+      ok = node_->init();
+    } catch (const std::exception& e) {
+      ROS_FATAL("laser_raycast: %s", e.what());
+      throw;
+    }
+    if (!ok) throw std::runtime_error("laser_raycast: bad configuration (see above)");
   }
 
   std::unique_ptr<RaycastNode> node_;

@@ -24,6 +24,14 @@ std::optional<ScanJob> ScanQueue::push(const std::vector<ros::Time>& times, int 
   return dropped;
 }
 
+std::optional<ros::Time> ScanQueue::oldestStamp() const {
+  std::optional<ros::Time> oldest;
+  for (const ScanJob& job : jobs_) {
+    if (!oldest || job.stamp() < *oldest) oldest = job.stamp();
+  }
+  return oldest;
+}
+
 ScanJob ScanQueue::pop() {
   ScanJob job = std::move(jobs_.front());
   jobs_.pop_front();

@@ -1,5 +1,7 @@
 // The scans waiting to be cast, in the order their transforms can become available: by the time of
-// their last beam. Sensors due at the same times share one job, and so one set of TF look-ups.
+// their last beam. Sensors due at the same times share one job. Sensors due at one stamp with
+// different times (an instantaneous and a rotating scan) are separate jobs, so that neither waits
+// for the other's transforms; they share their link look-ups through LinkPoses (link_poses.h).
 // Bounded: when the cast thread falls behind, the oldest job is dropped rather than memory grown.
 // Not thread-safe (the cast thread's owner locks around it); pure, so unit tests check it.
 #pragma once
@@ -40,6 +42,8 @@ class ScanQueue {
   std::size_t size() const { return jobs_.size(); }
   // The job whose transforms are due first. Not empty() first.
   const ScanJob& front() const { return jobs_.front(); }
+  // The earliest stamp of any job (nullopt when empty): no queued scan needs a time before it.
+  std::optional<ros::Time> oldestStamp() const;
   ScanJob pop();
 
  private:

@@ -4,15 +4,12 @@
 #include <sensor_msgs/PointCloud2.h>
 
 #include <chrono>
-#include <cmath>
 #include <iomanip>
 #include <sstream>
-#include <stdexcept>
 
 #include "laser_raycast/ScanLabels.h"
 #include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/node/point_cloud.h"
-#include "param_reader.h"
 #include "tf_timing.h"
 
 namespace laser_raycast {
@@ -67,35 +64,14 @@ std::vector<ros::Time> Sensor::sampleTimes(const ros::Time& stamp) const {
 
 Sensor::Live Sensor::live() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return Live{params_.scan.output, params_.rate};
+  return liveParams(params_);
 }
 
 std::string Sensor::setLive(const Live& live) {
-  SensorParams next;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    next = params_;
-  }
-  next.scan.output = live.output;
-  next.rate = live.rate;
-  if (!(std::isfinite(live.rate) && live.rate > 0 && live.rate <= SensorParams::kMaxRate)) {
-    return "rate must be in (0, " + formatNumber(SensorParams::kMaxRate) + "] Hz, got " +
-           formatNumber(live.rate);
-  }
-  if (next.sweep == Sweep::kRotating && next.scan_time > 1.0 / next.rate) {
-    return "rate " + formatNumber(next.rate) + " Hz is too fast for scan_time " +
-           formatNumber(next.scan_time) +
-           " s (a head turns once a scan; scan_time needs a restart)";
-  }
-  try {
-    next.scan.output.validate();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
   std::lock_guard<std::mutex> lock(mutex_);
-  params_ = next;
-  pending_ = live;
-  return "";
+  const std::string error = applyLiveParams(live, &params_);
+  if (error.empty()) pending_ = live;
+  return error;
 }
 
 void Sensor::applyLive() {
@@ -112,17 +88,20 @@ void Sensor::applyLive() {
 }
 
 bool Sensor::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose,
-                    std::string* why, bool* from_tf) {
+                    std::string* why, bool* from_tf, std::uint64_t* tf_failures) {
   // Without a pose topic the sensor is a TF frame like any other; with one, the topic gives the
   // pose of pose_frame, and TF (usually a static mount) the sensor relative to it.
   Eigen::Isometry3d world_from_pose_frame = Eigen::Isometry3d::Identity();
   *from_tf = false;
-  if (pose_topic_ && !pose_topic_->poseAt(t, tf, &world_from_pose_frame, why)) return false;
+  if (pose_topic_ && !pose_topic_->poseAt(t, tf, &world_from_pose_frame, why, tf_failures)) {
+    return false;
+  }
   *from_tf = true;
   const auto [target, source] = tfChain();
   Eigen::Isometry3d target_from_sensor;
   std::string error;
   if (!tf.lookup(target, source, t, &target_from_sensor, &error)) {
+    ++*tf_failures;
     std::ostringstream s;
     s << "no transform from '" << source << "' to '" << target << "' at t = " << std::fixed
       << std::setprecision(3) << t.toSec() << " (" << error << ")";

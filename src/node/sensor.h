@@ -7,6 +7,7 @@
 #include <ros/ros.h>
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -19,6 +20,7 @@
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scene.h"
 #include "laser_raycast/node/node_params.h"
+#include "live_params.h"
 #include "pose_topic.h"
 #include "sensor_monitor.h"
 #include "tf_source.h"
@@ -33,10 +35,7 @@ class Sensor {
   static constexpr double kSweepSampleSpacing = 0.01;  // s
 
   // The parameters that can change while the node runs (cfg/Raycast.cfg).
-  struct Live {
-    core::EncoderConfig output;  // range limits, min-range policy, noise, intensity, realism
-    double rate = 10.0;          // Hz
-  };
+  using Live = LiveParams;
 
   // history: how long pose topic messages are kept (s); threads: per cast (CastConfig::threads).
   Sensor(ros::NodeHandle& nh, const SensorParams& params, const std::string& fixed_frame,
@@ -54,13 +53,15 @@ class Sensor {
   std::vector<ros::Time> sampleTimes(const ros::Time& stamp) const;
 
   Live live() const;
-  // Validates `live` and applies it from the next scan; "" or the problem (naming the parameter).
+  // Validates `live` (applyLiveParams) and applies it from the next scan; "" or the problem
+  // (naming the parameter), the previous values staying.
   std::string setLive(const Live& live);
 
   // The sensor pose in fixed_frame at t; false with the reason in *why and whether TF (rather than
-  // the pose topic) lacked it in *from_tf.
+  // the pose topic) lacked it in *from_tf. The TF look-ups it made that failed (its chain, and with
+  // a pose topic the messages' frame) are added to *tf_failures.
   bool poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose, std::string* why,
-              bool* from_tf);
+              bool* from_tf, std::uint64_t* tf_failures);
   // Casts the scan whose pose samples are at `times`, from the frames and sensor poses at each,
   // and publishes it. missing_links: link transforms left out of it.
   void castAndPublish(const core::Scene& scene, const std::vector<double>& reflectivity,

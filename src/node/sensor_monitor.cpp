@@ -32,6 +32,11 @@ void SensorMonitor::published(const ros::Time& stamp, std::size_t missing_links,
   stats_.last_hit_share = hit_share;
 }
 
+void SensorMonitor::lookupFailures(std::uint64_t failures) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  stats_.tf_failures += failures;
+}
+
 void SensorMonitor::skipped(Skip kind, const ros::Time& stamp, const std::string& why) {
   std::lock_guard<std::mutex> lock(mutex_);
   switch (kind) {

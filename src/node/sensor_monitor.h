@@ -24,9 +24,13 @@ struct SensorStats {
   std::uint64_t published = 0;
   SkipCounts skipped;
   std::uint64_t missing_links = 0;  // link transforms left out of published scans, summed
-  double last_cast_seconds = 0;     // wall time of the last cast (look-ups and publishing excluded)
-  double last_hit_share = 0;        // share of the last scan's beams with a valid return
-  bool active = false;              // someone subscribes: scans are queued
+  // TF look-ups its scans needed that failed: its own pose's chain (to fixed_frame, or from
+  // pose_frame) and its pose topic's frames, at each sample time; and each link at each sample
+  // time (a look-up shared with other sensors due then counts for each of them).
+  std::uint64_t tf_failures = 0;
+  double last_cast_seconds = 0;  // wall time of the last cast (look-ups and publishing excluded)
+  double last_hit_share = 0;     // share of the last scan's beams with a valid return
+  bool active = false;           // someone subscribes: scans are queued
 };
 
 class SensorMonitor {
@@ -41,6 +45,8 @@ class SensorMonitor {
   bool quiet(const ros::Time& stamp);
   void published(const ros::Time& stamp, std::size_t missing_links, double cast_seconds,
                  double hit_share);
+  // Adds TF look-ups that failed (SensorStats::tf_failures).
+  void lookupFailures(std::uint64_t failures);
   // Counts a scan not published and warns (at most every kWarnPeriod) why, except while waiting.
   void skipped(Skip kind, const ros::Time& stamp, const std::string& why);
   // Whether scans are queued (someone listens); a lasting absence is logged once.

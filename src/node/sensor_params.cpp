@@ -138,10 +138,7 @@ void readSweep(ParamReader* r, SensorParams* s, std::vector<std::string>* warnin
 // Where the sensor pose comes from: TF, or a topic giving the pose of pose_frame.
 void readPoseSource(ParamReader* r, SensorParams* s) {
   s->pose_topic = r->text("pose_topic", s->pose_topic);
-  std::string why;
-  if (!s->pose_topic.empty() && !ros::names::validate(s->pose_topic, why)) {
-    r->fail("pose_topic", "'" + s->pose_topic + "' is not a valid topic name: " + why);
-  }
+  if (!s->pose_topic.empty()) checkTopic(r, "pose_topic", s->pose_topic);
   s->pose_frame = r->text("pose_frame", s->pose_frame);
   checkFrame(r, "pose_frame", s->pose_frame, true);
   if (!s->pose_frame.empty() && s->pose_topic.empty()) {
@@ -164,6 +161,20 @@ void checkFrame(ParamReader* r, const std::string& name, const std::string& fram
   if (!frame.empty() && frame[0] == '/') {
     r->fail(name, "'" + frame + "': tf2 frame ids must not start with '/'");
   }
+}
+
+bool checkTopic(ParamReader* r, const std::string& name, const std::string& topic) {
+  std::string why;
+  if (!ros::names::validate(topic, why)) {
+    r->fail(name, "'" + topic + "' is not a valid topic name: " + why);
+    return false;
+  }
+  if (topic[0] == '~') {
+    r->fail(name, "'" + topic + "': private topic names ('~') are not supported; give a name " +
+                      "relative to the node's namespace or a global one");
+    return false;
+  }
+  return true;
 }
 
 void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::string>* warnings) {

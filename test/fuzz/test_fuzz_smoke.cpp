@@ -6,7 +6,7 @@
 // checked, and a new finding comes from a long run (docs/testing.md), not as a failure of an
 // unrelated change. A time bound (60 s per harness with start-up) stops a slow machine early: it
 // then checks a prefix of the same inputs. Without clang the harnesses are not built and these
-// tests are skipped.
+// tests are skipped, unless LASER_RAYCAST_REQUIRE_FUZZ=1 (CI, .ci/run) makes that a failure.
 //
 // LASER_RAYCAST_FUZZ_SEED=N picks another seed (0: a random one, libFuzzer's choice);
 // LASER_RAYCAST_FUZZ_RUNS=N and LASER_RAYCAST_FUZZ_SECONDS=N set the number of inputs and the time
@@ -37,6 +37,12 @@ long setting(const char* name, long fallback) {
   return env && *env ? std::atol(env) : fallback;
 }
 
+// Whether the harnesses must have been built (CI): then their absence fails instead of skipping.
+bool fuzzRequired() {
+  const char* env = std::getenv("LASER_RAYCAST_REQUIRE_FUZZ");
+  return env && std::string(env) == "1";
+}
+
 // The fixed seed of every smoke run (any number; changing it changes which inputs are checked).
 constexpr long kSeed = 20261125;
 
@@ -47,7 +53,14 @@ void smoke(const std::string& harness, long runs, int duration,
   runs = setting("LASER_RAYCAST_FUZZ_RUNS", runs);
   duration = static_cast<int>(setting("LASER_RAYCAST_FUZZ_SECONDS", duration));
   const long seed = setting("LASER_RAYCAST_FUZZ_SEED", kSeed);
-  if (kFuzzers.empty()) GTEST_SKIP() << "the fuzz harnesses need clang (apt-get install clang)";
+  if (kFuzzers.empty()) {
+    if (fuzzRequired()) {
+      FAIL() << "the fuzz harnesses were not built (no clang++ when CMake configured the package) "
+                "and LASER_RAYCAST_REQUIRE_FUZZ=1: install clang and libclang-rt-dev, then "
+                "configure again";
+    }
+    GTEST_SKIP() << "the fuzz harnesses need clang (apt-get install clang libclang-rt-dev)";
+  }
   const fs::path work = fs::temp_directory_path() /
                         ("laser_raycast_fuzz_" + harness + "_" + std::to_string(getpid()));
   fs::remove_all(work);

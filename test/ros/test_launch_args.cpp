@@ -32,7 +32,7 @@ struct Parsed {
 Parsed parse(const XmlRpc::XmlRpcValue& values) {
   Parsed out;
   out.values = values;
-  out.error = laser_raycast::parseNodeParams(values, &out.params, &out.report);
+  out.error = laser_raycast::parseNodeParams(values, "/", &out.params, &out.report);
   return out;
 }
 

@@ -1,6 +1,8 @@
 // rostest node_pose_topic.test: the sensor pose from geometry_msgs/PoseWithCovarianceStamped (of
 // another frame, combined with TF) and from geometry_msgs/PoseStamped; a pose older than
-// ~pose_timeout or a non-finite one gives no scan.
+// ~pose_timeout or a non-finite one gives no scan; a pose in a frame without a transform is a
+// failed TF look-up in the diagnostics.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
@@ -10,8 +12,11 @@
 
 #include <array>
 #include <cmath>
+#include <iostream>
 #include <limits>
+#include <map>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "scan_access.h"
@@ -52,6 +57,35 @@ class PoseTopicTest : public ::testing::Test {
     mount.transform.translation.x = 0.5;
     mount.transform.rotation.w = 1;
     static_broadcaster_.sendTransform(mount);
+    diagnostics_sub_ = nh_.subscribe<diagnostic_msgs::DiagnosticArray>(
+        "/diagnostics", 20, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+          for (const auto& status : m->status) {
+            if (status.name != "plain: laser scans") continue;
+            std::lock_guard<std::mutex> lock(mutex_);
+            plain_status_stamp_ = m->header.stamp;
+            plain_status_.clear();
+            for (const auto& kv : status.values) plain_status_[kv.key] = kv.value;
+          }
+        });
+  }
+
+  // Node "plain"'s scans status ("<sensor> scans") from a report made after `after`, calling
+  // `publish` every 50 ms meanwhile (so that the pose does not go stale); empty (with a failure)
+  // if none comes.
+  template <class F>
+  std::map<std::string, std::string> plainStatusAfter(const ros::Time& after, F publish) {
+    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(10.0);
+    while (ros::ok() && ros::WallTime::now() < give_up) {
+      publish();
+      for (int i = 0; i < 5; ++i) {
+        ros::spinOnce();
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (plain_status_stamp_ > after) return plain_status_;
+        ros::WallDuration(0.01).sleep();
+      }
+    }
+    ADD_FAILURE() << "no diagnostics from node plain after t = " << after;
+    return {};
   }
 
   void store(sensor_msgs::LaserScan::ConstPtr* slot, const sensor_msgs::LaserScan::ConstPtr& m) {
@@ -108,10 +142,10 @@ class PoseTopicTest : public ::testing::Test {
     cov_pub_.publish(m);
   }
   // Returns the message's stamp.
-  ros::Time publishPlain(double x, double y, double qw) {
+  ros::Time publishPlain(double x, double y, double qw, const std::string& frame = "world") {
     geometry_msgs::PoseStamped m;
     m.header.stamp = ros::Time::now();
-    m.header.frame_id = "world";
+    m.header.frame_id = frame;
     m.pose.position.x = x;
     m.pose.position.y = y;
     m.pose.orientation.w = qw;
@@ -133,12 +167,24 @@ class PoseTopicTest : public ::testing::Test {
 
   ros::NodeHandle nh_;
   ros::Publisher cov_pub_, plain_pub_;
-  ros::Subscriber cov_sub_, plain_sub_;
+  ros::Subscriber cov_sub_, plain_sub_, diagnostics_sub_;
   tf2_ros::StaticTransformBroadcaster static_broadcaster_;
   std::mutex mutex_;
   sensor_msgs::LaserScan::ConstPtr cov_scan_, plain_scan_;
   std::vector<sensor_msgs::LaserScan::ConstPtr> plain_all_;
+  ros::Time plain_status_stamp_;
+  std::map<std::string, std::string> plain_status_;
 };
+
+// A diagnostics count, as a number (0 with a failure if absent).
+double count(const std::map<std::string, std::string>& status, const std::string& key) {
+  const auto found = status.find(key);
+  if (found == status.end()) {
+    ADD_FAILURE() << "no '" << key << "' in the diagnostics";
+    return 0;
+  }
+  return std::stod(found->second);
+}
 
 // Beam 4 looks along +x at the box face x = 2.5 (test/data/node_scene.urdf); beam 0 along -x at the
 // sphere surface x = -1.5.
@@ -187,6 +233,35 @@ TEST_F(PoseTopicTest, NoScanFromANonFinitePose) {
     const sensor_msgs::LaserScan again = scanAfter([&] { publishPlain(0.5, 0, 1); }, &plain_scan_);
     EXPECT_NEAR(rangeOf(again, 4), 2.0, kTolerance);
   }
+}
+
+// Poses in a frame TF cannot bring into fixed_frame: each scan is skipped (the pose topic's reason)
+// after a failed TF look-up, which the diagnostics count as such (a look-up failure, not a skip
+// for want of the sensor's transform). Poses are published all along, so that no scan is skipped
+// for a stale pose.
+TEST_F(PoseTopicTest, APoseInAFrameWithoutTransformIsAFailedTfLookUp) {
+  const auto good = [&] { publishPlain(0.5, 0, 1); };
+  const auto lost = [&] { publishPlain(0.5, 0, 1, "nowhere"); };
+  scanAfter(good, &plain_scan_);
+  const auto before = plainStatusAfter(ros::Time::now(), good);
+  const ros::Time last_good = publishPlain(0.5, 0, 1);
+  const auto scans = plainScansWhile(2.0, lost);
+  const auto after = plainStatusAfter(ros::Time::now(), lost);
+  expectNoScanFromAStalePose(scans, last_good);
+  const double failures =
+      count(after, "TF look-up failures") - count(before, "TF look-up failures");
+  const double skipped = count(after, "Scans skipped: pose topic stale or non-finite") -
+                         count(before, "Scans skipped: pose topic stale or non-finite");
+  std::cout << "2 s of poses in a frame without transform (20 Hz node): " << failures
+            << " failed TF look-ups, " << skipped << " scans skipped\n";
+  // About 40 scans in 2 s at 20 Hz (and more until the report), each skipped after a failed
+  // look-up.
+  EXPECT_GE(skipped, 20);
+  EXPECT_GE(failures, skipped);
+  EXPECT_EQ(count(after, "Scans skipped: no sensor transform"),
+            count(before, "Scans skipped: no sensor transform"));
+  const sensor_msgs::LaserScan again = scanAfter(good, &plain_scan_);
+  EXPECT_NEAR(rangeOf(again, 4), 2.0, kTolerance);
 }
 
 }  // namespace

@@ -1,138 +1,28 @@
-// rostest node_sensors.test: four sensors from one node over one scene (test/data/
+// rostest node_sensors.test: five sensors from one node over one scene (test/data/
 // sensors_room.urdf, a closed room with inner faces x = +-5, y = +-4, z = 0 and 4): a planar
 // scanner against hand-computed ranges, a VLP-16 cloud whose every point is checked against the
-// room's planes, a rotating scanner moving at 1 m/s away from a wall, a sensor nobody subscribes to
-// (not cast), the diagnostics, and a live reconfiguration taking effect from the next scan.
-#include <diagnostic_msgs/DiagnosticArray.h>
+// room's planes, a rotating scanner moving at 1 m/s away from a wall, a rotating 3D lidar's
+// organized cloud (per-column times, NaN points for no return), a sensor nobody subscribes to (not
+// cast), the diagnostics, and live reconfiguration taking effect from the next scan.
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
-#include <sensor_msgs/LaserScan.h>
-#include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
-#include <tf2_ros/static_transform_broadcaster.h>
-#include <tf2_ros/transform_broadcaster.h>
 
-#include <Eigen/Geometry>
 #include <cmath>
+#include <cstdint>
+#include <iostream>
 #include <limits>
 #include <map>
-#include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "scan_access.h"
+#include "sensors_rig.h"
 
 namespace laser_raycast_test {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
-// Ranges are floats: 1e-7 relative, well below this at 10 m.
-constexpr double kTolerance = 1e-4;  // m
-// The spinner's path (node_sensors.test): x = -3 + v (t - t0) along a 6 s ramp, then again.
-constexpr double kSpeed = 1.0;  // m/s
-constexpr double kRamp = 6.0;   // s
-
-geometry_msgs::TransformStamped transform(const ros::Time& stamp, const std::string& child,
-                                          const Eigen::Vector3d& t, double yaw) {
-  geometry_msgs::TransformStamped m;
-  m.header.stamp = stamp;
-  m.header.frame_id = "world";
-  m.child_frame_id = child;
-  m.transform.translation.x = t.x();
-  m.transform.translation.y = t.y();
-  m.transform.translation.z = t.z();
-  m.transform.rotation.z = std::sin(yaw / 2);
-  m.transform.rotation.w = std::cos(yaw / 2);
-  return m;
-}
-
-// The distance from p (inside the room) along unit direction d to the room's inner faces.
-double roomDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
-  const Eigen::Vector3d lo(-5, -4, 0), hi(5, 4, 4);
-  double t = kInf;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (d[axis] > 0) t = std::min(t, (hi[axis] - p[axis]) / d[axis]);
-    if (d[axis] < 0) t = std::min(t, (lo[axis] - p[axis]) / d[axis]);
-  }
-  return t;
-}
-
-// The sensor poses and what the node publishes, recorded from the spinner's threads.
-class Rig {
- public:
-  const Eigen::Vector3d front{0, 0, 1}, vlp{0.5, -0.3, 1.2};
-  const double vlp_yaw = 0.3;
-
-  Rig() {
-    start_ = ros::Time::now();
-    const ros::Time now = ros::Time::now();
-    statics_.sendTransform({transform(now, "front", front, 0), transform(now, "vlp", vlp, vlp_yaw),
-                            transform(now, "idle", front, 0)});
-    front_sub_ = nh_.subscribe("/front/scan", 100, &Rig::onFront, this);
-    vlp_sub_ = nh_.subscribe("/vlp/points", 5, &Rig::onVlp, this);
-    spinner_sub_ = nh_.subscribe("/spinner/scan", 20, &Rig::onSpinner, this);
-    diagnostics_sub_ = nh_.subscribe("/diagnostics", 20, &Rig::onDiagnostics, this);
-    timer_ = nh_.createTimer(ros::Duration(0.01), &Rig::publishSpinner, this);
-  }
-
-  // The spinner's x at time t (its y is 0, its height 1 m, no rotation).
-  double spinnerX(const ros::Time& t) const {
-    return -3 + kSpeed * std::fmod((t - start_).toSec(), kRamp);
-  }
-  // Whether [from, to] lies within one ramp of the path, away from its ends (the TF samples
-  // around a jump are interpolated across it).
-  bool withinOneRamp(const ros::Time& from, const ros::Time& to) const {
-    const double a = (from - start_).toSec() - 0.05, b = (to - start_).toSec() + 0.05;
-    return a > 0 && std::floor(a / kRamp) == std::floor(b / kRamp);
-  }
-
-  // Waits (wall time) for the first message in `slot` satisfying ok; nullptr after `seconds`.
-  template <class M, class F>
-  typename M::ConstPtr waitFor(std::vector<typename M::ConstPtr>* slot, F ok, double seconds) {
-    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(seconds);
-    std::size_t seen = 0;
-    while (ros::ok() && ros::WallTime::now() < give_up) {
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        for (; seen < slot->size(); ++seen) {
-          if (ok(*(*slot)[seen])) return (*slot)[seen];
-        }
-      }
-      ros::WallDuration(0.01).sleep();
-    }
-    return nullptr;
-  }
-
-  std::vector<sensor_msgs::LaserScan::ConstPtr> front_scans, spinner_scans;
-  std::vector<sensor_msgs::PointCloud2::ConstPtr> clouds;
-  std::vector<diagnostic_msgs::DiagnosticArray::ConstPtr> diagnostics;
-
- private:
-  template <class M>
-  void store(std::vector<M>* slot, const M& m) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    slot->push_back(m);
-  }
-  void onFront(const sensor_msgs::LaserScan::ConstPtr& m) { store(&front_scans, m); }
-  void onSpinner(const sensor_msgs::LaserScan::ConstPtr& m) { store(&spinner_scans, m); }
-  void onVlp(const sensor_msgs::PointCloud2::ConstPtr& m) { store(&clouds, m); }
-  void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
-    store(&diagnostics, m);
-  }
-  void publishSpinner(const ros::TimerEvent&) {
-    const ros::Time now = ros::Time::now();
-    broadcaster_.sendTransform(transform(now, "spinner", {spinnerX(now), 0, 1}, 0));
-  }
-
-  ros::NodeHandle nh_;
-  ros::Time start_;
-  tf2_ros::StaticTransformBroadcaster statics_;
-  tf2_ros::TransformBroadcaster broadcaster_;
-  ros::Subscriber front_sub_, vlp_sub_, spinner_sub_, diagnostics_sub_;
-  ros::Timer timer_;
-  std::mutex mutex_;
-};
 
 Rig* rig = nullptr;
 
@@ -222,25 +112,73 @@ TEST(NodeSensors, ARotatingScannerMovingAwayFromAWall) {
   EXPECT_GT(on_wall, 100);
 }
 
-// The status of `name` ("<node>: <task>") in the newest diagnostics that have it.
-const diagnostic_msgs::DiagnosticStatus* findStatus(
-    const std::vector<diagnostic_msgs::DiagnosticArray::ConstPtr>& arrays,
-    const std::string& suffix) {
-  for (auto a = arrays.rbegin(); a != arrays.rend(); ++a) {
-    for (const auto& s : (*a)->status) {
-      if (s.name.size() >= suffix.size() &&
-          s.name.compare(s.name.size() - suffix.size(), suffix.size(), suffix) == 0) {
-        return &s;
+// "sweep3d" (node_sensors.test): rings at -0.3, 0 and 0.3 rad (given unsorted), 361 azimuths over
+// the full turn, range_max 4.5 m, rotating at 10 Hz: the head turns in 0.1 s, so column c is taken
+// c * time_increment after the stamp, time_increment = (2 pi / 360) * 0.1 s / (2 pi).
+constexpr double kSweepElevations[3] = {-0.3, 0.0, 0.3};  // ring 0 lowest
+constexpr int kSweepAzimuths = 361;
+constexpr double kSweepRangeMax = 4.5;             // m
+constexpr double kSweepTimeIncrement = 0.1 / 360;  // s
+
+// Beam (ring, column) of sweep3d: its direction in the sensor frame, and the room's distance along
+// it from where the rig put the sensor.
+Eigen::Vector3d sweepDirection(int ring, int column) {
+  const double e = kSweepElevations[ring], a = -M_PI + column * (2 * M_PI / 360);
+  return {std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)};
+}
+double sweepDistance(int ring, int column) {
+  const Eigen::AngleAxisd yaw(rig->sweep3d_yaw, Eigen::Vector3d::UnitZ());
+  return roomDistance(rig->sweep3d, yaw * sweepDirection(ring, column));
+}
+// How many of sweep3d's beams meet the room within range_max.
+int sweepReturns() {
+  int n = 0;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < kSweepAzimuths; ++c) n += sweepDistance(r, c) <= kSweepRangeMax;
+  }
+  return n;
+}
+
+// The organized cloud of a rotating 3D lidar: every beam a point, row r ring r, each point's time
+// that of its column; a beam whose wall is beyond range_max is a NaN point, so is_dense is false.
+TEST(NodeSensors, ARotatingOrganizedCloudHasColumnTimesAndNanForNoReturn) {
+  const auto cloud = rig->waitFor<sensor_msgs::PointCloud2>(
+      &rig->sweep3d_clouds, [](const sensor_msgs::PointCloud2&) { return true; }, 30.0);
+  ASSERT_TRUE(cloud) << "no cloud from sensor sweep3d";
+  EXPECT_EQ(cloud->header.frame_id, "sweep3d");
+  ASSERT_EQ(cloud->height, 3u);
+  ASSERT_EQ(cloud->width, static_cast<std::uint32_t>(kSweepAzimuths));
+  ASSERT_EQ(cloud->data.size(), std::size_t{cloud->row_step} * cloud->height);
+  EXPECT_FALSE(cloud->is_dense);
+  sensor_msgs::PointCloud2ConstIterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
+  sensor_msgs::PointCloud2ConstIterator<float> intensity(*cloud, "intensity"), time(*cloud, "time");
+  sensor_msgs::PointCloud2ConstIterator<std::uint16_t> ring(*cloud, "ring");
+  int bad = 0, nan = 0, valid = 0;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < kSweepAzimuths; ++c, ++x, ++y, ++z, ++intensity, ++time, ++ring) {
+      const double expected = sweepDistance(r, c);
+      const Eigen::Vector3d p(*x, *y, *z);
+      bool ok = *ring == r && std::abs(*time - c * kSweepTimeIncrement) <= 1e-7;
+      if (expected > kSweepRangeMax) {
+        ++nan;
+        ok = ok && std::isnan(*x) && std::isnan(*y) && std::isnan(*z) && std::isnan(*intensity);
+      } else {
+        ++valid;
+        ok = ok && (p - expected * sweepDirection(r, c)).norm() < kTolerance;
+      }
+      if (!ok && ++bad <= 5) {
+        ADD_FAILURE() << "ring " << r << " column " << c << ": point " << p.transpose()
+                      << ", ring field " << *ring << ", time " << *time << " (expected "
+                      << c * kSweepTimeIncrement << " s); the room at " << expected << " m";
       }
     }
   }
-  return nullptr;
-}
-
-std::map<std::string, std::string> values(const diagnostic_msgs::DiagnosticStatus& s) {
-  std::map<std::string, std::string> out;
-  for (const auto& kv : s.values) out[kv.key] = kv.value;
-  return out;
+  EXPECT_EQ(bad, 0);
+  std::cout << "sweep3d: " << valid << " returns, " << nan << " NaN points of "
+            << 3 * kSweepAzimuths << "; last column at " << kSweepTimeIncrement * 360 << " s\n";
+  EXPECT_GT(nan, 100);
+  EXPECT_GT(valid, 100);
+  EXPECT_EQ(valid, sweepReturns());
 }
 
 TEST(NodeSensors, DiagnosticsPerSensorAndTheIdleOneIsNotCast) {
@@ -260,7 +198,7 @@ TEST(NodeSensors, DiagnosticsPerSensorAndTheIdleOneIsNotCast) {
       30.0);
   ASSERT_TRUE(array) << "no diagnostics with front's scans";
   const std::vector<diagnostic_msgs::DiagnosticArray::ConstPtr> arrays = {array};
-  for (const std::string sensor : {"front", "vlp", "spinner", "idle"}) {
+  for (const std::string sensor : {"front", "vlp", "spinner", "sweep3d", "idle"}) {
     const auto* rate = findStatus(arrays, sensor + " scan rate");
     const auto* scans = findStatus(arrays, sensor + " scans");
     ASSERT_TRUE(rate && scans) << "no diagnostics for sensor " << sensor;
@@ -280,17 +218,132 @@ TEST(NodeSensors, DiagnosticsPerSensorAndTheIdleOneIsNotCast) {
   EXPECT_EQ(values(*idle)["Events since startup"], "0");
 }
 
-// Sets front's range_max through dynamic_reconfigure; returns the values the node replied with.
-std::map<std::string, double> setFront(const std::string& name, double value) {
+// The sensors that are cast (someone subscribes), in the closed room.
+const std::vector<std::string> kCast = {"front", "vlp", "spinner", "sweep3d"};
+
+// Once the diagnostics' rate window (5 s) is full, each cast sensor achieves its rate within 10 %,
+// and every beam hits (they face the room's walls all round: share 1) except sweep3d's beyond its
+// range_max of 4.5 m. Front's transform is static: once it publishes, none of its look-ups fails.
+TEST(NodeSensors, DiagnosticsShowTheRatesMetAndEveryBeamHit) {
+  const auto full = [](const diagnostic_msgs::DiagnosticArray& a) {
+    for (const std::string& sensor : kCast) {
+      const auto* rate = statusIn(a, sensor + " scan rate");
+      if (!rate) return false;
+      for (const auto& kv : rate->values) {
+        if (kv.key == "Duration of window (s)" && std::stod(kv.value) < 4.9) return false;
+      }
+    }
+    return true;
+  };
+  const auto array = rig->waitFor<diagnostic_msgs::DiagnosticArray>(&rig->diagnostics, full, 60.0);
+  ASSERT_TRUE(array) << "no diagnostics with a full rate window for every cast sensor";
+  for (const std::string& sensor : kCast) {
+    const auto* rate = statusIn(*array, sensor + " scan rate");
+    const auto* scans = statusIn(*array, sensor + " scans");
+    ASSERT_TRUE(rate && scans) << sensor;
+    const double actual = number(*rate, "Actual frequency (Hz)");
+    const double target = number(*rate, "Target frequency (Hz)");
+    std::cout << sensor << ": " << actual << " Hz of " << target << " Hz over "
+              << number(*rate, "Duration of window (s)") << " s; share of beams hit "
+              << number(*scans, "Beams hit in the last scan (share)") << "\n";
+    EXPECT_NEAR(actual, target, 0.1 * target) << sensor;
+    EXPECT_EQ(rate->level, diagnostic_msgs::DiagnosticStatus::OK)
+        << sensor << ": " << rate->message;
+    const double share = sensor == "sweep3d" ? sweepReturns() / (3.0 * kSweepAzimuths) : 1.0;
+    // Printed with 6 significant digits; one beam of sweep3d's is 1 / 1083.
+    EXPECT_NEAR(number(*scans, "Beams hit in the last scan (share)"), share, 1e-5) << sensor;
+  }
+  EXPECT_EQ(number(*statusIn(*array, "front scan rate"), "Target frequency (Hz)"), 20.0);
+
+  // Two reports later, front has no new failed look-up.
+  const double failures = number(*statusIn(*array, "front scans"), "TF look-up failures");
+  const ros::Time later = array->header.stamp + ros::Duration(2.0);
+  const auto next = rig->waitFor<diagnostic_msgs::DiagnosticArray>(
+      &rig->diagnostics,
+      [&](const diagnostic_msgs::DiagnosticArray& a) { return a.header.stamp >= later; }, 10.0);
+  ASSERT_TRUE(next) << "no diagnostics 2 s later";
+  const auto* front_then = statusIn(*next, "front scans");
+  ASSERT_TRUE(front_then);
+  EXPECT_EQ(number(*front_then, "TF look-up failures"), failures);
+}
+
+// The scan times of one second that need link poses, from the sensors' configuration
+// (node_sensors.test): front's 20 Hz stamps (vlp's 10 Hz ones among them), and the sample times of
+// the rotating spinner and sweep3d at 10 Hz: from each stamp to its last beam 0.1 s later, at most
+// 10 ms apart (Sensor::kSweepSampleSpacing), i.e. stamp + 0, 10, ..., 100 ms.
+std::size_t scanTimesPerSecond() {
+  std::set<std::int64_t> ms;
+  for (int k = 0; k < 20; ++k) ms.insert(50 * k);
+  for (int k = 0; k < 10; ++k) {
+    for (int j = 0; j <= 10; ++j) ms.insert((100 * k + 10 * j) % 1000);
+  }
+  return ms.size();
+}
+
+// The link poses are looked up once per scan time for every sensor due then: an instantaneous and
+// a rotating sensor at one stamp share it, and the 20 Hz stamps inside a sweep. The node counts its
+// link look-ups ("link poses"); over 5 s they must come to link frames x scan times, not more
+// (one look-up per job would make 130 a second here instead of 100).
+TEST(NodeSensors, LinkPosesAreLookedUpOncePerScanTime) {
+  const auto has = [](const diagnostic_msgs::DiagnosticArray& a) {
+    return statusIn(a, "link poses") != nullptr;
+  };
+  const ros::Time now = ros::Time::now();  // every sensor casts by now (the tests above)
+  const auto first = rig->waitFor<diagnostic_msgs::DiagnosticArray>(
+      &rig->diagnostics,
+      [&](const diagnostic_msgs::DiagnosticArray& a) { return has(a) && a.header.stamp >= now; },
+      30.0);
+  ASSERT_TRUE(first) << "no 'link poses' diagnostics";
+  const ros::Time later = first->header.stamp + ros::Duration(5.0);
+  const auto last = rig->waitFor<diagnostic_msgs::DiagnosticArray>(
+      &rig->diagnostics,
+      [&](const diagnostic_msgs::DiagnosticArray& a) { return has(a) && a.header.stamp >= later; },
+      20.0);
+  ASSERT_TRUE(last) << "no 'link poses' diagnostics 5 s later";
+  const double frames = number(*statusIn(*last, "link poses"), "Link frames");
+  const double lookups = number(*statusIn(*last, "link poses"), "Link pose look-ups") -
+                         number(*statusIn(*first, "link poses"), "Link pose look-ups");
+  const double seconds = (last->header.stamp - first->header.stamp).toSec();
+  const double expected = frames * scanTimesPerSecond();
+  std::cout << "link pose look-ups: " << lookups / seconds << " a second for " << frames
+            << " link frames and " << scanTimesPerSecond() << " scan times a second\n";
+  EXPECT_EQ(frames, 1.0);  // the room's links are merged into its root, "world"
+  EXPECT_EQ(scanTimesPerSecond(), 100u);
+  EXPECT_NEAR(lookups / seconds, expected, 0.05 * expected);
+}
+
+// Sets one of front's live parameters through dynamic_reconfigure; returns the configuration the
+// node replied with.
+dynamic_reconfigure::Config reconfigureFront(const dynamic_reconfigure::Config& change) {
   dynamic_reconfigure::Reconfigure srv;
+  srv.request.config = change;
+  EXPECT_TRUE(ros::service::call("/laser_raycast/front/set_parameters", srv));
+  return srv.response.config;
+}
+
+// A double parameter of front; returns the doubles the node replied with.
+std::map<std::string, double> setFront(const std::string& name, double value) {
+  dynamic_reconfigure::Config change;
   dynamic_reconfigure::DoubleParameter p;
   p.name = name;
   p.value = value;
-  srv.request.config.doubles.push_back(p);
-  EXPECT_TRUE(ros::service::call("/laser_raycast/front/set_parameters", srv));
+  change.doubles.push_back(p);
   std::map<std::string, double> out;
-  for (const auto& d : srv.response.config.doubles) out[d.name] = d.value;
+  for (const auto& d : reconfigureFront(change).doubles) out[d.name] = d.value;
   return out;
+}
+
+// A string parameter of front; returns the value of that parameter the node replied with.
+std::string setFront(const std::string& name, const std::string& value) {
+  dynamic_reconfigure::Config change;
+  dynamic_reconfigure::StrParameter p;
+  p.name = name;
+  p.value = value;
+  change.strs.push_back(p);
+  for (const auto& v : reconfigureFront(change).strs) {
+    if (v.name == name) return v.value;
+  }
+  return "<not in the reply>";
 }
 
 TEST(NodeSensors, AReconfigureAppliesToTheNextScan) {
@@ -318,6 +371,63 @@ TEST(NodeSensors, AReconfigureAppliesToTheNextScan) {
       10.0);
   ASSERT_TRUE(scan) << "no scan after the second reconfiguration";
   EXPECT_NEAR(rangeOf(*scan, 4), 5.0, kTolerance);
+}
+
+// front's scans stamped after `after`: `count` of them, consecutive, `period` apart on the grid
+// of that period, each saying scan_time = period.
+void expectScansEvery(const ros::Time& after, double period, std::size_t count) {
+  const auto scans = rig->waitForSome<sensor_msgs::LaserScan>(
+      &rig->front_scans, [&](const sensor_msgs::LaserScan& s) { return s.header.stamp > after; },
+      count, 10 + count * period);
+  ASSERT_EQ(scans.size(), count) << "scans after t = " << after << " at " << period << " s";
+  const auto grid = static_cast<std::uint64_t>(std::llround(period * 1e9));
+  for (std::size_t i = 0; i < count; ++i) {
+    EXPECT_EQ(scans[i]->header.stamp.toNSec() % grid, 0u) << scans[i]->header.stamp;
+    EXPECT_NEAR(scans[i]->scan_time, period, 1e-6);
+    if (i > 0) {
+      EXPECT_NEAR((scans[i]->header.stamp - scans[i - 1]->header.stamp).toSec(), period, 1e-6)
+          << "scan " << i << " at t = " << scans[i]->header.stamp;
+    }
+  }
+}
+
+// A live rate restarts the timer on the new period's grid: from 20 Hz to 5 Hz and back.
+TEST(NodeSensors, ALiveRateChangesThePeriod) {
+  ASSERT_TRUE(ros::service::waitForService("/laser_raycast/front/set_parameters", 30000));
+  // Scans queued before a change are stamped at most one old period after it.
+  ros::Time changed = ros::Time::now();
+  EXPECT_EQ(setFront("rate", 5.0)["rate"], 5.0);
+  expectScansEvery(changed + ros::Duration(1.0 / 20), 1.0 / 5, 4);
+  changed = ros::Time::now();
+  EXPECT_EQ(setFront("rate", 20.0)["rate"], 20.0);
+  expectScansEvery(changed + ros::Duration(1.0 / 5), 1.0 / 20, 6);
+}
+
+// Intensity switched on while the node runs: from the next scan, the links' reflectivity (1, the
+// default) times |cos| of the incidence angle: 1 for the beams along the room's axes, which meet
+// the walls head-on, cos 45 deg for the diagonals (on the y walls, 4 m being nearer than 5).
+// Switched off: no intensities.
+TEST(NodeSensors, ALiveIntensityToggle) {
+  ASSERT_TRUE(ros::service::waitForService("/laser_raycast/front/set_parameters", 30000));
+  EXPECT_EQ(setFront("intensity", "reflectivity"), "reflectivity");
+  const ros::Time on = ros::Time::now() + ros::Duration(1.0 / 20);
+  auto scan = rig->waitFor<sensor_msgs::LaserScan>(
+      &rig->front_scans, [&](const sensor_msgs::LaserScan& s) { return s.header.stamp >= on; },
+      10.0);
+  ASSERT_TRUE(scan) << "no scan after switching intensity on";
+  ASSERT_EQ(scan->intensities.size(), 8u);
+  for (int i = 0; i < 8; ++i) {
+    EXPECT_NEAR(scan->intensities[i], i % 2 == 0 ? 1.0 : std::sqrt(0.5), 1e-6) << "beam " << i;
+  }
+  EXPECT_NEAR(rangeOf(*scan, 0), 5.0, kTolerance);  // the ranges stay
+
+  EXPECT_EQ(setFront("intensity", "off"), "off");
+  const ros::Time off = ros::Time::now() + ros::Duration(1.0 / 20);
+  scan = rig->waitFor<sensor_msgs::LaserScan>(
+      &rig->front_scans, [&](const sensor_msgs::LaserScan& s) { return s.header.stamp >= off; },
+      10.0);
+  ASSERT_TRUE(scan) << "no scan after switching intensity off";
+  EXPECT_TRUE(scan->intensities.empty());
 }
 
 }  // namespace

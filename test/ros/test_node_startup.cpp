@@ -111,6 +111,10 @@ TEST(NodeStartup, BadSensorInputStopsTheNodeBeforeAnythingStarts) {
   same_topic[1]["topic"] = "scan";
   nh.setParam("/p5/node/sensors", same_topic);
   refused(scene("/p5"), {"~sensors[1]/topic", "'scan'", "~sensors[0]"});
+  // Written differently, one topic once resolved in the node's namespace (/p6).
+  same_topic[1]["topic"] = "/p6/scan";
+  nh.setParam("/p6/node/sensors", same_topic);
+  refused(scene("/p6"), {"~sensors[1]/topic", "'/p6/scan' publishes on /p6/scan", "('scan')"});
 }
 
 TEST(NodeStartup, ReflectivityOfAnUnknownLink) {

@@ -35,22 +35,24 @@ struct Parsed {
   std::string error;
 };
 
-inline Parsed parse(const XmlRpc::XmlRpcValue& v) {
+// Parsed for a node whose topics are in namespace ns (the root namespace unless given).
+inline Parsed parse(const XmlRpc::XmlRpcValue& v, const std::string& ns = "/") {
   Parsed out;
-  out.error = laser_raycast::parseNodeParams(v, &out.params, &out.report);
+  out.error = laser_raycast::parseNodeParams(v, ns, &out.params, &out.report);
   return out;
 }
 
 // The parameters must be refused with a message containing every one of `mentions`.
-inline void expectRefused(const XmlRpc::XmlRpcValue& v, const std::vector<std::string>& mentions) {
-  const Parsed parsed = parse(v);
-  EXPECT_FALSE(parsed.error.empty()) << "accepted " << v.toXml();
+inline void expectRefused(const XmlRpc::XmlRpcValue& v, const std::vector<std::string>& mentions,
+                          const std::string& ns = "/") {
+  const Parsed parsed = parse(v, ns);
+  EXPECT_FALSE(parsed.error.empty()) << "accepted " << v.toXml() << " in namespace " << ns;
   expectMentions(parsed.error, mentions);
 }
 
-inline void expectAccepted(const XmlRpc::XmlRpcValue& v) {
-  const Parsed parsed = parse(v);
-  EXPECT_EQ(parsed.error, "") << v.toXml();
+inline void expectAccepted(const XmlRpc::XmlRpcValue& v, const std::string& ns = "/") {
+  const Parsed parsed = parse(v, ns);
+  EXPECT_EQ(parsed.error, "") << v.toXml() << " in namespace " << ns;
 }
 
 }  // namespace laser_raycast_test

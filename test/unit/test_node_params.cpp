@@ -329,8 +329,11 @@ TEST(NodeParams, PoseFrameWithoutPoseTopicIsRefused) {
 TEST(NodeParams, PoseTopicMustBeAValidName) {
   expectRefused(values({{"pose_topic", "my pose"}}),
                 {"~pose_topic", "'my pose'", "not a valid topic name"});
-  expectAccepted(values({{"pose_topic", "~pose"}}));
+  // A NodeHandle throws on a private name: refused here instead of stopping the node with an
+  // uncaught exception.
+  expectRefused(values({{"pose_topic", "~pose"}}), {"~pose_topic", "'~pose'", "private"});
   expectAccepted(values({{"pose_topic", "/robot/pose"}}));
+  expectAccepted(values({{"pose_topic", "pose"}}));
 }
 
 TEST(NodeParams, FramesWithALeadingSlashOrEmptyAreRefused) {

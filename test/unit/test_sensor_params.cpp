@@ -174,6 +174,70 @@ TEST(SensorParams, BadSensorsEntriesNameTheEntry) {
   expectRefused(values({{"sensors", "front"}}), {"~sensors", "non-empty list"});
 }
 
+// An entry without a name is named after its frame_id, made a valid name without '/' (it names the
+// namespace of the sensor's live parameters and the default topic).
+TEST(SensorParams, TheDefaultNameIsAValidNameMadeFromTheFrame) {
+  const Parsed parsed = parse(values({{"sensors", list({sensor({{"frame_id", "r1/laser"}}),
+                                                        sensor({{"frame_id", "2d-lidar.front"}}),
+                                                        sensor({{"frame_id", "top"}})})}}));
+  ASSERT_EQ(parsed.error, "");
+  ASSERT_EQ(parsed.params.sensors.size(), 3u);
+  EXPECT_EQ(parsed.params.sensors[0].name, "r1_laser");
+  EXPECT_EQ(parsed.params.sensors[0].frame_id, "r1/laser");
+  EXPECT_EQ(parsed.params.sensors[0].topic, "r1_laser/scan");
+  EXPECT_EQ(parsed.params.sensors[1].name, "sensor_2d_lidar_front");
+  EXPECT_EQ(parsed.params.sensors[2].name, "top");
+  const auto& log = parsed.report.values;
+  EXPECT_NE(std::find(log.begin(), log.end(), "~sensors[0]/name unset: 'r1_laser' (from frame_id)"),
+            log.end());
+  // Its live parameters (~r1_laser) are not taken for a typo.
+  const Parsed live = parse(values({{"sensors", list({sensor({{"frame_id", "r1/laser"}})})},
+                                    {"r1_laser", values({{"rate", 5}})}}));
+  ASSERT_EQ(live.error, "");
+  EXPECT_TRUE(live.report.warnings.empty()) << live.report.warnings.front();
+  // Two frames that give one name are refused as any two equal names are.
+  expectRefused(values({{"sensors", list({sensor({{"frame_id", "r1/laser"}}),
+                                          sensor({{"frame_id", "r1_laser"}})})}}),
+                {"~sensors[1]/name", "'r1_laser' is also the name of ~sensors[0]"});
+  // A name given explicitly is not changed.
+  expectRefused(values({{"sensors", list({sensor({{"frame_id", "a"}, {"name", "r1/laser"}})})}}),
+                {"~sensors[0]/name", "'r1/laser'"});
+}
+
+// Topics are compared as the node advertises them, resolved in its namespace: "scan" and "/scan"
+// are one topic in the root namespace, not in /robot, where "scan" is "/robot/scan".
+TEST(SensorParams, DuplicateTopicsAreFoundAfterResolving) {
+  const auto two = [](const std::string& a, const std::string& b) {
+    return values({{"sensors", list({sensor({{"frame_id", "a"}, {"topic", a}}),
+                                     sensor({{"frame_id", "b"}, {"topic", b}})})}});
+  };
+  expectRefused(two("scan", "/scan"), {"~sensors[1]/topic", "'/scan' publishes on /scan",
+                                       "as ~sensors[0] does ('scan')"});
+  expectRefused(two("/scan", "scan"), {"~sensors[1]/topic", "'scan' publishes on /scan"});
+  expectRefused(two("a//scan/", "/a/scan"), {"~sensors[1]/topic", "/a/scan"});
+  expectAccepted(two("scan", "/scan"), "/robot");
+  expectRefused(two("scan", "/robot/scan"), {"publishes on /robot/scan", "namespace /robot"},
+                "/robot");
+  // The labels' topics too: "/a_labels" is sensor a's labels topic.
+  expectRefused(two("a", "/a_labels"),
+                {"~sensors[1]/topic", "'/a_labels' publishes on /a_labels", "('a_labels')"});
+  // A default topic (a/scan: <name>/scan) against an explicit global one.
+  expectRefused(values({{"sensors", list({sensor({{"frame_id", "a"}}),
+                                          sensor({{"frame_id", "b"}, {"topic", "/a/scan"}})})}}),
+                {"~sensors[1]/topic", "'/a/scan' publishes on /a/scan", "('a/scan')"});
+  EXPECT_THROW(parse(values({}), "robot"), std::invalid_argument);
+}
+
+// A NodeHandle refuses private names: such a topic would stop the node with an exception at
+// start-up, not with a message naming the parameter.
+TEST(SensorParams, PrivateTopicNamesAreRefused) {
+  expectRefused(values({{"sensors", list({sensor({{"frame_id", "a"}, {"topic", "~scan"}})})}}),
+                {"~sensors[0]/topic", "'~scan'", "private"});
+  expectRefused(values({{"pose_topic", "~pose"}}), {"~pose_topic", "'~pose'", "private"});
+  expectRefused(values({{"sensors", list({sensor({{"frame_id", "a"}, {"pose_topic", "~p"}})})}}),
+                {"~sensors[0]/pose_topic", "'~p'", "private"});
+}
+
 TEST(SensorParams, SensorsEntriesWarnAboutUnknownKeysButNotTheirLiveParameters) {
   const Parsed parsed =
       parse(values({{"sensors", list({sensor({{"frame_id", "a"}, {"sampels", 5}})})},

@@ -56,8 +56,10 @@ struct SensorParams {
   static constexpr double kMaxRate = 1000.0;  // Hz
 
   // Entries of ~sensors: its name (in the log, the diagnostics, and the namespace of its live
-  // parameters), default frame_id; and its topic, default <name>/scan or <name>/points. The
-  // shorthand: frame_id, and scan or points (relative to the node's namespace).
+  // parameters), default frame_id made a valid name ('/' and other characters a name may not hold
+  // become '_', "sensor_" in front if it does not start with a letter); and its topic, default
+  // <name>/scan or <name>/points. The shorthand: frame_id, and scan or points (relative to the
+  // node's namespace).
   std::string name;
   std::string topic;
   std::string sensor_model;        // a preset (core::kSensorModelNames), "" for none
@@ -117,19 +119,23 @@ struct ParamReport {
 };
 
 // Parses the node's private parameters from `values`, a struct of them as the parameter server
-// returns the private namespace (an invalid value: none set). Unset parameters take their
-// defaults. Entries of ~models that name a parameter are kept as names (the node reads the URDF).
-// Returns "" on success, or the first error: a message naming the parameter and its bad value
-// (wrong type, out of range, inconsistent with another parameter). The report is filled either
-// way.
-std::string parseNodeParams(const XmlRpc::XmlRpcValue& values, NodeParams* params,
-                            ParamReport* report);
+// returns the private namespace (an invalid value: none set). `ns` is the namespace the node
+// resolves its topics in (its NodeHandle's: "/" or e.g. "/robot1"; std::invalid_argument if it is
+// not a global name), so that two sensors publishing on one topic are refused however their names
+// are written. Unset parameters take their defaults. Entries of ~models that name a parameter are
+// kept as names (the node reads the URDF). Returns "" on success, or the first error: a message
+// naming the parameter and its bad value (wrong type, out of range, inconsistent with another
+// parameter). The report is filled either way.
+std::string parseNodeParams(const XmlRpc::XmlRpcValue& values, const std::string& ns,
+                            NodeParams* params, ParamReport* report);
 
 // The name of every parameter parseNodeParams reads, in the order it reads them.
 std::vector<std::string> nodeParamNames();
 
-// Fetches the private namespace of pnh from the parameter server and parses it, logging each value
-// (INFO) and each warning (WARN). Returns false with the message in *error on a bad value.
-bool readNodeParams(const ros::NodeHandle& pnh, NodeParams* params, std::string* error);
+// Fetches the private namespace of pnh from the parameter server and parses it for a node whose
+// topics are advertised in nh, logging each value (INFO) and each warning (WARN). Returns false
+// with the message in *error on a bad value.
+bool readNodeParams(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, NodeParams* params,
+                    std::string* error);
 
 }  // namespace laser_raycast

@@ -1,0 +1,113 @@
+// What a live change (dynamic_reconfigure, Sensor::setLive) may change, without a node: the
+// refusals name the parameter and the value and leave the previous values; the rest is applied.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "expect_invalid.h"
+#include "live_params.h"
+
+namespace laser_raycast_test {
+namespace {
+
+using laser_raycast::applyLiveParams;
+using laser_raycast::LiveParams;
+using laser_raycast::liveParams;
+using laser_raycast::SensorParams;
+using laser_raycast::Sweep;
+
+// A rotating scanner at 10 Hz whose head turns in 0.1 s (scan_time set explicitly).
+SensorParams rotating(double scan_time) {
+  SensorParams p;
+  p.rate = 10.0;
+  p.sweep = Sweep::kRotating;
+  p.scan_time = scan_time;
+  return p;
+}
+
+// Expects the change refused with every one of `mentions`, and params unchanged.
+void expectRefused(const LiveParams& live, SensorParams params,
+                   const std::vector<std::string>& mentions) {
+  const SensorParams before = params;
+  const std::string error = applyLiveParams(live, &params);
+  EXPECT_FALSE(error.empty()) << "accepted rate " << live.rate;
+  expectMentions(error, mentions);
+  EXPECT_EQ(params.rate, before.rate);
+  EXPECT_EQ(params.scan.output.range_max, before.scan.output.range_max);
+  EXPECT_EQ(params.scan.output.intensity, before.scan.output.intensity);
+}
+
+// One turn per scan: with scan_time 0.1 s the period may not drop below 0.1 s (10 Hz).
+TEST(LiveParams, ARateTooFastForScanTimeIsRefused) {
+  const SensorParams p = rotating(0.1);
+  LiveParams live = liveParams(p);
+  live.rate = 20.0;
+  live.output.range_max = 12.0;  // the whole change is refused, not just the rate
+  expectRefused(live, p, {"rate 20 Hz", "too fast for scan_time 0.1 s", "restart"});
+
+  // 10 Hz exactly and slower are fine.
+  for (const double rate : {10.0, 4.0}) {
+    SensorParams q = p;
+    live.rate = rate;
+    EXPECT_EQ(applyLiveParams(live, &q), "") << rate;
+    EXPECT_EQ(q.rate, rate);
+    EXPECT_EQ(q.scan.output.range_max, 12.0);
+    EXPECT_EQ(q.scan_time, 0.1);
+  }
+}
+
+// Without scan_time the head turns once per period, whatever the rate; an instantaneous sensor has
+// no turn.
+TEST(LiveParams, ScanTimeFollowingTheRateOrNoSweepAllowsAnyRate) {
+  for (SensorParams p : {rotating(0.0), SensorParams()}) {
+    if (p.sweep == Sweep::kInstant) p.scan_time = 0.1;  // no effect without a sweep
+    LiveParams live = liveParams(p);
+    live.rate = 50.0;
+    EXPECT_EQ(applyLiveParams(live, &p), "");
+    EXPECT_EQ(p.rate, 50.0);
+  }
+  SensorParams p = rotating(0.0);
+  LiveParams live = liveParams(p);
+  live.rate = 50.0;
+  ASSERT_EQ(applyLiveParams(live, &p), "");
+  EXPECT_DOUBLE_EQ(p.scanTime(), 1.0 / 50);
+}
+
+TEST(LiveParams, RatesOutsideTheRangeAreRefused) {
+  for (const double rate : {0.0, -1.0, 1000.5, std::numeric_limits<double>::quiet_NaN(),
+                            std::numeric_limits<double>::infinity()}) {
+    LiveParams live = liveParams(SensorParams());
+    live.rate = rate;
+    expectRefused(live, SensorParams(), {"rate must be in (0, 1000] Hz"});
+  }
+}
+
+// The encoder's own validation, naming the field.
+TEST(LiveParams, InconsistentOutputSettingsAreRefused) {
+  LiveParams live = liveParams(SensorParams());
+  live.output.range_min = 6.0;
+  live.output.range_max = 4.5;
+  expectRefused(live, SensorParams(), {"range_max"});
+  live = liveParams(SensorParams());
+  live.output.dropout_probability = 1.5;
+  expectRefused(live, SensorParams(), {"dropout_probability", "1.5"});
+}
+
+TEST(LiveParams, AnAcceptedChangeIsApplied) {
+  SensorParams p;
+  LiveParams live = liveParams(p);
+  live.rate = 5.0;
+  live.output.intensity = true;
+  live.output.range_max = 4.5;
+  ASSERT_EQ(applyLiveParams(live, &p), "");
+  EXPECT_EQ(p.rate, 5.0);
+  EXPECT_TRUE(p.scan.output.intensity);
+  EXPECT_EQ(p.scan.output.range_max, 4.5);
+  EXPECT_EQ(liveParams(p).rate, 5.0);
+}
+
+}  // namespace
+}  // namespace laser_raycast_test
