@@ -50,8 +50,14 @@ class MeshWalk {
         frame_(active.sensor_from_body, planar_, config.tmax),
         stamp_(beams.newWalkStamp()) {
     if (slicing_) {
-      slicer_.emplace(mesh, active.sensor_from_body, beams.pattern(), config.tmin, config.tmax,
-                      config.cull_backfaces);
+      // Cut in the frame's plane coordinates when the walk gives them (as a kept slice is).
+      if (active.plane) {
+        slicer_.emplace(mesh, *active.plane, active.frame_from_body, active.sensor_from_body,
+                        beams.pattern(), config.tmin, config.tmax, config.cull_backfaces);
+      } else {
+        slicer_.emplace(mesh, active.sensor_from_body, beams.pattern(), config.tmin, config.tmax,
+                        config.cull_backfaces);
+      }
     }
   }
 

@@ -9,6 +9,8 @@
 #include "laser_raycast/core/beam_set.h"
 #include "laser_raycast/core/beam_window.h"
 #include "laser_raycast/core/body_traversal.h"
+#include "laser_raycast/core/plane_slice.h"
+#include "laser_raycast/core/plane_walk.h"
 #include "laser_raycast/core/pose.h"
 #include "laser_raycast/core/scene_walk.h"
 #include "laser_raycast/core/thread_pool.h"
@@ -53,7 +55,7 @@ bool CastConfig::operator==(const CastConfig& o) const {
   return method == o.method && cull_backfaces == o.cull_backfaces && tmin == o.tmin &&
          tmax == o.tmax && planar_fast_path == o.planar_fast_path &&
          raster_fast_path == o.raster_fast_path && occlusion_culling == o.occlusion_culling &&
-         compute_incidence == o.compute_incidence;
+         plane_cache == o.plane_cache && compute_incidence == o.compute_incidence;
 }
 
 Caster::Caster() : beams_(std::make_unique<BeamSet>()) {}
@@ -172,9 +174,30 @@ void Caster::castBodies(const Scene& scene, const ScanPattern& pattern, const Ca
   const std::size_t bodies = scene.bodies().size();
   if (cast_.size() != bodies) cast_ = std::vector<std::atomic<char>>(bodies);
   for (auto& mark : cast_) mark.store(0, std::memory_order_relaxed);
-  auto castWithin = [&](const BeamRect& within) {
+  PlaneSliceCache* planes = nullptr;
+  if (pattern.planar() && config.planar_fast_path && config.plane_cache) {
+    if (!planes_) planes_ = std::make_unique<PlaneSliceCache>();
+    planes_->newScan();
+    planes = planes_.get();
+  }
+  // Planar fans: each frame's kept slice by this plane, where there is one.
+  std::vector<std::pair<PlaneFrame, const PlaneSlice*>> slices;
+  if (pattern.planar() && config.planar_fast_path) {
     for (const PlacedGroup& p : placed_) {
-      castGroup(*beams_, scene, *p.group, *p.sensor_from_frame, config, within, &cast_);
+      slices.emplace_back(PlaneFrame(*p.sensor_from_frame), nullptr);
+      if (planes) slices.back().second = planes->find(scene, *p.group, slices.back().first);
+      result_.stats.kept_slices += slices.back().second != nullptr;
+    }
+  }
+  auto castWithin = [&](const BeamRect& within) {
+    for (std::size_t g = 0; g < placed_.size(); ++g) {
+      const PlacedGroup& p = placed_[g];
+      if (g < slices.size() && slices[g].second) {
+        castSlice(*beams_, scene, *slices[g].second, slices[g].first, *p.sensor_from_frame, config,
+                  within, &cast_);
+      } else {
+        castGroup(*beams_, scene, *p.group, *p.sensor_from_frame, config, within, &cast_);
+      }
     }
   };
   int threads = config.threads;

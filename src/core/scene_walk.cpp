@@ -1,8 +1,10 @@
 #include "laser_raycast/core/scene_walk.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "laser_raycast/core/body_traversal.h"
+#include "laser_raycast/core/fan_slicer.h"
 #include "laser_raycast/core/node_views.h"
 
 namespace laser_raycast {
@@ -21,7 +23,9 @@ class GroupWalk {
         config_(config),
         cast_(cast),
         planar_(beams.pattern().planar()),
-        frame_(sensor_from_frame, planar_, config.tmax) {}
+        frame_(sensor_from_frame, planar_, config.tmax) {
+    if (planar_) plane_.emplace(sensor_from_frame);
+  }
 
   void run(const BeamRect& within) {
     if (group_.wide.empty()) return;
@@ -97,6 +101,10 @@ class GroupWalk {
     if (!(a.view.near <= config_.tmax) || (planar_ && !a.view.crosses)) return;
     a.body_from_sensor_rot = rot.transpose();
     a.sensor_in_body = -(a.body_from_sensor_rot * a.sensor_from_body.translation());
+    if (plane_) {
+      a.plane = &*plane_;
+      a.frame_from_body = body.frame_from_body;
+    }
     const int slot = static_cast<int>(bodies_.size());
     bodies_.push_back(a);
     beams_.forEachRect(a.view, rect, [&](const BeamRect& r) {
@@ -112,6 +120,7 @@ class GroupWalk {
   std::vector<std::atomic<char>>* cast_;
   const bool planar_;
   const ViewFrame frame_;
+  std::optional<PlaneFrame> plane_;  // planar fans: the scan plane in the frame
   // Nearest first over the whole tree (a heap rather than a stack: a depth-first walk would finish
   // a near node's far bodies before the next near node), so that near hits hide far bodies.
   static bool farther(const Entry& a, const Entry& b) { return a.near > b.near; }

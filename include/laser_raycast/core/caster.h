@@ -36,6 +36,10 @@ struct CastConfig {
   // Skip bodies and BVH nodes that every beam able to reach them has already passed (a nearer
   // hit). Never changes the result; off only to test that.
   bool occlusion_culling = true;
+  // Planar fans: keep each mesh's slice by a scan plane met again (a sensor moving in its own
+  // plane, as on a floor) and cast later scans through it (plane_slice.h). Never changes the
+  // result; off to measure a cast whose plane is new every scan, or to test that.
+  bool plane_cache = true;
 
   // Throws std::invalid_argument naming the field and its value.
   void validate() const;
@@ -49,6 +53,9 @@ struct CastStats {
   // (planar fans), or hidden behind nearer hits.
   int bodies_culled = 0;
   bool reused = false;  // nothing moved relative to the sensor: the previous geometry was returned
+  // Planar fans: frames cast through a kept slice of their bodies by the scan plane
+  // (plane_slice.h).
+  int kept_slices = 0;
 };
 
 struct ScanResult {
@@ -63,6 +70,8 @@ struct ScanResult {
 };
 
 class BeamSet;
+struct PlaneFrame;
+class PlaneSliceCache;
 class ThreadPool;
 
 class Caster {
@@ -89,6 +98,8 @@ class Caster {
                               double time_increment);
 
   // Drops the remembered inputs, so that the next cast() computes even if nothing moved (timing).
+  // Kept slices of meshes by scan planes (CastConfig::plane_cache) stay: like the meshes' BVHs,
+  // they hold geometry, not results.
   void forget() { previous_.reset(); }
 
   // A body prepared for this scan: its pose relative to the sensor and its culling data.
@@ -100,6 +111,10 @@ class Caster {
     Eigen::Vector3d center;                // bounding sphere centre, sensor frame
     double radius;
     View view;  // how the body's box looks from the sensor: nearest distance, windows
+    // Planar fans: the scan plane in the body's frame's coordinates (fan_slicer.h), and where the
+    // body is in that frame: a mesh is cut there, as a kept slice of the frame is.
+    const PlaneFrame* plane = nullptr;
+    Eigen::Isometry3d frame_from_body = Eigen::Isometry3d::Identity();
   };
 
  private:
@@ -134,10 +149,11 @@ class Caster {
   ScanResult result_;
   std::unique_ptr<SceneIndex> index_;  // the scene's body trees, rebuilt when the scene changes
   std::vector<PlacedGroup> placed_;
-  std::vector<std::atomic<char>> cast_;  // per body: cast against this scan (for the stats)
-  std::unique_ptr<BeamSet> beams_;       // the walk's per-scan state, kept to reuse its memory
-  std::unique_ptr<ThreadPool> pool_;     // for CastConfig::threads > 1, kept between casts
-  std::optional<ReuseKey> previous_;     // the inputs of result_, if it is complete
+  std::vector<std::atomic<char>> cast_;      // per body: cast against this scan (for the stats)
+  std::unique_ptr<BeamSet> beams_;           // the walk's per-scan state, kept to reuse its memory
+  std::unique_ptr<ThreadPool> pool_;         // for CastConfig::threads > 1, kept between casts
+  std::unique_ptr<PlaneSliceCache> planes_;  // CastConfig::plane_cache, kept between casts
+  std::optional<ReuseKey> previous_;         // the inputs of result_, if it is complete
 };
 
 }  // namespace core

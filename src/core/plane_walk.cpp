@@ -1,0 +1,233 @@
+#include "laser_raycast/core/plane_walk.h"
+
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+#include "laser_raycast/core/node_views.h"
+#include "laser_raycast/core/primitive_cast.h"
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+// A node whose window holds at most this many beams has them traced through its subtree one ray at
+// a time instead of its children's windows being computed. Only speed depends on it.
+constexpr long long kTraceBeams = 3;
+
+// The map from plane coordinates (z = 0) to the sensor frame, for the node views.
+Eigen::Isometry3d sensorFromPlane(const PlaneFrame& f) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() << f.a, f.b, 0, f.c, f.d, 0, 0, 0, 1;
+  pose.translation() << f.tx, f.ty, 0;
+  return pose;
+}
+
+class SliceWalk {
+ public:
+  SliceWalk(BeamSet& beams, const Scene& scene, const PlaneSlice& slice, const PlaneFrame& plane,
+            const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
+            std::vector<std::atomic<char>>* cast)
+      : beams_(beams),
+        scene_(scene),
+        slice_(slice),
+        plane_(plane),
+        sensor_from_frame_(sensor_from_frame),
+        config_(config),
+        cast_(cast),
+        sensor_from_plane_(sensorFromPlane(plane)),
+        views_(sensor_from_plane_, true, config.tmax),
+        stamp_(beams.newWalkStamp()) {
+    // The sensor and the beams in plane coordinates (z = 0), for the traced rays' box tests: the
+    // inverse of the map to the sensor frame.
+    const double det = plane.a * plane.d - plane.b * plane.c;
+    inverse_ << plane.d / det, -plane.b / det, -plane.c / det, plane.a / det;
+    sensor_in_plane_ = -(inverse_ * Eigen::Vector2d(plane.tx, plane.ty));
+  }
+
+  void run(const BeamRect& within) {
+    if (slice_.wide.empty()) return;
+    const Aabb& bounds = slice_.tree.bounds();
+    const Eigen::Matrix3d& rot = sensor_from_plane_.linear();
+    const View view = boxView(bounds.center(), bounds.extent() * 0.5, rot, rot.cwiseAbs(),
+                              sensor_from_plane_.translation(), beams_.pattern().angleMin(), false);
+    if (!(view.near <= config_.tmax)) return;
+    beams_.forEachRect(view, within, [&](const BeamRect& rect) {
+      stack_.push_back(Entry{slice_.wide.root(), rect, floatBelow(view.near)});
+    });
+    while (!stack_.empty()) {
+      const Entry e = stack_.back();
+      stack_.pop_back();
+      if (!beams_.anyOpen(e.rect, e.near)) continue;  // hidden behind nearer hits
+      if (e.ref.isLeaf()) {
+        for (std::uint32_t i = e.ref.index; i < e.ref.index + e.ref.count; ++i) {
+          testItem(slice_.items[slice_.tree.triangleIds()[i]], e.rect, e.near);
+        }
+      } else if (e.rect.beams() <= kTraceBeams) {
+        traceRect(e);
+      } else {
+        expand(e);
+      }
+    }
+  }
+
+ private:
+  struct Entry {
+    WideBvh::Ref ref;
+    BeamRect rect;
+    float near;
+  };
+
+  void expand(const Entry& e) {
+    const WideBvh::Node& node = slice_.wide.nodes()[e.ref.index];
+    NodeViews views;
+    views.compute(node, views_);
+    Entry children[4 * 3];  // a child's view may wrap into several rects
+    int n = 0;
+    for (int k = 0; k < WideBvh::kWidth; ++k) {
+      if (!(views.mask & (1 << k))) continue;
+      beams_.forEachChildRect(views, k, e.rect, [&](const BeamRect& rect) {
+        if (n < 12) children[n++] = Entry{node.child(k), rect, views.near[k]};
+      });
+    }
+    // Farthest first onto the stack, so that the nearest is walked next.
+    std::sort(children, children + n,
+              [](const Entry& a, const Entry& b) { return a.near > b.near; });
+    for (int j = 0; j < n; ++j) stack_.push_back(children[j]);
+  }
+
+  // The body's pose relative to the sensor.
+  Eigen::Isometry3d sensorFromBody(int body) const {
+    return sensor_from_frame_ * scene_.bodies()[body].frame_from_body;
+  }
+  const Mesh& meshOf(int body) const {
+    return *std::get<std::shared_ptr<const Mesh>>(scene_.bodies()[body].shape);
+  }
+
+  // A segment against the beams [first, last] as PlaneSlicer tests it; a hit improving *best (if
+  // given) or offered to the beam.
+  template <class Hit, class Open>
+  void testSegment(const PlaneSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
+    Eigen::Vector2d front;
+    if (config_.cull_backfaces) {
+      const auto& v = meshOf(s.body).bvh().triangleVertices()[s.slot];
+      front = (sensorFromBody(s.body).linear() * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
+    }
+    testSegmentInFan(beams_.pattern(), plane_.toSensor(s.p), plane_.toSensor(s.q), config_.tmin,
+                     config_.tmax, config_.cull_backfaces ? &front : nullptr, first, last, hit,
+                     open);
+  }
+
+  void offerSegmentHit(int col, double t, const PlaneSlice::Item& s) {
+    const Mesh& mesh = meshOf(s.body);
+    const std::uint32_t triangle = mesh.bvh().triangleIds()[s.slot];
+    beams_.offer(0, col, t, s.body, static_cast<int>(triangle), [&] {
+      return Eigen::Vector3d(sensorFromBody(s.body).linear() * mesh.normal(triangle));
+    });
+  }
+
+  void testItem(const PlaneSlice::Item& item, const BeamRect& rect, float near) {
+    (*cast_)[item.body].store(1, std::memory_order_relaxed);
+    if (item.slot == PlaneSlice::kPrimitive) {
+      castPrimitiveItem(item.body, rect);
+      return;
+    }
+    testSegment(
+        item, rect.col_lo, rect.col_hi, [&](int col, double t) { offerSegmentHit(col, t, item); },
+        [&](int col, double segment_near) {
+          return beams_.range(0, col) >= std::max(double(near), segment_near);
+        });
+  }
+
+  // A primitive: its pose, culled as the scene walk culls it, then cast over the rect.
+  void castPrimitiveItem(int index, const BeamRect& rect) {
+    Caster::ActiveBody a;
+    a.index = index;
+    a.sensor_from_body = sensorFromBody(index);
+    a.center = a.sensor_from_body * scene_.sphereCenter(index);
+    a.radius = scene_.sphereRadius(index);
+    const Eigen::Matrix3d& rot = a.sensor_from_body.linear();
+    a.view = boxView(scene_.boxCenter(index), scene_.boxHalf(index), rot, rot.cwiseAbs(),
+                     a.sensor_from_body.translation(), beams_.pattern().angleMin(), false);
+    if (!(a.view.near <= config_.tmax) || !a.view.crosses) return;
+    a.body_from_sensor_rot = rot.transpose();
+    a.sensor_in_body = -(a.body_from_sensor_rot * a.sensor_from_body.translation());
+    beams_.forEachRect(a.view, rect, [&](const BeamRect& r) {
+      if (beams_.anyOpen(r, a.view.near)) castPrimitive(beams_, scene_, a, config_, r);
+    });
+  }
+
+  // Each open beam of the rect through the node's subtree, one ray at a time: box tests in plane
+  // coordinates, each item tested as testItem tests it.
+  void traceRect(const Entry& e) {
+    const auto& ids = slice_.tree.triangleIds();
+    for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
+      const double range = beams_.range(0, col);
+      if (!(range >= e.near)) continue;
+      double tmax = std::min(config_.tmax, range);
+      const PlaneSlice::Item* best = nullptr;
+      double best_t = std::numeric_limits<double>::infinity();
+      std::uint32_t best_triangle = 0;
+      const BeamRect one{0, 0, col, col};
+      traceWide(slice_.wide, e.ref, boxRay(col), &tmax, [&](std::uint32_t i) {
+        const PlaneSlice::Item& item = slice_.items[ids[i]];
+        (*cast_)[item.body].store(1, std::memory_order_relaxed);
+        if (item.slot == PlaneSlice::kPrimitive) {
+          castPrimitiveItem(item.body, one);
+          tmax = std::min(tmax, beams_.range(0, col));
+          return;
+        }
+        const std::uint32_t triangle = meshOf(item.body).bvh().triangleIds()[item.slot];
+        testSegment(
+            item, col, col,
+            [&](int, double t) {
+              if (t < best_t ||
+                  (t == best_t && (item.body < best->body ||
+                                   (item.body == best->body && triangle < best_triangle)))) {
+                best = &item;
+                best_t = t;
+                best_triangle = triangle;
+                tmax = t;
+              }
+            },
+            [&](int, double segment_near) { return segment_near <= tmax; });
+      });
+      if (best) offerSegmentHit(col, best_t, *best);
+    }
+  }
+
+  const WideBoxRay& boxRay(int col) {
+    return beams_.boxRay(0, col, stamp_, [&](const Eigen::Vector3d& dir) {
+      Ray r;
+      r.origin << sensor_in_plane_, 0;
+      r.dir << inverse_ * dir.head<2>(), 0;
+      r.tmin = config_.tmin;
+      return WideBoxRay(r, slice_.tree.bounds());
+    });
+  }
+
+  BeamSet& beams_;
+  const Scene& scene_;
+  const PlaneSlice& slice_;
+  const PlaneFrame& plane_;
+  const Eigen::Isometry3d sensor_from_frame_;
+  const CastConfig& config_;
+  std::vector<std::atomic<char>>* cast_;
+  const Eigen::Isometry3d sensor_from_plane_;
+  const ViewFrame views_;
+  const std::uint32_t stamp_;
+  Eigen::Matrix2d inverse_;
+  Eigen::Vector2d sensor_in_plane_;
+  std::vector<Entry> stack_;
+};
+
+}  // namespace
+
+void castSlice(BeamSet& beams, const Scene& scene, const PlaneSlice& slice, const PlaneFrame& plane,
+               const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
+               const BeamRect& within, std::vector<std::atomic<char>>* cast) {
+  SliceWalk(beams, scene, slice, plane, sensor_from_frame, config, cast).run(within);
+}
+
+}  // namespace core
+}  // namespace laser_raycast
