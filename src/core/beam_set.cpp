@@ -24,14 +24,13 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
   one_turn_ = span <= 2 * M_PI && col_turn_ < 1e9;
   // The rounding of the few operations from an angle to a column index, with room to spare.
   col_pad_ = 64 * std::numeric_limits<double>::epsilon() * (col_turn_ + cols() + 8);
-  tiles_.reset(&result->range, &beam_of_row_, rows(), cols());
   const std::size_t beams = pattern.directions().size();
   box_rays_.resize(beams);
   if (ray_stamp_.size() != beams) ray_stamp_.assign(beams, 0);
   prepareSensorRays(config);
   // resetResult left every range +inf (or NaN for a sensor pose that is not valid, and then
   // nothing is cast): the farthest hit a beam keeps is tmax.
-  range_above_.assign(direction_x_.size(), floatAbove(config.tmax));
+  tiles_.reset(rows(), cols(), floatAbove(config.tmax));
 }
 
 void BeamSet::prepareSensorRays(const CastConfig& config) {
@@ -71,27 +70,6 @@ void BeamSet::prepareSensorRays(const CastConfig& config) {
       direction_y_[row * padded_cols_ + col] = static_cast<float>(direction(row, col).y());
     }
   }
-}
-
-bool BeamSet::anyOpen(const BeamRect& rect, double near) {
-  if (!occlusion_culling_) return !rect.empty();
-  // Reading up to this many beams directly, four at a time, is about as cheap as the tiles.
-  constexpr long long kDirect = 128;
-  if (rect.beams() > kDirect) return tiles_.anyOpen(rect, near);
-  // The float ranges are rounded up and near down: a beam counts as closed only if it certainly is
-  // (and a NaN range is open).
-  const __m128 limit = _mm_set1_ps(floatBelow(near));
-  const int first = rect.col_lo & ~3;
-  for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-    const float* r = rangeAbove(row);
-    for (int base = first; base <= rect.col_hi; base += 4) {
-      int open = _mm_movemask_ps(_mm_cmpnlt_ps(_mm_loadu_ps(r + base), limit));
-      if (base < rect.col_lo) open &= 0xF << (rect.col_lo - base);
-      if (base + 3 > rect.col_hi) open &= 0xF >> (base + 3 - rect.col_hi);
-      if (open) return true;
-    }
-  }
-  return false;
 }
 
 void RowTable::build(std::vector<double> values) {

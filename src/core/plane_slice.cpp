@@ -61,12 +61,21 @@ std::unique_ptr<PlaneSlice> PlaneSlice::build(const Scene& scene, const SceneInd
       addPrimitive(scene, body, frame, &slice->items);
     }
   }
+  // The tree is built over 2D boxes, but the SAH weighs a box by its area, and a flat box (an
+  // axis-aligned segment) has none: each box gets the same height, as large as the slice, so that
+  // the area follows the perimeter, which is what a 2D ray meets. The walk ignores the height.
+  Aabb all;
+  for (const Item& item : slice->items) {
+    all.grow(Eigen::Vector3d(item.p.x(), item.p.y(), 0));
+    all.grow(Eigen::Vector3d(item.q.x(), item.q.y(), 0));
+  }
+  const double height = all.empty() ? 1.0 : std::max(1.0, all.extent().maxCoeff());
   std::vector<Aabb> boxes;
   boxes.reserve(slice->items.size());
   for (const Item& item : slice->items) {
     Aabb box;
-    box.grow(Eigen::Vector3d(item.p.x(), item.p.y(), 0));
-    box.grow(Eigen::Vector3d(item.q.x(), item.q.y(), 0));
+    box.grow(Eigen::Vector3d(item.p.x(), item.p.y(), -height));
+    box.grow(Eigen::Vector3d(item.q.x(), item.q.y(), height));
     boxes.push_back(box);
   }
   slice->tree = Bvh::buildOverBoxes(boxes);

@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <vector>
 
-#include "laser_raycast/core/node_views.h"
+#include "laser_raycast/core/plane_views.h"
 #include "laser_raycast/core/primitive_cast.h"
 
 namespace laser_raycast {
@@ -13,7 +14,7 @@ namespace {
 
 // A node whose window holds at most this many beams has them traced through its subtree one ray at
 // a time instead of its children's windows being computed. Only speed depends on it.
-constexpr long long kTraceBeams = 3;
+constexpr long long kTraceBeams = 16;
 
 // The map from plane coordinates (z = 0) to the sensor frame, for the node views.
 Eigen::Isometry3d sensorFromPlane(const PlaneFrame& f) {
@@ -36,13 +37,13 @@ class SliceWalk {
         config_(config),
         cast_(cast),
         sensor_from_plane_(sensorFromPlane(plane)),
-        views_(sensor_from_plane_, true, config.tmax),
-        stamp_(beams.newWalkStamp()) {
-    // The sensor and the beams in plane coordinates (z = 0), for the traced rays' box tests: the
-    // inverse of the map to the sensor frame.
+        views_(plane, config.tmax, beams.pattern()) {
+    // The sensor and the beams in plane coordinates, for the traced rays' box tests: the inverse
+    // of the map to the sensor frame.
     const double det = plane.a * plane.d - plane.b * plane.c;
     inverse_ << plane.d / det, -plane.b / det, -plane.c / det, plane.a / det;
-    sensor_in_plane_ = -(inverse_ * Eigen::Vector2d(plane.tx, plane.ty));
+    origin_.emplace(-(inverse_ * Eigen::Vector2d(plane.tx, plane.ty)), slice.tree.bounds(),
+                    config.tmin);
   }
 
   void run(const BeamRect& within) {
@@ -80,20 +81,33 @@ class SliceWalk {
 
   void expand(const Entry& e) {
     const WideBvh::Node& node = slice_.wide.nodes()[e.ref.index];
-    NodeViews views;
+    PlaneViews views;
     views.compute(node, views_);
     Entry children[4 * 3];  // a child's view may wrap into several rects
     int n = 0;
     for (int k = 0; k < WideBvh::kWidth; ++k) {
       if (!(views.mask & (1 << k))) continue;
-      beams_.forEachChildRect(views, k, e.rect, [&](const BeamRect& rect) {
-        if (n < 12) children[n++] = Entry{node.child(k), rect, views.near[k]};
-      });
+      auto add = [&](int first, int last) {
+        const int lo = std::max(first, e.rect.col_lo), hi = std::min(last, e.rect.col_hi);
+        if (lo <= hi && n < 12)
+          children[n++] = Entry{node.child(k), BeamRect{0, 0, lo, hi}, views.near[k]};
+      };
+      if (views.columns_known & (1 << k)) {
+        add(views.col_lo[k], views.col_hi[k]);
+      } else if (!(views.az_half[k] >= 0)) {
+        add(e.rect.col_lo, e.rect.col_hi);
+      } else {
+        beams_.forEachColumnRange(views.az_center[k], views.az_half[k], add);
+      }
     }
-    // Farthest first onto the stack, so that the nearest is walked next.
-    std::sort(children, children + n,
-              [](const Entry& a, const Entry& b) { return a.near > b.near; });
-    for (int j = 0; j < n; ++j) stack_.push_back(children[j]);
+    // Farthest first onto the stack, so that the nearest is walked next (insertion sort: n <= 12).
+    for (int j = 1; j < n; ++j) {
+      const Entry moving = children[j];
+      int i = j;
+      for (; i > 0 && children[i - 1].near < moving.near; --i) children[i] = children[i - 1];
+      children[i] = moving;
+    }
+    stack_.insert(stack_.end(), children, children + n);
   }
 
   // The body's pose relative to the sensor.
@@ -109,10 +123,7 @@ class SliceWalk {
   template <class Hit, class Open>
   void testSegment(const PlaneSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
     Eigen::Vector2d front;
-    if (config_.cull_backfaces) {
-      const auto& v = meshOf(s.body).bvh().triangleVertices()[s.slot];
-      front = (sensorFromBody(s.body).linear() * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
-    }
+    if (config_.cull_backfaces) front = frontOf(s);
     testSegmentInFan(beams_.pattern(), plane_.toSensor(s.p), plane_.toSensor(s.q), config_.tmin,
                      config_.tmax, config_.cull_backfaces ? &front : nullptr, first, last, hit,
                      open);
@@ -161,49 +172,51 @@ class SliceWalk {
   // coordinates, each item tested as testItem tests it.
   void traceRect(const Entry& e) {
     const auto& ids = slice_.tree.triangleIds();
+    const auto& dirs = beams_.pattern().directions();
     for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
       const double range = beams_.range(0, col);
       if (!(range >= e.near)) continue;
       double tmax = std::min(config_.tmax, range);
       const PlaneSlice::Item* best = nullptr;
       double best_t = std::numeric_limits<double>::infinity();
-      std::uint32_t best_triangle = 0;
-      const BeamRect one{0, 0, col, col};
-      traceWide(slice_.wide, e.ref, boxRay(col), &tmax, [&](std::uint32_t i) {
+      const double dx = dirs[col].x(), dy = dirs[col].y();
+      const PlaneRay ray(*origin_, inverse_ * Eigen::Vector2d(dx, dy));
+      traceWide(slice_.wide, e.ref, ray, &tmax, [&](std::uint32_t i) {
         const PlaneSlice::Item& item = slice_.items[ids[i]];
         (*cast_)[item.body].store(1, std::memory_order_relaxed);
         if (item.slot == PlaneSlice::kPrimitive) {
-          castPrimitiveItem(item.body, one);
+          castPrimitiveItem(item.body, BeamRect{0, 0, col, col});
           tmax = std::min(tmax, beams_.range(0, col));
           return;
         }
-        const std::uint32_t triangle = meshOf(item.body).bvh().triangleIds()[item.slot];
-        testSegment(
-            item, col, col,
-            [&](int, double t) {
-              if (t < best_t ||
-                  (t == best_t && (item.body < best->body ||
-                                   (item.body == best->body && triangle < best_triangle)))) {
-                best = &item;
-                best_t = t;
-                best_triangle = triangle;
-                tmax = t;
-              }
-            },
-            [&](int, double segment_near) { return segment_near <= tmax; });
+        Eigen::Vector2d front;
+        if (config_.cull_backfaces) front = frontOf(item);
+        double t;
+        if (!beamCrossesSegment(dx, dy, plane_.toSensor(item.p), plane_.toSensor(item.q),
+                                config_.tmin, tmax, config_.cull_backfaces ? &front : nullptr,
+                                &t)) {
+          return;
+        }
+        if (t < best_t || (t == best_t && before(item, *best))) {
+          best = &item;
+          best_t = t;
+          tmax = t;
+        }
       });
       if (best) offerSegmentHit(col, best_t, *best);
     }
   }
 
-  const WideBoxRay& boxRay(int col) {
-    return beams_.boxRay(0, col, stamp_, [&](const Eigen::Vector3d& dir) {
-      Ray r;
-      r.origin << sensor_in_plane_, 0;
-      r.dir << inverse_ * dir.head<2>(), 0;
-      r.tmin = config_.tmin;
-      return WideBoxRay(r, slice_.tree.bounds());
-    });
+  // The tie rule of BeamSet::offer: the lower body, then the lower triangle.
+  bool before(const PlaneSlice::Item& a, const PlaneSlice::Item& b) const {
+    if (a.body != b.body) return a.body < b.body;
+    const auto& ids = meshOf(a.body).bvh().triangleIds();
+    return ids[a.slot] < ids[b.slot];
+  }
+
+  Eigen::Vector2d frontOf(const PlaneSlice::Item& s) const {
+    const auto& v = meshOf(s.body).bvh().triangleVertices()[s.slot];
+    return (sensorFromBody(s.body).linear() * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
   }
 
   BeamSet& beams_;
@@ -214,10 +227,9 @@ class SliceWalk {
   const CastConfig& config_;
   std::vector<std::atomic<char>>* cast_;
   const Eigen::Isometry3d sensor_from_plane_;
-  const ViewFrame views_;
-  const std::uint32_t stamp_;
+  const PlaneViewFrame views_;
   Eigen::Matrix2d inverse_;
-  Eigen::Vector2d sensor_in_plane_;
+  std::optional<PlaneRay::Origin> origin_;
   std::vector<Entry> stack_;
 };
 

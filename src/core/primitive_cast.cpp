@@ -61,19 +61,10 @@ class BoxPrefilter {
   __m128 r_[3][3], gap_[3], side_[3];
 };
 
-std::optional<PrimitiveHit> intersectShape(const Ray& ray, const Shape& shape) {
-  if (const auto* box = std::get_if<Box>(&shape)) return intersect(ray, *box);
-  if (const auto* cylinder = std::get_if<Cylinder>(&shape)) return intersect(ray, *cylinder);
-  if (const auto* sphere = std::get_if<Sphere>(&shape)) return intersect(ray, *sphere);
-  return std::nullopt;
-}
-
-}  // namespace
-
-void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& a,
-                   const CastConfig& config, const BeamRect& rect) {
-  const Body& body = scene.bodies()[a.index];
-  const BoxPrefilter filter(a, scene.boxHalf(a.index));
+// The open beams of rect that the pre-test lets through against one primitive, analytically.
+template <class Primitive>
+void castShape(BeamSet& beams, const Primitive& shape, const Caster::ActiveBody& a,
+               const BoxPrefilter& filter, const CastConfig& config, const BeamRect& rect) {
   for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
     const float* x = beams.directionX(row);
     const float* y = beams.directionY(row);
@@ -94,12 +85,28 @@ void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody&
         ray.dir = a.body_from_sensor_rot * beams.direction(row, col);
         ray.tmin = config.tmin;
         ray.tmax = std::min(config.tmax, current);
-        const std::optional<PrimitiveHit> hit = intersectShape(ray, body.shape);
+        // The beams are valid rays (a unit direction, a finite pose): no check needed.
+        const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
         if (!hit) continue;
         beams.offer(row, col, hit->t, a.index, -1,
                     [&] { return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal); });
       }
     }
+  }
+}
+
+}  // namespace
+
+void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& a,
+                   const CastConfig& config, const BeamRect& rect) {
+  const Shape& shape = scene.bodies()[a.index].shape;
+  const BoxPrefilter filter(a, scene.boxHalf(a.index));
+  if (const auto* box = std::get_if<Box>(&shape)) {
+    castShape(beams, *box, a, filter, config, rect);
+  } else if (const auto* cylinder = std::get_if<Cylinder>(&shape)) {
+    castShape(beams, *cylinder, a, filter, config, rect);
+  } else if (const auto* sphere = std::get_if<Sphere>(&shape)) {
+    castShape(beams, *sphere, a, filter, config, rect);
   }
 }
 

@@ -53,6 +53,12 @@ struct Nearest {
 
 std::optional<PrimitiveHit> intersect(const Ray& ray, const Box& box) {
   if (!isValidRay(ray)) return std::nullopt;
+  return detail::intersectValid(ray, box);
+}
+
+namespace detail {
+
+std::optional<PrimitiveHit> intersectValid(const Ray& ray, const Box& box) {
   const Eigen::Vector3d half = box.size * 0.5;
   double t_enter = -kInf, t_exit = kInf;
   int enter_axis = -1, exit_axis = -1;
@@ -88,8 +94,16 @@ std::optional<PrimitiveHit> intersect(const Ray& ray, const Box& box) {
   return nearest.hit;
 }
 
+}  // namespace detail
+
 std::optional<PrimitiveHit> intersect(const Ray& ray, const Sphere& sphere) {
   if (!isValidRay(ray)) return std::nullopt;
+  return detail::intersectValid(ray, sphere);
+}
+
+namespace detail {
+
+std::optional<PrimitiveHit> intersectValid(const Ray& ray, const Sphere& sphere) {
   const Eigen::Vector3d& o = ray.origin;
   const Eigen::Vector3d& d = ray.dir;
   const double r = sphere.radius;
@@ -107,8 +121,16 @@ std::optional<PrimitiveHit> intersect(const Ray& ray, const Sphere& sphere) {
   return nearest.hit;
 }
 
+}  // namespace detail
+
 std::optional<PrimitiveHit> intersect(const Ray& ray, const Cylinder& cylinder) {
   if (!isValidRay(ray)) return std::nullopt;
+  return detail::intersectValid(ray, cylinder);
+}
+
+namespace detail {
+
+std::optional<PrimitiveHit> intersectValid(const Ray& ray, const Cylinder& cylinder) {
   const Eigen::Vector3d& o = ray.origin;
   const Eigen::Vector3d& d = ray.dir;
   const double r = cylinder.radius;
@@ -159,6 +181,8 @@ std::optional<PrimitiveHit> intersect(const Ray& ray, const Cylinder& cylinder) 
   if (!nearest.hit) nearest.offer(t_exit, exit_side ? side_normal(t_exit) : cap_exit_normal);
   return nearest.hit;
 }
+
+}  // namespace detail
 
 void validate(const Box& box) {
   requirePositive("box size x", box.size.x());

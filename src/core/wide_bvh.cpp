@@ -176,29 +176,13 @@ WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) :
   root_triangles_ = root.triangles;
 }
 
-WideBoxRay::WideBoxRay(const Ray& ray, const Aabb& bounds)
-    : reach_((bounds.lo - ray.origin)
-                 .cwiseAbs()
-                 .cwiseMax((bounds.hi - ray.origin).cwiseAbs())
-                 .maxCoeff() /
-             ray.dir.cwiseAbs().maxCoeff()) {
+WideBoxRay::WideBoxRay(const Ray& ray, const Aabb& bounds) {
+  reach_ =
+      (bounds.lo - ray.origin).cwiseAbs().cwiseMax((bounds.hi - ray.origin).cwiseAbs()).maxCoeff() /
+      ray.dir.cwiseAbs().maxCoeff();
   tnear0_ = floatBelow(ray.tmin - (std::abs(ray.tmin) + reach_) * kWiden);
-  constexpr std::uint32_t kLo = offsetof(WideBvh::Node, lo), kHi = offsetof(WideBvh::Node, hi);
   for (int k = 0; k < 3; ++k) {
-    // Adding +0 turns -0 into +0, so a zero component gives +inf and counts as positive (see
-    // SlabRay): a ray lying in a slab plane then gives NaN there, which never narrows the interval.
-    const double d = ray.dir[k] + 0.0;
-    const bool positive = !(d < 0);
-    const auto axis = static_cast<std::uint32_t>(k * WideBvh::kWidth * sizeof(float));
-    near_offset_[k] = (positive ? kLo : kHi) + axis;
-    far_offset_[k] = (positive ? kHi : kLo) + axis;
-    // The near plane minus the origin must not come out larger than exact, nor the far one smaller:
-    // for a positive direction that is the origin rounded up for the near plane (lo) and down for
-    // the far plane (hi); for a negative one the other way round.
-    const float up = floatAbove(ray.origin[k]), down = floatBelow(ray.origin[k]);
-    origin_near_[k] = positive ? up : down;
-    origin_far_[k] = positive ? down : up;
-    inv_dir_[k] = static_cast<float>(1.0 / d);
+    setAxis(k, ray.dir[k], floatAbove(ray.origin[k]), floatBelow(ray.origin[k]));
   }
 }
 

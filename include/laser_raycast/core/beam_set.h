@@ -88,10 +88,20 @@ class BeamSet {
   // The same for child k of a wide node's views.
   template <class F>
   void forEachChildRect(const NodeViews& views, int k, const BeamRect& within, F&& f) const;
+  // Calls f(first, last) for the column ranges an azimuth window (centre, half width, rad) can
+  // reach; the same ranges as forEachBeamRange or more, computed without wrapping angles for fans
+  // of at most a turn.
+  template <class F>
+  void forEachColumnRange(double center, double half, F&& f) const;
 
   // False only if every beam of rect has hit something nearer than `near` (small rects are read
   // beam by beam, larger ones through the occlusion tiles).
-  bool anyOpen(const BeamRect& rect, double near);
+  bool anyOpen(const BeamRect& rect, float near) {
+    return occlusion_culling_ ? tiles_.anyOpen(rect, near) : !rect.empty();
+  }
+  // The same for a double distance (rounded down: a beam counts as closed only if it certainly
+  // is).
+  bool anyOpen(const BeamRect& rect, double near) { return anyOpen(rect, floatBelow(near)); }
 
   // The beams as rays from the sensor (sensor frame, origin 0) for the rasterising walk, prepared
   // for config's method, tmin and back-face culling when the pattern or these change.
@@ -106,7 +116,7 @@ class BeamSet {
   float directionZ(int row) const { return direction_z_[row]; }
   // The farthest hit each beam can still keep (its current range, or tmax) rounded up to float,
   // one row at a time, padded like the directions.
-  const float* rangeAbove(int row) const { return &range_above_[row * padded_cols_]; }
+  const float* rangeAbove(int row) const { return tiles_.row(row); }
 
   // For ColumnRaster: whether the pattern allows it, the columns' cos and sin of the azimuth and
   // the rows' cos and sin of the elevation (float, columns padded to a multiple of four), the
@@ -146,11 +156,6 @@ class BeamSet {
     }
   }
   void prepareRows();
-  // Calls f(first, last) for the column ranges an azimuth window (centre, half width, rad) can
-  // reach; the same ranges as forEachBeamRange or more, computed without wrapping angles for fans
-  // of at most a turn.
-  template <class F>
-  void forEachColumnRange(double center, double half, F&& f) const;
 
   const ScanPattern* pattern_ = nullptr;
   ScanResult* result_ = nullptr;
@@ -182,7 +187,6 @@ class BeamSet {
       sensor_rays_;
   int padded_cols_ = 0;
   std::vector<float> direction_x_, direction_y_, direction_z_;
-  std::vector<float> range_above_;
 
   std::vector<WideBoxRay> box_rays_;
   std::vector<std::uint32_t> ray_stamp_;      // the walk each cached ray was built for
@@ -285,8 +289,7 @@ bool BeamSet::offer(int row, int col, double t, int body, int triangle, Normal&&
   hit_body = body;
   hit_triangle = triangle;
   if (with_normals_) result_->normal[i] = normal();
-  range_above_[row * padded_cols_ + col] = floatAbove(t);
-  tiles_.touched(row, col);
+  tiles_.lower(row, col, floatAbove(t));
   return true;
 }
 

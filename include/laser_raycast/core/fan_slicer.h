@@ -137,6 +137,30 @@ class PlaneSlicer {
 void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
                double tmin, double tmax, bool cull_backfaces, int body_index, DepthBuffer buffer);
 
+// Whether the beam with direction (dx, dy) (sensor frame) crosses the segment with ends p != q
+// (sensor x, y) with t in [tmin, tmax], and where. With front (the triangle's front normal's
+// sensor x, y), a beam meeting its back does not.
+inline bool beamCrossesSegment(double dx, double dy, const Eigen::Vector2d& p,
+                               const Eigen::Vector2d& q, double tmin, double tmax,
+                               const Eigen::Vector2d* front, double* t) {
+  // Which side of the beam's line each endpoint is on; a shared endpoint gives the same value to
+  // both of its segments.
+  const double side_p = dx * p.y() - dy * p.x();
+  const double side_q = dx * q.y() - dy * q.x();
+  if (!((side_p <= 0 && side_q >= 0) || (side_p >= 0 && side_q <= 0))) return false;
+  // Both on the line: the beam runs along the triangle's plane.
+  if (side_p == side_q) return false;
+  // Exactly through an endpoint: the beam counts for the segment whose other end lies on its left
+  // (as if nudged to the right), so for exactly one of the two segments sharing a point where the
+  // outline crosses the beam.
+  if (side_p == 0 ? !(side_q > 0) : (side_q == 0 && !(side_p > 0))) return false;
+  const double along_p = dx * p.x() + dy * p.y();
+  const double along_q = dx * q.x() + dy * q.y();
+  *t = along_p + (side_p / (side_p - side_q)) * (along_q - along_p);
+  if (!(*t >= tmin && *t <= tmax)) return false;
+  return !(front && dx * front->x() + dy * front->y() > 0);
+}
+
 // Tests the beams [first, last] of fan against a segment with ends p, q (sensor x, y): hit(beam, t)
 // for every beam that crosses it with t in [tmin, tmax]; open(beam, near) may say that a beam needs
 // no test (it has hit something nearer than `near`, the segment's nearest distance). With front
@@ -162,24 +186,8 @@ void testSegmentInFan(const ScanPattern& fan, const Eigen::Vector2d& p, const Ei
   auto test = [&](int lo, int hi) {
     for (int i = std::max(lo, first); i <= std::min(hi, last); ++i) {
       if (!open(i, near)) continue;
-      const double dx = dirs[i].x(), dy = dirs[i].y();
-      // Which side of the beam's line each endpoint is on; a shared endpoint gives the same value
-      // to both of its segments.
-      const double side_p = dx * p.y() - dy * p.x();
-      const double side_q = dx * q.y() - dy * q.x();
-      if (!((side_p <= 0 && side_q >= 0) || (side_p >= 0 && side_q <= 0))) continue;
-      // Both on the line: the beam runs along the triangle's plane.
-      if (side_p == side_q) continue;
-      // Exactly through an endpoint: the beam counts for the segment whose other end lies on its
-      // left (as if nudged to the right), so for exactly one of the two segments sharing a point
-      // where the outline crosses the beam.
-      if (side_p == 0 ? !(side_q > 0) : (side_q == 0 && !(side_p > 0))) continue;
-      const double along_p = dx * p.x() + dy * p.y();
-      const double along_q = dx * q.x() + dy * q.y();
-      const double t = along_p + (side_p / (side_p - side_q)) * (along_q - along_p);
-      if (!(t >= tmin && t <= tmax)) continue;
-      if (front && dx * front->x() + dy * front->y() > 0) continue;
-      hit(i, t);
+      double t;
+      if (beamCrossesSegment(dirs[i].x(), dirs[i].y(), p, q, tmin, tmax, front, &t)) hit(i, t);
     }
   };
   // A few beams are tested directly; for more, only those the segment's bearings can reach.

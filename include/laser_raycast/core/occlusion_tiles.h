@@ -1,12 +1,16 @@
-// Which parts of a scan are still open: an upper bound of the current range over tiles of beams, in
-// two levels (fine tiles of one ring by kFineWidth azimuths, coarse tiles of kCoarseRings rings by
-// kCoarseWidth azimuths), so that "is every beam of this window already nearer than d?" costs a few
-// tile reads instead of one read per beam. The caster asks it before it walks a body or a BVH node:
-// if every beam the node's window holds has hit something nearer than the node, the node is hidden.
+// Which parts of a scan are still open: every beam's range so far, rounded up to float, and its
+// maximum over tiles of beams in two levels (fine tiles of one ring by kFineWidth azimuths, kept up
+// to date with every hit; coarse tiles of kCoarseRings rings by kCoarseWidth azimuths, refreshed
+// when read), so that "is every beam of this window already nearer than d?" costs a few reads, four
+// at a time, instead of one per beam. The caster asks it before it walks a body or a BVH node: if
+// every beam the node's window holds has hit something nearer than the node, the node is hidden.
 //
-// Ranges only ever decrease while a scan is cast, so a stale tile maximum is still an upper bound:
-// a write only marks its tiles stale, and a query refreshes the stale tiles it reads.
+// Ranges only ever decrease while a scan is cast, so a stale coarse maximum is still an upper
+// bound: a hit refreshes its fine tile and marks its coarse tile stale. Threads that cast separate
+// pieces of the columns (whole coarse tiles each) never share a tile.
 #pragma once
+
+#include <emmintrin.h>
 
 #include <cstdint>
 #include <vector>
@@ -30,34 +34,58 @@ class OcclusionTiles {
   static constexpr int kCoarseRings = 8;
   static constexpr int kCoarseWidth = 128;
 
-  // range(row, col) is range[beam_of_row[row] * cols + col]; all tiles start stale.
-  void reset(const std::vector<double>* range, const std::vector<int>* beam_of_row, int rows,
-             int cols);
-  // range of the beam at (row, col) decreased.
-  void touched(int row, int col) {
-    fine_stale_[row * fine_cols_ + col / kFineWidth] = 1;
-    coarse_stale_[(row / kCoarseRings) * coarse_cols_ + col / kCoarseWidth] = 1;
-  }
+  // rows x cols beams, every range `start` (the farthest hit a beam can keep: tmax, rounded up).
+  void reset(int rows, int cols, float start);
+  // The ranges of one row, padded to whole fine tiles (the padding holds 0: never open).
+  const float* row(int r) const { return &range_[static_cast<std::size_t>(r) * padded_cols_]; }
+  // The beam at (row, col) hit something at `range` (rounded up), nearer than before.
+  void lower(int row, int col, float range);
   // False only if every beam in rect has a range below `near` (so nothing at distance >= near can
-  // be seen through rect). May answer true when that holds too (the tiles overlap the rect's
-  // border), never false when some beam is at near or farther. NaN ranges count as open.
-  bool anyOpen(const BeamRect& rect, double near);
-  // Tiles read so far (a cost measure for tests and tuning).
-  std::uint64_t tileReads() const { return tile_reads_; }
+  // be seen through rect). May answer true when that holds too (a coarse tile overlaps the rect's
+  // border), never false when some beam is at near or farther.
+  bool anyOpen(const BeamRect& rect, float near) {
+    if (rect.row_lo == rect.row_hi && rect.col_hi - rect.col_lo < kFineWidth) {
+      return !rect.empty() && anyOpenInRow(rect.row_lo, rect.col_lo, rect.col_hi, near);
+    }
+    return anyOpenInRows(rect, near);
+  }
 
  private:
-  double rangeAt(int row, int col) const {
-    return (*range_)[static_cast<std::size_t>((*beam_of_row_)[row]) * cols_ + col];
+  float coarseMax(int tile_row, int tile);
+  bool anyOpenInRows(const BeamRect& rect, float near);
+  // Beams first..last of a row, four at a time, against near; whole fine tiles by their maximum.
+  bool anyOpenInRow(int row, int first, int last, float near) const {
+    const float* r = &range_[static_cast<std::size_t>(row) * padded_cols_];
+    const int t_lo = first / kFineWidth, t_hi = last / kFineWidth;
+    if (t_lo != t_hi) {
+      if (chunkOpen(r, first, t_lo * kFineWidth + kFineWidth - 1, near)) return true;
+      const float* fine = &fine_max_[static_cast<std::size_t>(row) * fine_cols_];
+      for (int t = t_lo + 1; t < t_hi; ++t) {
+        if (!(fine[t] < near)) return true;  // written so that NaN counts as open
+      }
+      first = t_hi * kFineWidth;
+    }
+    return chunkOpen(r, first, last, near);
   }
-  double fineMax(int row, int tile);
-  double coarseMax(int tile_row, int tile);
+  static bool chunkOpen(const float* r, int first, int last, float near) {
+    const __m128 limit = _mm_set1_ps(near);
+    const int base0 = first & ~3;
+    int open = 0;
+    for (int base = base0; base <= last; base += 4) {
+      // Not less than: a NaN (a beam that could not be cast) counts as open.
+      int m = _mm_movemask_ps(_mm_cmpnlt_ps(_mm_loadu_ps(r + base), limit));
+      if (base == base0) m &= 0xF << (first - base);
+      if (base + 3 > last) m &= 0xF >> (base + 3 - last);
+      open |= m;
+    }
+    return open != 0;
+  }
 
-  const std::vector<double>* range_ = nullptr;
-  const std::vector<int>* beam_of_row_ = nullptr;
-  int rows_ = 0, cols_ = 0, fine_cols_ = 0, coarse_rows_ = 0, coarse_cols_ = 0;
-  std::vector<double> fine_max_, coarse_max_;
-  std::vector<char> fine_stale_, coarse_stale_;
-  std::uint64_t tile_reads_ = 0;
+  int rows_ = 0, cols_ = 0, padded_cols_ = 0, fine_cols_ = 0, coarse_rows_ = 0, coarse_cols_ = 0;
+  std::vector<float> range_;     // rows_ x padded_cols_
+  std::vector<float> fine_max_;  // rows_ x fine_cols_, always up to date
+  std::vector<float> coarse_max_;
+  std::vector<char> coarse_stale_;
 };
 
 }  // namespace core

@@ -35,6 +35,13 @@ std::optional<PrimitiveHit> intersect(const Ray& ray, const Box& box);
 std::optional<PrimitiveHit> intersect(const Ray& ray, const Cylinder& cylinder);
 std::optional<PrimitiveHit> intersect(const Ray& ray, const Sphere& sphere);
 
+namespace detail {
+// The same for a ray the caller knows to be valid (isValidRay): the caster's beams.
+std::optional<PrimitiveHit> intersectValid(const Ray& ray, const Box& box);
+std::optional<PrimitiveHit> intersectValid(const Ray& ray, const Cylinder& cylinder);
+std::optional<PrimitiveHit> intersectValid(const Ray& ray, const Sphere& sphere);
+}  // namespace detail
+
 // Throw std::invalid_argument naming the dimension and its value unless every size is finite and >
 // 0.
 void validate(const Box& box);

@@ -14,6 +14,7 @@
 #include <emmintrin.h>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -76,9 +77,9 @@ class WideBvh {
     Ref child(int k) const { return Ref{index[k], count[k]}; }
     // Bit k set iff child k exists.
     int presentMask() const {
-      int mask = 0;
-      for (int k = 0; k < kWidth; ++k) mask |= int(index[k] != kEmpty) << k;
-      return mask;
+      const __m128i empty = _mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(index)),
+                                            _mm_set1_epi32(-1));
+      return ~_mm_movemask_ps(_mm_castsi128_ps(empty)) & 0xF;
     }
   };
 
@@ -121,15 +122,17 @@ class WideBvh {
   std::uint32_t root_triangles_ = 0;
 };
 
-// A ray prepared for the wide BVH's conservative box tests: the origin rounded to float both ways,
-// the reciprocal direction, and the ray's reach (the farthest a coordinate of the mesh's bounds is
-// from the origin, in units of t), which scales the widening of the cull limit.
-class WideBoxRay {
+// A ray prepared for conservative box tests against a wide node's four children in its first kAxes
+// axes: the origin rounded to float both ways, the reciprocal direction, and the ray's reach (how
+// far a box coordinate can be from the origin, in units of t), which scales the widening of the
+// cull limit. Conservative: a box the exact ray enters is never skipped. The boxes contain the
+// exact ones; each slab plane is measured from the origin rounded the way that moves it towards the
+// ray (the near plane can only come nearer, the far plane only farther); the remaining rounding of
+// the subtraction, the reciprocal and the product is covered by widening the exit by 1 + 2 gamma(3)
+// (Ize, "Robust BVH Ray Traversal", JCGT 2013).
+template <int kAxes>
+class WideSlabRay {
  public:
-  WideBoxRay() = default;
-  // bounds: the box of everything the ray will be tested against (a mesh's).
-  WideBoxRay(const Ray& ray, const Aabb& bounds);
-
   // The box cull limit for a far limit tmax: widened as BvhT::traverse does (a hit's t and its
   // box's entry and exit round differently).
   float cullLimit(double tmax) const {
@@ -141,7 +144,7 @@ class WideBoxRay {
     const char* base = reinterpret_cast<const char*>(&node);
     __m128 tnear = _mm_set1_ps(tnear0_);
     __m128 tfar = _mm_set1_ps(std::numeric_limits<float>::infinity());
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < kAxes; ++k) {
       const __m128 near_plane = _mm_load_ps(reinterpret_cast<const float*>(base + near_offset_[k]));
       const __m128 far_plane = _mm_load_ps(reinterpret_cast<const float*>(base + far_offset_[k]));
       const __m128 inv = _mm_set1_ps(inv_dir_[k]);
@@ -155,27 +158,55 @@ class WideBoxRay {
     _mm_storeu_ps(t_entry, tnear);
     return _mm_movemask_ps(_mm_cmple_ps(tnear, tfar)) & node.presentMask();
   }
-  // The same test for one box given by its float corners.
-  bool enters(const float lo[3], const float hi[3], float cull) const;
 
- private:
+ protected:
   static constexpr double kWiden = 64 * std::numeric_limits<double>::epsilon();
   static constexpr float kWidenExit = 1 + 2 * roundingGamma<float>(3);
+
+  // Axis k from the direction's component and the origin's coordinate rounded up and down.
+  void setAxis(int k, double dir, float origin_up, float origin_down) {
+    constexpr std::uint32_t kLo = offsetof(WideBvh::Node, lo), kHi = offsetof(WideBvh::Node, hi);
+    // Adding +0 turns -0 into +0, so a zero component gives +inf and counts as positive (see
+    // SlabRay): a ray lying in a slab plane then gives NaN there, which never narrows the interval.
+    const double d = dir + 0.0;
+    const bool positive = !(d < 0);
+    const auto axis = static_cast<std::uint32_t>(k * WideBvh::kWidth * sizeof(float));
+    near_offset_[k] = (positive ? kLo : kHi) + axis;
+    far_offset_[k] = (positive ? kHi : kLo) + axis;
+    // The near plane minus the origin must not come out larger than exact, nor the far one
+    // smaller: for a positive direction that is the origin rounded up for the near plane (lo) and
+    // down for the far plane (hi); for a negative one the other way round.
+    origin_near_[k] = positive ? origin_up : origin_down;
+    origin_far_[k] = positive ? origin_down : origin_up;
+    inv_dir_[k] = static_cast<float>(1.0 / d);
+  }
 
   double reach_ = 0;
   float tnear0_ = 0;  // the entry limit: tmin, widened like the cull limit
   // Per axis, the slab plane the ray meets first (near) and last (far), chosen by the sign of the
   // direction: byte offsets into a Node's lo/hi arrays, and the origin rounded the way that moves
-  // each plane outward (the near plane nearer, the far plane farther).
-  std::uint32_t near_offset_[3] = {0, 0, 0}, far_offset_[3] = {0, 0, 0};
-  float origin_near_[3] = {0, 0, 0}, origin_far_[3] = {0, 0, 0}, inv_dir_[3] = {0, 0, 0};
+  // each plane outward.
+  std::uint32_t near_offset_[kAxes] = {}, far_offset_[kAxes] = {};
+  float origin_near_[kAxes] = {}, origin_far_[kAxes] = {}, inv_dir_[kAxes] = {};
+};
+
+// A ray prepared for the wide BVH's box tests in 3D.
+class WideBoxRay : public WideSlabRay<3> {
+ public:
+  WideBoxRay() = default;
+  // bounds: the box of everything the ray will be tested against (a mesh's), for the reach.
+  WideBoxRay(const Ray& ray, const Aabb& bounds);
+
+  // The same test for one box given by its float corners.
+  bool enters(const float lo[3], const float hi[3], float cull) const;
 };
 
 // Walks the subtree `start` for one ray, nearest box first, and calls leaf(slot) for every triangle
 // slot of each leaf the ray enters before the cull limit of *tmax. leaf may lower *tmax (an
-// improving hit), which culls the boxes beyond. The start's own box is not tested.
-template <class Leaf>
-void traceWide(const WideBvh& bvh, WideBvh::Ref start, const WideBoxRay& ray, double* tmax,
+// improving hit), which culls the boxes beyond. The start's own box is not tested. BoxRay: a
+// WideBoxRay, or a ray with the same two members (cullLimit, enter) for other boxes.
+template <class BoxRay, class Leaf>
+void traceWide(const WideBvh& bvh, WideBvh::Ref start, const BoxRay& ray, double* tmax,
                Leaf&& leaf) {
   if (start.isEmpty()) return;
   struct Entry {
