@@ -42,22 +42,23 @@ void BeamSet::prepareSensorRays(const CastConfig& config) {
   key.tmin = config.tmin;
   key.cull_backfaces = config.cull_backfaces;
   key.method = config.method;
+  tmin_ = config.tmin;
+  cull_backfaces_ = config.cull_backfaces;
   if (prepared_key_ && *prepared_key_ == key) return;
   prepared_key_ = key;
-  const auto& dirs = pattern_->directions();
-  dispatchTriangleMethod(config.method, [&](auto method) {
-    constexpr TriangleMethod M = decltype(method)::value;
-    std::vector<PreparedRay<double, M>> rays;
-    rays.reserve(dirs.size());
-    for (const Eigen::Vector3d& d : dirs) {
-      Ray ray;
-      ray.origin = Eigen::Vector3d::Zero();
-      ray.dir = d;
-      ray.tmin = config.tmin;
-      rays.emplace_back(ray, config.cull_backfaces);
-    }
-    sensor_rays_ = std::move(rays);
-  });
+  // As ScanPattern computes each direction: (cos e cos a, cos e sin a, sin e).
+  row_ce_.clear();
+  row_se_.clear();
+  for (const int ring : beam_of_row_) {
+    row_ce_.push_back(std::cos(pattern_->elevations()[ring]));
+    row_se_.push_back(std::sin(pattern_->elevations()[ring]));
+  }
+  column_cos_d_.resize(cols());
+  column_sin_d_.resize(cols());
+  for (int col = 0; col < cols(); ++col) {
+    column_cos_d_[col] = std::cos(pattern_->azimuth(col));
+    column_sin_d_[col] = std::sin(pattern_->azimuth(col));
+  }
   padded_cols_ = (cols() + 3) / 4 * 4;
   prepareRows();
   direction_x_.assign(static_cast<std::size_t>(rows()) * padded_cols_, 0.0f);

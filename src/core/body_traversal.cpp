@@ -22,7 +22,7 @@ namespace {
 constexpr long long kTraceBeams = 12;
 // A leaf whose window holds at most this many beams has them tested against each of its triangles;
 // more are rasterised (3D) against each triangle's edge planes first.
-constexpr long long kLeafDirectBeams = 4;
+constexpr long long kLeafDirectBeams = 8;
 // A subtree with at most this many triangles and at least this many beams per triangle in its
 // window is sliced whole (planar fans), without windows or occlusion tests on the way.
 constexpr std::uint32_t kPlainSliceTriangles = 64;
@@ -49,6 +49,8 @@ class MeshWalk {
         tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
         frame_(active.sensor_from_body, planar_, config.tmax),
         stamp_(beams.newWalkStamp()) {
+    eye_ = active.sensor_in_body;
+    closed_ = !slicing_ && mesh.hasClosedComponents();
     if (slicing_) {
       // Cut in the frame's plane coordinates when the walk gives them (as a kept slice is).
       if (active.plane) {
@@ -198,11 +200,13 @@ class MeshWalk {
         double tmax = std::min(config_.tmax, range);
         Best best;
         if (slicing_) {
-          traceWide(wide_, e.ref, boxRay(row, col), &tmax,
-                    [&](std::uint32_t slot) { sliceOne(slot, col, &tmax, &best); });
-        } else {
-          const auto& ray = beams_.template sensorRay<M>(row, col);
           traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
+            if (!hidden(slot)) sliceOne(slot, col, &tmax, &best);
+          });
+        } else {
+          const auto ray = beams_.template sensorRay<M>(row, col);
+          traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
+            if (hidden(slot)) return;
             const SensorTriangle s = sensorTriangle(slot);
             const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
             if (hit && best.improves(hit->t, ids_[slot])) {
@@ -214,6 +218,15 @@ class MeshWalk {
         if (best.found()) offer(row, col, best);
       }
     }
+  }
+
+  // A back face of a closed component that the sensor sees from outside: never the nearest hit of a
+  // beam (hiddenBackFace), so never tested. Only for the 3D tests: a planar fan's segments are
+  // cheap, and kept slices (which must skip what the walk skips) would pay more to decide.
+  bool hidden(std::uint32_t slot) const { return closed_ && hiddenClosed(slot); }
+  // Out of line: the tests that ask stay small inline.
+  __attribute__((noinline)) bool hiddenClosed(std::uint32_t slot) const {
+    return hiddenBackFace(mesh_, slot, eye_, config_.tmin);
   }
 
   // The slot's segment in the scan plane against one beam, as slicing tests it.
@@ -238,11 +251,12 @@ class MeshWalk {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
         if (!(range >= e.near)) continue;
-        const auto& ray = beams_.template sensorRay<M>(row, col);
+        const auto ray = beams_.template sensorRay<M>(row, col);
         double tmax = std::min(config_.tmax, range);
         Best best;
         for (std::uint32_t i = 0; i < e.ref.count; ++i) {
           const std::uint32_t slot = e.ref.index + i;
+          if (hidden(slot)) continue;
           const SensorTriangle s = i < count ? tris[i] : sensorTriangle(slot);
           const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
           if (hit && best.improves(hit->t, ids_[slot])) {
@@ -261,10 +275,13 @@ class MeshWalk {
   // through.
   void rasterLeaf(const Entry& e) {
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
+      if (hidden(slot)) continue;
       const SensorTriangle s = sensorTriangle(slot);
       const std::uint32_t triangle = ids_[slot];
       auto test = [&](int row, int col) {
-        const double range = beams_.range(row, col);
+        // The range rounded up to float (compact, so cheaper to read here than the result's): a
+        // hit it lets through beyond the exact range is turned down by offer().
+        const double range = beams_.rangeAbove(row)[col];
         if (!(range >= e.near)) return;
         const auto hit = beams_.template sensorRay<M>(row, col).intersect(
             s.a, s.b, s.c, std::min(config_.tmax, range));
@@ -306,6 +323,7 @@ class MeshWalk {
 
   void sliceLeaf(WideBvh::Ref leaf, const BeamRect& rect, double near) {
     for (std::uint32_t slot = leaf.index; slot < leaf.index + leaf.count; ++slot) {
+      if (hidden(slot)) continue;
       slicer_->sliceSlot(
           slot, rect.col_lo, rect.col_hi,
           [&](int col, double t) {
@@ -328,6 +346,8 @@ class MeshWalk {
   const Eigen::Matrix3d rot_, abs_rot_;
   const Eigen::Vector3d trans_;
   const bool planar_, slicing_, tracing_only_;
+  Eigen::Vector3d eye_;  // the sensor in the mesh frame, for hidden()
+  bool closed_;          // the mesh has closed components
   const ViewFrame frame_;
   const std::uint32_t stamp_;
   std::optional<PlaneSlicer> slicer_;

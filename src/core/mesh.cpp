@@ -1,7 +1,9 @@
 #include "laser_raycast/core/mesh.h"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace laser_raycast {
 namespace core {
@@ -51,6 +53,55 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
   slot_component.reserve(bvh_.triangleIds().size());
   for (const std::uint32_t id : bvh_.triangleIds()) slot_component.push_back(component_[id]);
   wide_ = WideBvh(bvh_, slot_component);
+  findClosedComponents();
+}
+
+void Mesh::findClosedComponents() {
+  component_bounds_.assign(component_count_, Aabb{});
+  for (std::size_t t = 0; t < triangles_.size(); ++t) {
+    for (const std::uint32_t v : triangles_[t]) component_bounds_[component_[t]].grow(vertices_[v]);
+  }
+  // Every directed edge once, and its reverse once: a closed surface wound one way.
+  std::vector<char> closed(component_count_, 1);
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> edges;  // (from << 32 | to, component)
+  edges.reserve(triangles_.size() * 3);
+  for (std::size_t t = 0; t < triangles_.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t from = triangles_[t][k], to = triangles_[t][(k + 1) % 3];
+      if (from == to) closed[component_[t]] = 0;
+      edges.emplace_back(from << 32 | to, component_[t]);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const std::uint64_t e = edges[i].first;
+    const bool repeated = i + 1 < edges.size() && edges[i + 1].first == e;
+    const std::uint64_t reverse = (e & 0xffffffffull) << 32 | e >> 32;
+    const bool paired =
+        std::binary_search(edges.begin(), edges.end(), std::make_pair(reverse, std::uint32_t{0}),
+                           [](const auto& x, const auto& y) { return x.first < y.first; });
+    if (repeated || !paired) closed[edges[i].second] = 0;
+  }
+  // The orientation: the sign of the enclosed volume (six times it: the tetrahedra from a point of
+  // the component's bounds to each triangle), kept only if it stands clear of the rounding.
+  std::vector<double> volume(component_count_, 0.0), magnitude(component_count_, 0.0);
+  for (std::size_t t = 0; t < triangles_.size(); ++t) {
+    const std::uint32_t c = component_[t];
+    const Eigen::Vector3d o = component_bounds_[c].center();
+    const auto& v = triangles_[t];
+    const Eigen::Vector3d a = vertices_[v[0]] - o, b = vertices_[v[1]] - o, d = vertices_[v[2]] - o;
+    const double term = a.dot(b.cross(d));
+    volume[c] += term;
+    magnitude[c] += a.norm() * b.norm() * d.norm();
+  }
+  slot_facing_.clear();
+  slot_facing_.reserve(bvh_.triangleIds().size());
+  for (const std::uint32_t id : bvh_.triangleIds()) {
+    const std::uint32_t c = component_[id];
+    const bool clear = std::abs(volume[c]) > 1e-9 * magnitude[c];
+    slot_facing_.push_back(!closed[c] || !clear ? 0 : (volume[c] > 0 ? 1 : -1));
+    has_closed_ = has_closed_ || slot_facing_.back() != 0;
+  }
 }
 
 // Union-find over vertex indices: triangles sharing a vertex index are in one component. Only

@@ -29,22 +29,24 @@ void OcclusionTiles::reset(int rows, int cols, float start) {
     std::fill_n(range_.begin() + static_cast<std::size_t>(r) * padded_cols_, cols_, start);
   }
   fine_max_.assign(static_cast<std::size_t>(rows_) * fine_cols_, start);
+  fine_stale_.assign(fine_max_.size(), 0);
   coarse_max_.assign(static_cast<std::size_t>(coarse_rows_) * coarse_cols_, start);
   coarse_stale_.assign(coarse_max_.size(), 0);
 }
 
-void OcclusionTiles::lower(int row, int col, float range) {
-  float* r = &range_[static_cast<std::size_t>(row) * padded_cols_];
-  r[col] = range;
-  const int tile = col / kFineWidth;
-  const float* t = r + tile * kFineWidth;
-  const __m128 m = _mm_max_ps(_mm_max_ps(_mm_loadu_ps(t), _mm_loadu_ps(t + 4)),
-                              _mm_max_ps(_mm_loadu_ps(t + 8), _mm_loadu_ps(t + 12)));
-  fine_max_[static_cast<std::size_t>(row) * fine_cols_ + tile] = maxOf(m);
-  coarse_stale_[(row / kCoarseRings) * coarse_cols_ + col / kCoarseWidth] = 1;
+float OcclusionTiles::fineMax(int row, int tile) const {
+  const std::size_t i = static_cast<std::size_t>(row) * fine_cols_ + tile;
+  if (fine_stale_[i]) {
+    const float* t = &range_[static_cast<std::size_t>(row) * padded_cols_ + tile * kFineWidth];
+    const __m128 m = _mm_max_ps(_mm_max_ps(_mm_loadu_ps(t), _mm_loadu_ps(t + 4)),
+                                _mm_max_ps(_mm_loadu_ps(t + 8), _mm_loadu_ps(t + 12)));
+    fine_max_[i] = maxOf(m);
+    fine_stale_[i] = 0;
+  }
+  return fine_max_[i];
 }
 
-float OcclusionTiles::coarseMax(int tile_row, int tile) {
+float OcclusionTiles::coarseMax(int tile_row, int tile) const {
   const std::size_t i = static_cast<std::size_t>(tile_row) * coarse_cols_ + tile;
   if (coarse_stale_[i]) {
     float m = 0;
@@ -52,8 +54,7 @@ float OcclusionTiles::coarseMax(int tile_row, int tile) {
     const int fine_per_coarse = kCoarseWidth / kFineWidth;
     const int fine_end = std::min(fine_cols_, (tile + 1) * fine_per_coarse);
     for (int row = tile_row * kCoarseRings; row < row_end; ++row) {
-      const float* f = &fine_max_[static_cast<std::size_t>(row) * fine_cols_];
-      for (int k = tile * fine_per_coarse; k < fine_end; ++k) m = std::max(m, f[k]);
+      for (int k = tile * fine_per_coarse; k < fine_end; ++k) m = std::max(m, fineMax(row, k));
     }
     coarse_max_[i] = m;
     coarse_stale_[i] = 0;
@@ -61,7 +62,7 @@ float OcclusionTiles::coarseMax(int tile_row, int tile) {
   return coarse_max_[i];
 }
 
-bool OcclusionTiles::anyOpenInRows(const BeamRect& rect, float near) {
+bool OcclusionTiles::anyOpenInRows(const BeamRect& rect, float near) const {
   if (rect.empty()) return false;
   // Large windows are answered from the coarse tiles (fewer reads, a looser bound).
   const long long fine_tiles = static_cast<long long>(rect.row_hi - rect.row_lo + 1) *

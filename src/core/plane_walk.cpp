@@ -56,6 +56,18 @@ class SliceWalk {
     beams_.forEachRect(view, within, [&](const BeamRect& rect) {
       stack_.push_back(Entry{slice_.wide.root(), rect, floatBelow(view.near)});
     });
+    walk();
+    castDeferred();
+  }
+
+ private:
+  struct Entry {
+    WideBvh::Ref ref;
+    BeamRect rect;
+    float near;
+  };
+
+  void walk() {
     while (!stack_.empty()) {
       const Entry e = stack_.back();
       stack_.pop_back();
@@ -73,12 +85,6 @@ class SliceWalk {
   }
 
  private:
-  struct Entry {
-    WideBvh::Ref ref;
-    BeamRect rect;
-    float near;
-  };
-
   void expand(const Entry& e) {
     const WideBvh::Node& node = slice_.wide.nodes()[e.ref.index];
     PlaneViews views;
@@ -150,7 +156,9 @@ class SliceWalk {
         });
   }
 
-  // A primitive: its pose, culled as the scene walk culls it, then cast over the rect.
+  // A primitive: its pose, culled as the scene walk culls it, then cast over the rect, or after the
+  // walk if it is large for its distance (a wall the sensor stands beside: nearest first would
+  // test it with every beam before the nearer things in front of it).
   void castPrimitiveItem(int index, const BeamRect& rect) {
     Caster::ActiveBody a;
     a.index = index;
@@ -164,8 +172,22 @@ class SliceWalk {
     a.body_from_sensor_rot = rot.transpose();
     a.sensor_in_body = -(a.body_from_sensor_rot * a.sensor_from_body.translation());
     beams_.forEachRect(a.view, rect, [&](const BeamRect& r) {
-      if (beams_.anyOpen(r, a.view.near)) castPrimitive(beams_, scene_, a, config_, r);
+      if (deferLargePrimitive(a)) {
+        deferred_.emplace_back(a, r);
+      } else if (beams_.anyOpen(r, a.view.near)) {
+        castPrimitive(beams_, scene_, a, config_, r);
+      }
     });
+  }
+
+  void castDeferred() {
+    std::stable_sort(deferred_.begin(), deferred_.end(), [](const auto& x, const auto& y) {
+      return x.first.view.near < y.first.view.near;
+    });
+    for (const auto& [a, r] : deferred_) {
+      if (beams_.anyOpen(r, a.view.near)) castPrimitive(beams_, scene_, a, config_, r);
+    }
+    deferred_.clear();
   }
 
   // Each open beam of the rect through the node's subtree, one ray at a time: box tests in plane
@@ -231,6 +253,7 @@ class SliceWalk {
   Eigen::Matrix2d inverse_;
   std::optional<PlaneRay::Origin> origin_;
   std::vector<Entry> stack_;
+  std::vector<std::pair<Caster::ActiveBody, BeamRect>> deferred_;  // cast after the walk
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "laser_raycast/core/body_traversal.h"
 #include "laser_raycast/core/fan_slicer.h"
 #include "laser_raycast/core/node_views.h"
+#include "laser_raycast/core/primitive_cast.h"
 
 namespace laser_raycast {
 namespace core {
@@ -46,7 +47,11 @@ class GroupWalk {
       if (e.body >= 0) {
         const Caster::ActiveBody& a = bodies_[e.body];
         (*cast_)[a.index].store(1, std::memory_order_relaxed);
-        castBody(beams_, scene_, a, config_, e.rect);
+        if (isPrimitive(a.index) && deferLargePrimitive(a)) {
+          deferred_.push_back(e);
+        } else {
+          castBody(beams_, scene_, a, config_, e.rect);
+        }
       } else if (e.ref.isLeaf()) {
         for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
           placeBody(group_.bodies[group_.tree.triangleIds()[slot]], e.rect);
@@ -55,6 +60,16 @@ class GroupWalk {
         expand(e);
       }
     }
+    // Large primitives, nearest first, once everything nearer has had its turn.
+    for (const Entry& e : deferred_) {
+      if (beams_.anyOpen(e.rect, e.near))
+        castBody(beams_, scene_, bodies_[e.body], config_, e.rect);
+    }
+    deferred_.clear();
+  }
+
+  bool isPrimitive(int body) const {
+    return !std::holds_alternative<std::shared_ptr<const Mesh>>(scene_.bodies()[body].shape);
   }
 
  private:
@@ -130,6 +145,7 @@ class GroupWalk {
   }
   std::vector<Entry> heap_;
   std::vector<Caster::ActiveBody> bodies_;  // placed this walk
+  std::vector<Entry> deferred_;             // large primitives, in the order their turn came
 };
 
 }  // namespace

@@ -76,6 +76,20 @@ struct FreshBeams {
   }
 };
 
+// The beam set rebuilds a beam's direction from its row's and column's factors, the pattern's own
+// expression: the same bits as the pattern's directions.
+TEST(BeamSet, RebuiltDirectionsAreThePatternsBitForBit) {
+  for (const core::ScanPattern& pattern : patterns()) {
+    FreshBeams fresh(pattern, core::CastConfig{});
+    for (int row = 0; row < fresh.beams.rows(); ++row) {
+      for (int col = 0; col < fresh.beams.cols(); ++col) {
+        ASSERT_EQ(fresh.beams.rebuiltDirection(row, col), fresh.beams.direction(row, col))
+            << "row " << row << " col " << col;
+      }
+    }
+  }
+}
+
 TEST(NodeViews, EveryBeamThatEntersAChildBoxIsInItsWindow) {
   Rng rng(21);
   long long checked = 0, inside = 0;

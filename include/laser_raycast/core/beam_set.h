@@ -103,11 +103,22 @@ class BeamSet {
   // is).
   bool anyOpen(const BeamRect& rect, double near) { return anyOpen(rect, floatBelow(near)); }
 
-  // The beams as rays from the sensor (sensor frame, origin 0) for the rasterising walk, prepared
-  // for config's method, tmin and back-face culling when the pattern or these change.
+  // A beam as a ray from the sensor (sensor frame, origin 0) for the triangle tests, prepared for
+  // the cast's method, tmin and back-face culling. Prepared when asked for, from the direction
+  // rebuilt from its row's and column's sines and cosines (the pattern's own expression, so the
+  // same bits): cheaper than reading a stored one from a scan of many beams, out of the cache.
   template <TriangleMethod M>
-  const PreparedRay<double, M>& sensorRay(int row, int col) const {
-    return std::get<std::vector<PreparedRay<double, M>>>(sensor_rays_)[beam(row, col)];
+  PreparedRay<double, M> sensorRay(int row, int col) const {
+    Ray ray;
+    ray.origin.setZero();
+    ray.dir = rebuiltDirection(row, col);
+    ray.tmin = tmin_;
+    return PreparedRay<double, M>(ray, cull_backfaces_);
+  }
+  // direction(row, col), bit for bit, from small tables.
+  Eigen::Vector3d rebuiltDirection(int row, int col) const {
+    return Eigen::Vector3d(row_ce_[row] * column_cos_d_[col], row_ce_[row] * column_sin_d_[col],
+                           row_se_[row]);
   }
   // The beams' directions in float, one row at a time, each row padded to a multiple of four
   // columns (x and y; z is the same for a whole row).
@@ -164,7 +175,7 @@ class BeamSet {
   bool occlusion_culling_ = true;
   void prepareSensorRays(const CastConfig& config);
 
-  // What sensor_rays_ and the float directions were built for.
+  // What the directions' tables were built for.
   struct PreparedKey {
     double angle_min = 0, angle_increment = 0;
     int azimuths = 0;
@@ -179,12 +190,10 @@ class BeamSet {
     }
   };
   std::optional<PreparedKey> prepared_key_;
-  std::variant<std::vector<PreparedRay<double, TriangleMethod::kSeedPlane>>,
-               std::vector<PreparedRay<double, TriangleMethod::kSeedUv>>,
-               std::vector<PreparedRay<double, TriangleMethod::kCramer>>,
-               std::vector<PreparedRay<double, TriangleMethod::kMollerTrumbore>>,
-               std::vector<PreparedRay<double, TriangleMethod::kWatertight>>>
-      sensor_rays_;
+  // Each row's cos and sin of its elevation, each column's of its azimuth: the directions' factors.
+  std::vector<double> row_ce_, row_se_, column_cos_d_, column_sin_d_;
+  double tmin_ = 0;
+  bool cull_backfaces_ = false;
   int padded_cols_ = 0;
   std::vector<float> direction_x_, direction_y_, direction_z_;
 

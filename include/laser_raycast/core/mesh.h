@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
@@ -32,6 +33,17 @@ class Mesh {
   // The connected component of each triangle, numbered from 0, and how many there are.
   const std::vector<std::uint32_t>& components() const { return component_; }
   std::uint32_t componentCount() const { return component_count_; }
+  // Closed surfaces, whose back faces a sensor outside them never sees first: per BVH slot, +1 if
+  // its triangle's component is closed and consistently wound with the front normals
+  // ((b - a) x (c - a)) pointing out of the solid, -1 if pointing in, 0 if the component is open,
+  // inconsistently wound, or encloses no volume. A component is closed when every edge between two
+  // of its vertex indices is used by exactly two of its triangles, once in each direction.
+  const std::vector<std::int8_t>& slotFacing() const { return slot_facing_; }
+  bool hasClosedComponents() const { return has_closed_; }
+  // Per BVH slot, the bounds of its triangle's component (the sensor must be outside them).
+  const Aabb& slotComponentBounds(std::uint32_t slot) const {
+    return component_bounds_[component_[bvh_.triangleIds()[slot]]];
+  }
   const Aabb& bounds() const { return bounds_; }
   // A sphere containing every vertex that a triangle uses: centre of their bounds, radius to the
   // farthest of them.
@@ -45,6 +57,7 @@ class Mesh {
 
  private:
   void labelComponents();
+  void findClosedComponents();
 
   std::vector<Eigen::Vector3d> vertices_;
   std::vector<TriangleIndices> triangles_;
@@ -53,9 +66,31 @@ class Mesh {
   double sphere_radius_ = 0;
   std::vector<std::uint32_t> component_;
   std::uint32_t component_count_ = 0;
+  std::vector<Aabb> component_bounds_;
+  std::vector<std::int8_t> slot_facing_;
+  bool has_closed_ = false;
   Bvh bvh_;
   WideBvh wide_;
 };
+
+// Whether the triangle in BVH slot `slot` is a back face of a closed component (slotFacing) as seen
+// from a sensor at `eye` (mesh frame) outside the component's bounds and no nearer to them than
+// tmin: a beam from there meets one of the component's front faces first, so it never reports this
+// triangle. Only clear cases count: the triangle's plane must pass the eye by more than rounding.
+inline bool hiddenBackFace(const Mesh& mesh, std::uint32_t slot, const Eigen::Vector3d& eye,
+                           double tmin) {
+  const int facing = mesh.slotFacing()[slot];
+  if (!facing) return false;
+  const Aabb& box = mesh.slotComponentBounds(slot);
+  const double gap2 = (box.lo - eye).cwiseMax(eye - box.hi).cwiseMax(0.0).squaredNorm();
+  // Outside the bounds, and its front faces no nearer than tmin (written so that NaN fails).
+  if (!(gap2 > 0 && gap2 > tmin * tmin * (1 + 1e-9))) return false;
+  const auto& v = mesh.bvh().triangleVertices()[slot];
+  const Eigen::Vector3d ab = v[1] - v[0], ac = v[2] - v[0], from_eye = v[0] - eye;
+  // The front normal's side of the eye: positive when it points away from it.
+  const double side = ab.cross(ac).dot(from_eye);
+  return facing * side > 1e-10 * ab.lpNorm<1>() * ac.lpNorm<1>() * from_eye.lpNorm<1>();
+}
 
 }  // namespace core
 }  // namespace laser_raycast

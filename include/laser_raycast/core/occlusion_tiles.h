@@ -1,13 +1,13 @@
 // Which parts of a scan are still open: every beam's range so far, rounded up to float, and its
-// maximum over tiles of beams in two levels (fine tiles of one ring by kFineWidth azimuths, kept up
-// to date with every hit; coarse tiles of kCoarseRings rings by kCoarseWidth azimuths, refreshed
-// when read), so that "is every beam of this window already nearer than d?" costs a few reads, four
-// at a time, instead of one per beam. The caster asks it before it walks a body or a BVH node: if
-// every beam the node's window holds has hit something nearer than the node, the node is hidden.
+// maximum over tiles of beams in two levels (fine tiles of one ring by kFineWidth azimuths, coarse
+// tiles of kCoarseRings rings by kCoarseWidth azimuths), so that "is every beam of this window
+// already nearer than d?" costs a few reads, four at a time, instead of one per beam. The caster
+// asks it before it walks a body or a BVH node: if every beam the node's window holds has hit
+// something nearer than the node, the node is hidden.
 //
-// Ranges only ever decrease while a scan is cast, so a stale coarse maximum is still an upper
-// bound: a hit refreshes its fine tile and marks its coarse tile stale. Threads that cast separate
-// pieces of the columns (whole coarse tiles each) never share a tile.
+// Ranges only ever decrease while a scan is cast, so a stale maximum is still an upper bound: a hit
+// only marks its tiles stale, and a read refreshes the stale tiles it reads. Threads that cast
+// separate pieces of the columns (whole coarse tiles each) never share a tile.
 #pragma once
 
 #include <emmintrin.h>
@@ -39,11 +39,15 @@ class OcclusionTiles {
   // The ranges of one row, padded to whole fine tiles (the padding holds 0: never open).
   const float* row(int r) const { return &range_[static_cast<std::size_t>(r) * padded_cols_]; }
   // The beam at (row, col) hit something at `range` (rounded up), nearer than before.
-  void lower(int row, int col, float range);
+  void lower(int row, int col, float range) {
+    range_[static_cast<std::size_t>(row) * padded_cols_ + col] = range;
+    fine_stale_[static_cast<std::size_t>(row) * fine_cols_ + col / kFineWidth] = 1;
+    coarse_stale_[(row / kCoarseRings) * coarse_cols_ + col / kCoarseWidth] = 1;
+  }
   // False only if every beam in rect has a range below `near` (so nothing at distance >= near can
   // be seen through rect). May answer true when that holds too (a coarse tile overlaps the rect's
   // border), never false when some beam is at near or farther.
-  bool anyOpen(const BeamRect& rect, float near) {
+  bool anyOpen(const BeamRect& rect, float near) const {
     if (rect.row_lo == rect.row_hi && rect.col_hi - rect.col_lo < kFineWidth) {
       return !rect.empty() && anyOpenInRow(rect.row_lo, rect.col_lo, rect.col_hi, near);
     }
@@ -51,17 +55,17 @@ class OcclusionTiles {
   }
 
  private:
-  float coarseMax(int tile_row, int tile);
-  bool anyOpenInRows(const BeamRect& rect, float near);
+  float coarseMax(int tile_row, int tile) const;
+  float fineMax(int row, int tile) const;
+  bool anyOpenInRows(const BeamRect& rect, float near) const;
   // Beams first..last of a row, four at a time, against near; whole fine tiles by their maximum.
   bool anyOpenInRow(int row, int first, int last, float near) const {
     const float* r = &range_[static_cast<std::size_t>(row) * padded_cols_];
     const int t_lo = first / kFineWidth, t_hi = last / kFineWidth;
     if (t_lo != t_hi) {
       if (chunkOpen(r, first, t_lo * kFineWidth + kFineWidth - 1, near)) return true;
-      const float* fine = &fine_max_[static_cast<std::size_t>(row) * fine_cols_];
       for (int t = t_lo + 1; t < t_hi; ++t) {
-        if (!(fine[t] < near)) return true;  // written so that NaN counts as open
+        if (!(fineMax(row, t) < near)) return true;  // written so that NaN counts as open
       }
       first = t_hi * kFineWidth;
     }
@@ -82,10 +86,10 @@ class OcclusionTiles {
   }
 
   int rows_ = 0, cols_ = 0, padded_cols_ = 0, fine_cols_ = 0, coarse_rows_ = 0, coarse_cols_ = 0;
-  std::vector<float> range_;     // rows_ x padded_cols_
-  std::vector<float> fine_max_;  // rows_ x fine_cols_, always up to date
-  std::vector<float> coarse_max_;
-  std::vector<char> coarse_stale_;
+  std::vector<float> range_;  // rows_ x padded_cols_
+  // The tiles' maxima, refreshed when read (a query that reads a stale tile writes it: mutable).
+  mutable std::vector<float> fine_max_, coarse_max_;
+  mutable std::vector<char> fine_stale_, coarse_stale_;
 };
 
 }  // namespace core

@@ -10,6 +10,12 @@
 namespace laser_raycast {
 namespace core {
 
+// Whether a walk should cast the primitive after everything else: it is large for its distance
+// (its bounding sphere's radius beyond its nearest distance: a floor under the sensor, a wall
+// beside it), so taken nearest first it would be tested with every beam before the nearer things in
+// front of most of it. Only speed depends on it.
+inline bool deferLargePrimitive(const Caster::ActiveBody& a) { return a.radius > a.view.near; }
+
 // Casts the open beams of rect against the primitive body active.index of scene.
 void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& active,
                    const CastConfig& config, const BeamRect& rect);
