@@ -24,9 +24,6 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
   one_turn_ = span <= 2 * M_PI && col_turn_ < 1e9;
   // The rounding of the few operations from an angle to a column index, with room to spare.
   col_pad_ = 64 * std::numeric_limits<double>::epsilon() * (col_turn_ + cols() + 8);
-  const std::size_t beams = pattern.directions().size();
-  box_rays_.resize(beams);
-  if (ray_stamp_.size() != beams) ray_stamp_.assign(beams, 0);
   prepareSensorRays(config);
   // resetResult left every range +inf (or NaN for a sensor pose that is not valid, and then
   // nothing is cast): the farthest hit a beam keeps is tmax.

@@ -48,7 +48,7 @@ class MeshWalk {
         // Without the fast paths every beam is traced from the root, as the reference.
         tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
         frame_(active.sensor_from_body, planar_, config.tmax),
-        stamp_(beams.newWalkStamp()) {
+        origin_(active.sensor_in_body, mesh.bvh().bounds(), config.tmin) {
     eye_ = active.sensor_in_body;
     closed_ = !slicing_ && mesh.hasClosedComponents();
     if (slicing_) {
@@ -148,14 +148,8 @@ class MeshWalk {
 
   // The beam as a ray in the body's frame, for box tests: the same one for every box test of this
   // walk.
-  const WideBoxRay& boxRay(int row, int col) {
-    return beams_.boxRay(row, col, stamp_, [&](const Eigen::Vector3d& dir) {
-      Ray r;
-      r.origin = active_.sensor_in_body;
-      r.dir = active_.body_from_sensor_rot * dir;
-      r.tmin = config_.tmin;
-      return WideBoxRay(r, wide_.binary().bounds());
-    });
+  WideBoxRay boxRay(int row, int col) const {
+    return WideBoxRay(origin_, active_.body_from_sensor_rot * beams_.rebuiltDirection(row, col));
   }
 
   // A triangle slot moved into the sensor frame. Every 3D test of this body's triangles is the
@@ -167,6 +161,16 @@ class MeshWalk {
   SensorTriangle sensorTriangle(std::uint32_t slot) const {
     const auto& v = slots_[slot];
     return SensorTriangle{rot_ * v[0] + trans_, rot_ * v[1] + trans_, rot_ * v[2] + trans_};
+  }
+
+  // The same through a small cache: the beams traced through one node meet the same leaves.
+  const SensorTriangle& cachedTriangle(std::uint32_t slot) {
+    CachedTriangle& c = cache_[slot % kCachedTriangles];
+    if (c.slot != slot) {
+      c.slot = slot;
+      c.triangle = sensorTriangle(slot);
+    }
+    return c.triangle;
   }
 
   Eigen::Vector3d sensorNormal(std::uint32_t triangle) const {
@@ -207,7 +211,7 @@ class MeshWalk {
           const auto ray = beams_.template sensorRay<M>(row, col);
           traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
             if (hidden(slot)) return;
-            const SensorTriangle s = sensorTriangle(slot);
+            const SensorTriangle& s = cachedTriangle(slot);
             const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
             if (hit && best.improves(hit->t, ids_[slot])) {
               best = Best{hit->t, ids_[slot], slot};
@@ -347,9 +351,15 @@ class MeshWalk {
   const Eigen::Vector3d trans_;
   const bool planar_, slicing_, tracing_only_;
   Eigen::Vector3d eye_;  // the sensor in the mesh frame, for hidden()
-  bool closed_;          // the mesh has closed components
+  static constexpr std::uint32_t kCachedTriangles = 64;
+  struct CachedTriangle {
+    std::uint32_t slot = std::numeric_limits<std::uint32_t>::max();
+    SensorTriangle triangle;
+  };
+  std::array<CachedTriangle, kCachedTriangles> cache_;
+  bool closed_;  // the mesh has closed components
   const ViewFrame frame_;
-  const std::uint32_t stamp_;
+  const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame
   std::optional<PlaneSlicer> slicer_;
   std::vector<Entry> stack_ = std::vector<Entry>(256);
   int top_ = 0;

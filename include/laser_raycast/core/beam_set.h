@@ -10,7 +10,6 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <variant>
@@ -142,12 +141,6 @@ class BeamSet {
     row_tan_.find(lo, hi, row_lo, row_hi);
   }
 
-  // Each beam as a ray in the frame of the body being walked, for box tests, built once per (beam,
-  // body walk). A walk takes a fresh stamp; the rays of other walks are rebuilt when asked for.
-  std::uint32_t newWalkStamp() { return walk_stamp_.fetch_add(1) + 1; }
-  template <class Make>
-  const WideBoxRay& boxRay(int row, int col, std::uint32_t stamp, Make&& make);
-
   // Offers a hit (t, body, triangle) to the beam at (row, col); normal() gives its unit normal in
   // the sensor frame, asked only if the hit is kept and normals are wanted. True if kept.
   template <class Normal>
@@ -197,11 +190,8 @@ class BeamSet {
   int padded_cols_ = 0;
   std::vector<float> direction_x_, direction_y_, direction_z_;
 
-  std::vector<WideBoxRay> box_rays_;
-  std::vector<std::uint32_t> ray_stamp_;      // the walk each cached ray was built for
-  std::atomic<std::uint32_t> walk_stamp_{0};  // walks of several threads take stamps
-  std::vector<int> beam_of_row_;              // the ring of each row
-  RowTable row_elevation_, row_tan_;          // of the rows, ascending
+  std::vector<int> beam_of_row_;      // the ring of each row
+  RowTable row_elevation_, row_tan_;  // of the rows, ascending
   bool column_raster_ = false;
   std::vector<float> column_cos_, column_sin_, row_cos_, row_sin_;
   float smallest_row_cos_ = 1;
@@ -272,16 +262,6 @@ void BeamSet::forEachChildRect(const NodeViews& views, int k, const BeamRect& wi
                         std::min(last, within.col_hi)};
     if (!rect.empty()) f(rect);
   });
-}
-
-template <class Make>
-const WideBoxRay& BeamSet::boxRay(int row, int col, std::uint32_t stamp, Make&& make) {
-  const int i = beam(row, col);
-  if (ray_stamp_[i] != stamp) {
-    box_rays_[i] = make(direction(row, col));
-    ray_stamp_[i] = stamp;
-  }
-  return box_rays_[i];
 }
 
 template <class Normal>

@@ -193,9 +193,25 @@ class WideSlabRay {
 // A ray prepared for the wide BVH's box tests in 3D.
 class WideBoxRay : public WideSlabRay<3> {
  public:
+  // What the rays of one walk share: they start at one point (rounded once each way), and a bound
+  // on how far a box coordinate of the tree is from it, in units of t of a unit direction (for the
+  // cull limit's widening).
+  struct Origin {
+    float up[3], down[3];
+    double reach;
+    float tnear0;  // the rays' tmin, widened as the cull limit is
+    Origin(const Eigen::Vector3d& origin, const Aabb& bounds, double tmin);
+  };
+
   WideBoxRay() = default;
   // bounds: the box of everything the ray will be tested against (a mesh's), for the reach.
   WideBoxRay(const Ray& ray, const Aabb& bounds);
+  // A unit direction from a walk's origin.
+  WideBoxRay(const Origin& origin, const Eigen::Vector3d& dir) {
+    reach_ = origin.reach;
+    tnear0_ = origin.tnear0;
+    for (int k = 0; k < 3; ++k) setAxis(k, dir[k], origin.up[k], origin.down[k]);
+  }
 
   // The same test for one box given by its float corners.
   bool enters(const float lo[3], const float hi[3], float cull) const;
