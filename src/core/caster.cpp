@@ -27,11 +27,22 @@ constexpr int kMinBeamsPerThread = 4096;
 
 // Columns per piece of work when a cast is split between threads: whole coarse occlusion tiles, so
 // that no tile is written by two threads, and several pieces per thread to even out the load.
+constexpr int kPiecesPerThread = 8;
 int chunkColumns(int columns, int threads) {
   const int unit = OcclusionTiles::kCoarseWidth;
-  const int pieces = threads * 4;
+  const int pieces = threads * kPiecesPerThread;
   const int width = (columns + pieces - 1) / pieces;
   return std::max(unit, (width + unit - 1) / unit * unit);
+}
+
+// Rows per piece: whole coarse tile rows, so that with the column pieces there are about
+// kPiecesPerThread pieces per thread. Each piece walks the scene from its top, so pieces are no
+// smaller than the load needs.
+int bandRows(int rows, int column_pieces, int threads) {
+  const int unit = OcclusionTiles::kCoarseRings;
+  const int bands = std::max(1, kPiecesPerThread * threads / std::max(1, column_pieces));
+  const int height = (rows + bands - 1) / bands;
+  return std::max(unit, (height + unit - 1) / unit * unit);
 }
 
 }  // namespace
@@ -210,11 +221,16 @@ void Caster::castBodies(const Scene& scene, const ScanPattern& pattern, const Ca
     if (!pool_ || pool_->threads() != threads) pool_ = std::make_unique<ThreadPool>(threads);
     const int columns = pattern.azimuthCount();
     const int width = chunkColumns(columns, threads);
-    const int pieces = (columns + width - 1) / width;
-    pool_->run(pieces, [&](int i) {
+    const int column_pieces = (columns + width - 1) / width;
+    const int rows = beams_->all().row_hi + 1;
+    const int height = bandRows(rows, column_pieces, threads);
+    const int bands = (rows + height - 1) / height;
+    pool_->run(column_pieces * bands, [&](int i) {
       BeamRect piece = beams_->all();
-      piece.col_lo = i * width;
+      piece.col_lo = (i / bands) * width;
       piece.col_hi = std::min(columns - 1, piece.col_lo + width - 1);
+      piece.row_lo = (i % bands) * height;
+      piece.row_hi = std::min(rows - 1, piece.row_lo + height - 1);
       castWithin(piece);
     });
   }
