@@ -69,15 +69,18 @@ Pass brutePass(const core::BvhT<T>& bvh) {
 
 // The pipeline as the node runs it: one Caster::cast per sensor pose over the whole pattern.
 // forget() first, so that an unchanged pose does not return the previous result. The caster keeps
-// its thread pool between casts, as the node's does.
-Pass pipelinePass(const BenchScene& scene, int threads) {
+// its thread pool between casts, as the node's does, and its kept slices (plane_slice.h) unless
+// plane_cache is false: then every planar fan is cast as one in a plane never met before (a tilting
+// sensor's, or a robot's first scans).
+Pass pipelinePass(const BenchScene& scene, int threads, bool plane_cache) {
   auto caster = std::make_shared<core::Caster>();
-  return [caster, &scene, threads](const WorkloadRays& w, const std::vector<int>&,
-                                   std::vector<double>* out) {
+  return [caster, &scene, threads, plane_cache](const WorkloadRays& w, const std::vector<int>&,
+                                                std::vector<double>* out) {
     core::CastConfig config;
     config.tmin = 0;
     config.tmax = w.tmax;
     config.threads = threads;
+    config.plane_cache = plane_cache;
     const std::size_t beams = static_cast<std::size_t>(w.pattern->size());
     for (std::size_t p = 0; p < w.sensors.size(); ++p) {
       caster->forget();
@@ -177,11 +180,17 @@ std::vector<Method> coreMethods(const SceneGeometry& g, const MethodFilter& want
   }
   if (wanted("pipeline")) {
     const std::size_t triangles = g.scene->scene.triangleCount();
-    methods.push_back(Method{"pipeline", false, true, triangles, pipelinePass(*g.scene, 1), true});
+    methods.push_back(
+        Method{"pipeline", false, true, triangles, pipelinePass(*g.scene, 1, true), true});
     if (threads != 1) {
-      methods.push_back(Method{"pipeline", false, true, triangles, pipelinePass(*g.scene, threads),
-                               true, threads});
+      methods.push_back(Method{"pipeline", false, true, triangles,
+                               pipelinePass(*g.scene, threads, true), true, threads});
     }
+  }
+  if (wanted("pipeline_new_plane")) {
+    const std::size_t triangles = g.scene->scene.triangleCount();
+    methods.push_back(Method{"pipeline_new_plane", false, true, triangles,
+                             pipelinePass(*g.scene, 1, false), true, 1, true});
   }
   return methods;
 }
@@ -196,6 +205,7 @@ std::vector<std::string> coreMethodNames() {
     }
   }
   names.push_back("pipeline");
+  names.push_back("pipeline_new_plane");
   return names;
 }
 

@@ -56,6 +56,7 @@ struct Method {
   Pass pass;
   bool paired = false;  // timed in alternating rounds with the other paired rows (speed ratios)
   int threads = 1;      // threads the method casts with (the pipeline's CastConfig::threads)
+  bool planar_only = false;  // a row only a planar fan differs in (not run on other workloads)
 };
 
 // Which methods to build (--method); a method not wanted costs nothing.
@@ -71,7 +72,8 @@ struct SceneGeometry {
 // The core's methods: every intersector in double and float, brute force and BVH, then the
 // pipeline (Caster::cast, with Caster::forget() before every cast so nothing is reused); those
 // wanted. With threads != 1 the pipeline has a second row cast with that many threads (0: every
-// core). The float rows need geometry.bvh_f.
+// core); pipeline_new_plane casts planar fans without kept slices. The float rows need
+// geometry.bvh_f.
 std::vector<Method> coreMethods(const SceneGeometry& geometry, const MethodFilter& wanted,
                                 int threads);
 // Their names, in the same order, for --list-methods.

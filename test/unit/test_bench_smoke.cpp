@@ -115,6 +115,7 @@ TEST(BenchSmoke, ListsTheCoreMethods) {
     }
   }
   EXPECT_EQ(methods.count("pipeline"), 1u);
+  EXPECT_EQ(methods.count("pipeline_new_plane"), 1u);
 }
 
 // agree_robust is a fraction in [0, 1] that is 1 exactly when disagree_robust is 0, and at most
@@ -170,20 +171,23 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
     EXPECT_TRUE(parseDouble(f[10], &max_ulp) && max_ulp >= 0) << lines[i];
     EXPECT_TRUE(parseCount(f[11], &leaks)) << lines[i];
     EXPECT_TRUE(parseCount(f[12], &false_hits)) << lines[i];
-    if (method == "watertight_bvh" || method == "pipeline") {
+    if (method == "watertight_bvh" || method == "pipeline" || method == "pipeline_new_plane") {
       EXPECT_EQ(leaks, 0) << lines[i];
       EXPECT_EQ(false_hits, 0) << lines[i];
     }
     expectAgreementFields(f[13], f[14], has_robust, rays, method == "embree_robust", lines[i]);
   }
 
-  // Every method for every workload and scene that ran; every generated scene in both workloads
-  // (tb3 runs only where its data is).
+  // Every method for every workload and scene that ran, but pipeline_new_plane on planar fans only
+  // (elsewhere it is the pipeline); every generated scene in both workloads (tb3 runs only where
+  // its data is).
   for (const auto& [key, present] : ran) {
+    const bool planar = key.first == "fan2d";
     for (const std::string& m : methods) {
-      EXPECT_EQ(present.count(m), 1u) << m << " missing for " << key.first << ", " << key.second;
+      EXPECT_EQ(present.count(m), m == "pipeline_new_plane" && !planar ? 0u : 1u)
+          << m << " for " << key.first << ", " << key.second;
     }
-    EXPECT_EQ(present.size(), methods.size()) << key.first << ", " << key.second;
+    EXPECT_EQ(present.size(), methods.size() - (planar ? 0 : 1)) << key.first << ", " << key.second;
   }
   for (const std::string scene :
        {"sphere", "box_room", "million", "vertex_rows", "forest", "warehouse"}) {
@@ -221,6 +225,31 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
   }
   EXPECT_EQ(rows, (std::multiset<std::string>{"fan2d watertight_bvh", "fan2d pipeline",
                                               "rings3d watertight_bvh", "rings3d pipeline"}));
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(log);
+}
+
+// pipeline_new_plane casts the fan without kept slices: the same ranges (so the same errors and
+// agreement, field for field), and no row on the 3D workload.
+TEST(BenchSmoke, NewPlaneRowHasThePipelinesRanges) {
+  const std::string dir = tempDir("bench_new_plane");
+  const std::string log = dir + ".log";
+  const auto run = runCommand("timeout 300 " + kBench +
+                              " --quick --scene forest --method pipeline pipeline_new_plane --out " +
+                              dir + " 2>" + log);
+  ASSERT_EQ(run.status, 0) << readFile(log);
+  const auto lines = splitLines(readFile(dir + "/results.csv"));
+  // header, fan2d x 2 rows, rings3d x 1 row
+  ASSERT_EQ(lines.size(), 4u) << readFile(dir + "/results.csv");
+  const auto kept = splitFields(lines[1]), fresh = splitFields(lines[2]);
+  ASSERT_EQ(kept.size(), kFields);
+  ASSERT_EQ(fresh.size(), kFields);
+  EXPECT_EQ(kept[0] + " " + kept[2], "fan2d pipeline");
+  EXPECT_EQ(fresh[0] + " " + fresh[2], "fan2d pipeline_new_plane");
+  for (const std::size_t k : {8, 9, 10, 11, 12, 13, 14}) {  // errors and agreement
+    EXPECT_EQ(kept[k], fresh[k]) << "field " << k << ": " << lines[1] << " / " << lines[2];
+  }
+  EXPECT_EQ(splitFields(lines[3])[2], "pipeline");
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
 }
