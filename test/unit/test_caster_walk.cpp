@@ -91,6 +91,66 @@ TEST(CasterWalk, CullingThreadsAndFastPathsNeverChangeAResult) {
   EXPECT_GT(hits, beams / 3);
 }
 
+// A closed room on a slope, with a row of vertices at the sensor's height: every beam of a fan in
+// the room's level plane passes within an ulp of that row, on either side of it depending on the
+// frame the arithmetic is done in (the boxes are the body's, the triangles are tested moved into
+// the sensor's frame or cut by the plane). Every path must still hit the wall with every beam:
+// traced, sliced, rasterised, through a kept slice, and a 3D pattern with a ring in that plane.
+TEST(CasterWalk, TiltedRoomWithAVertexRowAtTheSensorHeightLeaksNowhere) {
+  core::Scene scene = sceneWithFrame();
+  const Eigen::Isometry3d room = pose(Eigen::Vector3d(40, 0, 3), rpy(0.25, -0.15, 0.6));
+  addBody(&scene, prism(circle(48, 4.0, 0.1), steps(0, 2.5, 10), true), 0, room);
+  const core::FramePoses poses = core::FramePoses::identity(scene);
+  const core::ScanPattern fan(fanBySamples(-2.35, 2.35, 1081));
+  const core::ScanPattern rings(fanBySamples(-M_PI, M_PI, 1024), {-0.02, 0.0, 0.02});
+  core::Caster kept;  // one caster for every pose: the room's plane is sliced whole and kept
+  Rng rng(53);
+  long long beams = 0;
+  for (int p = 0; p < 12; ++p) {
+    // Level in the room, exactly at the height of its third row of vertices (z = 0.5).
+    const Eigen::Isometry3d sensor =
+        room * pose(Eigen::Vector3d(uniform(rng, -2.5, 2.5), uniform(rng, -2.5, 2.5), 0.5),
+                    yaw(uniform(rng, -M_PI, M_PI)));
+    for (int variant = 0; variant < 6; ++variant) {
+      core::CastConfig c = config(true, 30.0);
+      const core::ScanPattern* pattern = &fan;
+      core::ScanResult result;
+      switch (variant) {
+        case 0:  // kept slices, cast three times (a plane is kept the second time it is met)
+          for (int k = 0; k < 3; ++k) {
+            kept.forget();
+            result = kept.cast(scene, poses, sensor, fan, c);
+          }
+          break;
+        case 1:
+          c.plane_cache = false;
+          break;
+        case 2:
+          c.planar_fast_path = false;  // every beam traced
+          break;
+        case 3:
+          c.occlusion_culling = false;
+          c.plane_cache = false;
+          break;
+        case 4:
+          pattern = &rings;
+          break;
+        default:
+          pattern = &rings;
+          c.raster_fast_path = false;
+      }
+      if (variant > 0) result = cast(scene, poses, sensor, *pattern, c);
+      for (int i = 0; i < pattern->size(); ++i) {
+        ASSERT_TRUE(result.range[i] > 0 && result.range[i] < 9.0)
+            << "pose " << p << ", variant " << variant << ", beam " << i << ": range "
+            << result.range[i];
+      }
+      beams += pattern->size();
+    }
+  }
+  EXPECT_GT(beams, 12 * 4 * 1081);
+}
+
 // The same with a scan that many threads share: every beam's answer is the one thread's.
 TEST(CasterWalk, ManyThreadsOnALargeScan) {
   Rng rng(41);

@@ -54,7 +54,8 @@ struct PlaneViews {
 // rounded once each way and shared by every beam of a walk.
 class PlaneRay : public WideSlabRay<2> {
  public:
-  // Where every beam of a walk starts (plane coordinates), and an upper bound of how far a box
+  // Where every beam of a walk starts (plane coordinates; moved by frameSlack() each way, since
+  // the segments are tested mapped to the sensor's x, y), and an upper bound of how far a box
   // coordinate of the tree is from it (for the cull limit's widening).
   struct Origin {
     float up[2], down[2];

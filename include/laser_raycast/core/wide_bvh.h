@@ -47,6 +47,17 @@ inline float floatBelow(double x) {
 }
 inline float floatAbove(double x) { return -floatBelow(-x); }
 
+// How far apart a point can be in the frame of a tree's boxes and in the frame where the walk tests
+// what the boxes hold: a traced beam's boxes are in the body's (or the plane's) coordinates, but
+// its triangles are tested moved into the sensor frame, and its direction is rotated into the
+// boxes' frame, each a few roundings at the magnitude of the coordinates (bound: the largest box
+// coordinate) and of the sensor's position there (origin). A walk's rays widen every box by this
+// much, so that the box test never drops a triangle the exact test in the other frame hits (a beam
+// within an ulp of a row of vertices: the two frames can put it on either side).
+inline double frameSlack(double bound, double origin) {
+  return 64 * std::numeric_limits<double>::epsilon() * (bound + origin);
+}
+
 class WideBvh {
  public:
   static constexpr int kWidth = 4;
@@ -193,9 +204,10 @@ class WideSlabRay {
 // A ray prepared for the wide BVH's box tests in 3D.
 class WideBoxRay : public WideSlabRay<3> {
  public:
-  // What the rays of one walk share: they start at one point (rounded once each way), and a bound
-  // on how far a box coordinate of the tree is from it, in units of t of a unit direction (for the
-  // cull limit's widening).
+  // What the rays of one walk share: they start at one point (rounded once each way, after moving
+  // it by frameSlack(), which widens every box by that much), and a bound on how far a box
+  // coordinate of the tree is from it, in units of t of a unit direction (for the cull limit's
+  // widening).
   struct Origin {
     float up[3], down[3];
     double reach;
