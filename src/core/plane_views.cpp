@@ -124,9 +124,9 @@ void PlaneViews::compute(const WideBvh::Node& node, const PlaneViewFrame& f) {
 }
 
 PlaneRay::Origin::Origin(const Eigen::Vector2d& origin, const Aabb& bounds, double tmin) {
-  const double slack = frameSlack(
-      bounds.lo.head<2>().cwiseAbs().cwiseMax(bounds.hi.head<2>().cwiseAbs()).maxCoeff(),
-      origin.cwiseAbs().maxCoeff());
+  const double slack =
+      frameSlack(bounds.lo.head<2>().cwiseAbs().cwiseMax(bounds.hi.head<2>().cwiseAbs()).maxCoeff(),
+                 origin.cwiseAbs().maxCoeff());
   for (int k = 0; k < 2; ++k) {
     up[k] = floatAbove(origin[k] + slack);
     down[k] = floatBelow(origin[k] - slack);

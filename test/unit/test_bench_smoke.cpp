@@ -234,9 +234,9 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
 TEST(BenchSmoke, NewPlaneRowHasThePipelinesRanges) {
   const std::string dir = tempDir("bench_new_plane");
   const std::string log = dir + ".log";
-  const auto run = runCommand("timeout 300 " + kBench +
-                              " --quick --scene forest --method pipeline pipeline_new_plane --out " +
-                              dir + " 2>" + log);
+  const auto run = runCommand(
+      "timeout 300 " + kBench +
+      " --quick --scene forest --method pipeline pipeline_new_plane --out " + dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
   // header, fan2d x 2 rows, rings3d x 1 row
