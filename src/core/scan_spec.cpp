@@ -13,7 +13,7 @@ void ScanSpec::validate() const {
   output.validate();
   std::ostringstream msg;
   if (elevations.empty()) {
-    msg << "elevations must not be empty";
+    msg << "elevations must not be empty (a planar scanner is [0])";
     throw std::invalid_argument(msg.str());
   }
   for (std::size_t r = 0; r < elevations.size(); ++r) {

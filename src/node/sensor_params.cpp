@@ -14,8 +14,9 @@ namespace laser_raycast {
 namespace {
 
 // The beam count comes from exactly one of angle_increment and samples; with neither, from the
-// fallback fan (a preset's, or an entry's defaults) or else kDefaultSamples. The core checks the
-// angles and the beam count. Returns the name of the parameter the beam count came from.
+// fallback fan (a preset's, or an entry's defaults) or else core::FanSpec::kDefaultSamples. The
+// core checks the angles and the beam count. Returns the name of the parameter the beam count came
+// from.
 const char* readFan(ParamReader* r, core::FanSpec* fan) {
   fan->angle_min = r->number("angle_min", fan->angle_min, "rad");
   fan->angle_max = r->number("angle_max", fan->angle_max, "rad");
@@ -31,7 +32,7 @@ const char* readFan(ParamReader* r, core::FanSpec* fan) {
     fan->samples = 0;
     r->note(r->prefix() + "samples unset (beams from " + r->prefix() + "angle_increment)");
   } else if (has_samples || fan->angle_increment == 0) {
-    const int fallback = fan->samples > 0 ? fan->samples : SensorParams::kDefaultSamples;
+    const int fallback = fan->samples > 0 ? fan->samples : core::FanSpec::kDefaultSamples;
     fan->samples = r->integer("samples", fallback, "beams");
     fan->angle_increment = 0;
     r->note(r->prefix() + "angle_increment unset (beams from " + r->prefix() + "samples)");
@@ -57,20 +58,10 @@ void failWithCoreMessage(ParamReader* r, const std::string& message, const char*
   r->fail(is_parameter ? field : beams_from, message);
 }
 
-// ~elevations: one fan per elevation (rad, any order); [0] is a planar scanner.
+// ~elevations: one fan per elevation (rad, any order); [0] is a planar scanner. Empty, non-finite,
+// out-of-range or repeated values are the core's to refuse (ScanSpec::validate, below).
 void readElevations(ParamReader* r, core::ScanSpec* scan) {
-  const bool given = r->has("elevations");
   scan->elevations = r->numberList("elevations", scan->elevations, "rad");
-  if (!given) return;
-  if (scan->elevations.empty()) {
-    r->fail("elevations", "must not be empty (a planar scanner is [0])");
-  }
-  for (std::size_t i = 0; i < scan->elevations.size(); ++i) {
-    if (!std::isfinite(scan->elevations[i])) {
-      r->fail("elevations[" + std::to_string(i) + "]",
-              "must be finite, got " + formatNumber(scan->elevations[i]));
-    }
-  }
 }
 
 // ~sensor_model: a preset's pattern, range limits and rate, before the explicit parameters.

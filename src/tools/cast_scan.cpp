@@ -32,9 +32,6 @@ namespace po = boost::program_options;
 constexpr int kExitBadArguments = 2;
 constexpr int kExitBadScene = 3;
 
-// Beams when neither --samples nor --angle-increment is given: one a degree over the full turn.
-constexpr int kDefaultSamples = 360;
-
 struct Model {
   std::string path;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -240,7 +237,7 @@ Args parseArgs(int argc, char** argv, bool* help) {
   if (args.models.empty()) throw ArgError("give at least one --urdf");
   if (!values.count("sensor")) throw ArgError("--sensor is required");
   if (has_samples && has_increment) throw ArgError("give --samples or --angle-increment, not both");
-  if (!has_samples && !has_increment) args.scan.fan.samples = kDefaultSamples;
+  if (!has_samples && !has_increment) args.scan.fan.samples = core::FanSpec::kDefaultSamples;
   // The angles, the beam count, the range limits and the elevations: checked once, by the core.
   const char* beams_from = has_samples ? "samples" : has_increment ? "angle-increment" : "";
   try {
@@ -288,7 +285,8 @@ std::string synopsis() {
   return out.str();
 }
 
-// The output, the defaults (Args': a ScanSpec's, and kDefaultSamples) and the exit statuses.
+// The output, the defaults (Args': a ScanSpec's, and core::FanSpec::kDefaultSamples) and the exit
+// statuses.
 std::string notes() {
   const Args defaults;
   const core::ScanSpec& scan = defaults.scan;
@@ -296,10 +294,11 @@ std::string notes() {
   out << "Prints CSV 'index,angle,range,link' (REP 117: inf, -inf, nan); with --elevations\n"
       << "'index,ring,elevation,angle,range,link' (ring 0 the lowest).\n"
       << "Defaults: angles " << formatAngle(scan.fan.angle_min) << ".."
-      << formatAngle(scan.fan.angle_max) << ", " << kDefaultSamples << " samples, ranges "
-      << formatNumber(scan.output.range_min) << ".." << formatNumber(scan.output.range_max)
-      << " m, geometry " << laser_raycast::toString(defaults.geometry) << ", method "
-      << core::toString(scan.method) << ",\n"
+      << formatAngle(scan.fan.angle_max) << ", " << core::FanSpec::kDefaultSamples
+      << " samples, ranges " << formatNumber(scan.output.range_min) << ".."
+      << formatNumber(scan.output.range_max) << " m, geometry "
+      << laser_raycast::toString(defaults.geometry) << ", method " << core::toString(scan.method)
+      << ",\n"
       << defaults.threads << (defaults.threads == 1 ? " thread" : " threads") << ".\n"
       << "Poses in metres and radians (URDF rpy). Exit status: 0 ok, 2 bad arguments, 3 bad scene\n"
       << "input.\n";
@@ -358,7 +357,9 @@ LoadedScene loadScene(const Args& args) {
   return out;
 }
 
-// Casts the scan `repeat` more times, each from scratch, and prints the median time to stderr.
+// Casts the scan `repeat` more times and prints the median time to stderr. Each cast is computed
+// anew (forget(): not the previous scan's result), as the node casts scan after scan: a planar
+// fan's kept slices of its plane (plane_slice.h) serve the casts after the first two.
 void reportMedianCastTime(const Args& args, const LoadedScene& loaded,
                           const core::ScanPattern& pattern, const core::CastConfig& config,
                           core::Caster& caster) {

@@ -16,6 +16,9 @@ namespace core {
 // - samples: N = samples beams from angle_min to angle_max inclusive, spaced by (max - min) / (N -
 // 1).
 struct FanSpec {
+  // The beams the node and cast_scan use when neither samples nor angle_increment is given: one a
+  // degree over the full turn.
+  static constexpr int kDefaultSamples = 360;
   double angle_min = -M_PI;    // rad, first beam, counter-clockwise from x about z
   double angle_max = M_PI;     // rad, > angle_min
   double angle_increment = 0;  // rad, > 0; or 0 to derive it from samples

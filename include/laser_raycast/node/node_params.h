@@ -48,8 +48,6 @@ inline const core::EnumNames<Sweep, 2> kSweepNames{{{
 // the private namespace describe one (the shorthand); each entry of ~sensors describes one, with
 // those as its defaults.
 struct SensorParams {
-  // Beams when neither ~samples nor ~angle_increment is set: one a degree over the full turn.
-  static constexpr int kDefaultSamples = 360;
   // ~rate above this is taken for a slip (a value meant in another unit) rather than served: it is
   // ten times the fastest real planar scanners (about 100 Hz), and at 1 kHz the cast thread has 1
   // ms a scan for the TF look-ups, the cast and publishing.
@@ -65,7 +63,7 @@ struct SensorParams {
   std::string sensor_model;        // a preset (core::kSensorModelNames), "" for none
   std::string frame_id = "laser";  // sensor frame; header.frame_id of the scans
   // Beams, range limits, min-range policy, noise, intensity, triangle test. fan.samples is 0 here:
-  // the parser sets kDefaultSamples when neither it nor angle_increment is given.
+  // the parser sets core::FanSpec::kDefaultSamples when neither it nor angle_increment is given.
   core::ScanSpec scan;
   double rate = 10.0;  // Hz, in (0, kMaxRate]
   Sweep sweep = Sweep::kInstant;
