@@ -136,13 +136,7 @@ class MeshWalk {
         }
       });
     }
-    // Farthest first onto the stack, so that the nearest is walked next (insertion sort: n <= 12).
-    for (int j = 1; j < n; ++j) {
-      const Entry moving = children[j];
-      int i = j;
-      for (; i > 0 && children[i - 1].near < moving.near; --i) children[i] = children[i - 1];
-      children[i] = moving;
-    }
+    sortFarthestFirst(children, n);
     for (int j = 0; j < n; ++j) push(children[j]);
   }
 

@@ -123,21 +123,5 @@ void PlaneViews::compute(const WideBvh::Node& node, const PlaneViewFrame& f) {
   _mm_store_si128(reinterpret_cast<__m128i*>(col_hi), _mm_cvttps_epi32(hi_c));
 }
 
-PlaneRay::Origin::Origin(const Eigen::Vector2d& origin, const Aabb& bounds, double tmin) {
-  const double slack =
-      frameSlack(bounds.lo.head<2>().cwiseAbs().cwiseMax(bounds.hi.head<2>().cwiseAbs()).maxCoeff(),
-                 origin.cwiseAbs().maxCoeff());
-  for (int k = 0; k < 2; ++k) {
-    up[k] = floatAbove(origin[k] + slack);
-    down[k] = floatBelow(origin[k] - slack);
-  }
-  const Eigen::Vector2d far =
-      (bounds.lo.head<2>() - origin).cwiseAbs().cwiseMax((bounds.hi.head<2>() - origin).cwiseAbs());
-  // In units of t for a direction whose largest component is at least 1/sqrt(2) (a unit vector in
-  // 2D): twice the largest coordinate distance bounds it.
-  reach = 2 * far.maxCoeff();
-  tnear0 = floatBelow(tmin - (std::abs(tmin) + reach) * PlaneRay::kWiden);
-}
-
 }  // namespace core
 }  // namespace laser_raycast

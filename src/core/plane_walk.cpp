@@ -7,6 +7,7 @@
 
 #include "laser_raycast/core/plane_views.h"
 #include "laser_raycast/core/primitive_cast.h"
+#include "laser_raycast/core/scene_walk.h"
 
 namespace laser_raycast {
 namespace core {
@@ -106,13 +107,7 @@ class SliceWalk {
         beams_.forEachColumnRange(views.az_center[k], views.az_half[k], add);
       }
     }
-    // Farthest first onto the stack, so that the nearest is walked next (insertion sort: n <= 12).
-    for (int j = 1; j < n; ++j) {
-      const Entry moving = children[j];
-      int i = j;
-      for (; i > 0 && children[i - 1].near < moving.near; --i) children[i] = children[i - 1];
-      children[i] = moving;
-    }
+    sortFarthestFirst(children, n);
     stack_.insert(stack_.end(), children, children + n);
   }
 
@@ -156,21 +151,13 @@ class SliceWalk {
         });
   }
 
-  // A primitive: its pose, culled as the scene walk culls it, then cast over the rect, or after the
-  // walk if it is large for its distance (a wall the sensor stands beside: nearest first would
-  // test it with every beam before the nearer things in front of it).
+  // A primitive: its pose, culled by its box's view as the scene walk culls it, then cast over the
+  // rect, or after the walk if it is large for its distance (a wall the sensor stands beside:
+  // nearest first would test it with every beam before the nearer things in front of it).
   void castPrimitiveItem(int index, const BeamRect& rect) {
-    Caster::ActiveBody a;
-    a.index = index;
-    a.sensor_from_body = sensorFromBody(index);
-    a.center = a.sensor_from_body * scene_.sphereCenter(index);
-    a.radius = scene_.sphereRadius(index);
-    const Eigen::Matrix3d& rot = a.sensor_from_body.linear();
-    a.view = boxView(scene_.boxCenter(index), scene_.boxHalf(index), rot, rot.cwiseAbs(),
-                     a.sensor_from_body.translation(), beams_.pattern().angleMin(), false);
+    Caster::ActiveBody a = activeBody(scene_, index, sensor_from_frame_);
+    viewActiveBody(scene_, beams_.pattern().angleMin(), false, &a);
     if (!(a.view.near <= config_.tmax) || !a.view.crosses) return;
-    a.body_from_sensor_rot = rot.transpose();
-    a.sensor_in_body = -(a.body_from_sensor_rot * a.sensor_from_body.translation());
     beams_.forEachRect(a.view, rect, [&](const BeamRect& r) {
       if (deferLargePrimitive(a)) {
         deferred_.emplace_back(a, r);

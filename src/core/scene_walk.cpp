@@ -100,25 +100,16 @@ class GroupWalk {
   // the search interval and by its box's view against the scan plane (planar fans) and the leaf's
   // beams; the rest waits its turn by its own nearest distance.
   void placeBody(int index, const BeamRect& rect) {
-    const Body& body = scene_.bodies()[index];
-    Caster::ActiveBody a;
-    a.index = index;
-    a.sensor_from_body = sensor_from_frame_ * body.frame_from_body;
     // The sphere first: a cheap answer for bodies out of range.
-    a.center = a.sensor_from_body * scene_.sphereCenter(index);
-    a.radius = scene_.sphereRadius(index);
+    Caster::ActiveBody a = activeBody(scene_, index, sensor_from_frame_);
     const double dist = a.center.norm();
     const double slack = kWindowSlack * (dist + a.radius + config_.tmax);
     if (dist - a.radius > config_.tmax + slack || dist + a.radius < config_.tmin - slack) return;
-    const Eigen::Matrix3d& rot = a.sensor_from_body.linear();
-    a.view = boxView(scene_.boxCenter(index), scene_.boxHalf(index), rot, rot.cwiseAbs(),
-                     a.sensor_from_body.translation(), beams_.pattern().angleMin(), !planar_);
+    viewActiveBody(scene_, beams_.pattern().angleMin(), !planar_, &a);
     if (!(a.view.near <= config_.tmax) || (planar_ && !a.view.crosses)) return;
-    a.body_from_sensor_rot = rot.transpose();
-    a.sensor_in_body = -(a.body_from_sensor_rot * a.sensor_from_body.translation());
     if (plane_) {
       a.plane = &*plane_;
-      a.frame_from_body = body.frame_from_body;
+      a.frame_from_body = scene_.bodies()[index].frame_from_body;
     }
     const int slot = static_cast<int>(bodies_.size());
     bodies_.push_back(a);
@@ -149,6 +140,24 @@ class GroupWalk {
 };
 
 }  // namespace
+
+Caster::ActiveBody activeBody(const Scene& scene, int index,
+                              const Eigen::Isometry3d& sensor_from_frame) {
+  Caster::ActiveBody a;
+  a.index = index;
+  a.sensor_from_body = sensor_from_frame * scene.bodies()[index].frame_from_body;
+  a.center = a.sensor_from_body * scene.sphereCenter(index);
+  a.radius = scene.sphereRadius(index);
+  return a;
+}
+
+void viewActiveBody(const Scene& scene, double angle_min, bool elevations, Caster::ActiveBody* a) {
+  const Eigen::Matrix3d& rot = a->sensor_from_body.linear();
+  a->view = boxView(scene.boxCenter(a->index), scene.boxHalf(a->index), rot, rot.cwiseAbs(),
+                    a->sensor_from_body.translation(), angle_min, elevations);
+  a->body_from_sensor_rot = rot.transpose();
+  a->sensor_in_body = -(a->body_from_sensor_rot * a->sensor_from_body.translation());
+}
 
 void castGroup(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,

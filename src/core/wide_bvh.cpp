@@ -186,19 +186,6 @@ WideBoxRay::WideBoxRay(const Ray& ray, const Aabb& bounds) {
   }
 }
 
-WideBoxRay::Origin::Origin(const Eigen::Vector3d& origin, const Aabb& bounds, double tmin) {
-  const double slack = frameSlack(bounds.lo.cwiseAbs().cwiseMax(bounds.hi.cwiseAbs()).maxCoeff(),
-                                  origin.cwiseAbs().maxCoeff());
-  for (int k = 0; k < 3; ++k) {
-    up[k] = floatAbove(origin[k] + slack);
-    down[k] = floatBelow(origin[k] - slack);
-  }
-  // A unit direction's largest component is at least 1/sqrt(3): twice the largest coordinate
-  // distance bounds the reach of every direction.
-  reach = 2 * (bounds.lo - origin).cwiseAbs().cwiseMax((bounds.hi - origin).cwiseAbs()).maxCoeff();
-  tnear0 = floatBelow(tmin - (std::abs(tmin) + reach) * kWiden);
-}
-
 // The four-wide test's arithmetic on one box.
 bool WideBoxRay::enters(const float lo[3], const float hi[3], float cull) const {
   constexpr std::uint32_t kLo = offsetof(WideBvh::Node, lo);

@@ -197,9 +197,8 @@ void runWorkload(const Settings& settings, int poses, const BenchScene& scene,
   // Every row's distances (and the unpaired rows' times), in order.
   const std::size_t first = rows->size();
   std::vector<Measured> measured;
-  const bool planar = workload.elevations.size() == 1 && workload.elevations[0] == 0.0;
   for (const Method& method : methods.rows) {
-    if (method.planar_only && !planar) continue;
+    if (method.planar_only && !rays.pattern->planar()) continue;
     const std::vector<int>& used = method.brute ? subset : all;
     std::vector<double> dist = unknown();
     Measured m{&method, &used, 0, {}, {}};

@@ -54,21 +54,9 @@ struct PlaneViews {
 // rounded once each way and shared by every beam of a walk.
 class PlaneRay : public WideSlabRay<2> {
  public:
-  // Where every beam of a walk starts (plane coordinates; moved by frameSlack() each way, since
-  // the segments are tested mapped to the sensor's x, y), and an upper bound of how far a box
-  // coordinate of the tree is from it (for the cull limit's widening).
-  struct Origin {
-    float up[2], down[2];
-    double reach;
-    float tnear0;  // the rays' tmin, widened as the cull limit is
-    Origin(const Eigen::Vector2d& origin, const Aabb& bounds, double tmin);
-  };
-
-  PlaneRay(const Origin& origin, const Eigen::Vector2d& dir) {
-    reach_ = origin.reach;
-    tnear0_ = origin.tnear0;
-    for (int k = 0; k < 2; ++k) setAxis(k, dir[k], origin.up[k], origin.down[k]);
-  }
+  // Origin: plane coordinates, moved by frameSlack() each way, since the segments are tested
+  // mapped to the sensor's x, y.
+  using WideSlabRay<2>::WideSlabRay;
 };
 
 }  // namespace core

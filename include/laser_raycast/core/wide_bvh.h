@@ -144,6 +144,38 @@ class WideBvh {
 template <int kAxes>
 class WideSlabRay {
  public:
+  using Vector = Eigen::Matrix<double, kAxes, 1>;
+  // What the rays of one walk share: they start at one point (rounded once each way, after moving
+  // it by frameSlack(), which widens every box by that much), and a bound on how far a box
+  // coordinate of the tree is from it, in units of t of a unit direction (for the cull limit's
+  // widening). bounds: the tree's box (its first kAxes coordinates are the tree's).
+  struct Origin {
+    float up[kAxes], down[kAxes];
+    double reach;
+    float tnear0;  // the rays' tmin, widened as the cull limit is
+    Origin(const Vector& origin, const Aabb& bounds, double tmin) {
+      const Vector lo = bounds.lo.template head<kAxes>(), hi = bounds.hi.template head<kAxes>();
+      const double slack = frameSlack(lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).maxCoeff(),
+                                      origin.cwiseAbs().maxCoeff());
+      for (int k = 0; k < kAxes; ++k) {
+        up[k] = floatAbove(origin[k] + slack);
+        down[k] = floatBelow(origin[k] - slack);
+      }
+      // A unit direction's largest component is at least 1/sqrt(kAxes) >= 1/2: twice the largest
+      // coordinate distance bounds the reach of every direction.
+      reach = 2 * (lo - origin).cwiseAbs().cwiseMax((hi - origin).cwiseAbs()).maxCoeff();
+      tnear0 = floatBelow(tmin - (std::abs(tmin) + reach) * kWiden);
+    }
+  };
+
+  WideSlabRay() = default;
+  // A unit direction from a walk's origin.
+  WideSlabRay(const Origin& origin, const Vector& dir) {
+    reach_ = origin.reach;
+    tnear0_ = origin.tnear0;
+    for (int k = 0; k < kAxes; ++k) setAxis(k, dir[k], origin.up[k], origin.down[k]);
+  }
+
   // The box cull limit for a far limit tmax: widened as BvhT::traverse does (a hit's t and its
   // box's entry and exit round differently).
   float cullLimit(double tmax) const {
@@ -204,30 +236,26 @@ class WideSlabRay {
 // A ray prepared for the wide BVH's box tests in 3D.
 class WideBoxRay : public WideSlabRay<3> {
  public:
-  // What the rays of one walk share: they start at one point (rounded once each way, after moving
-  // it by frameSlack(), which widens every box by that much), and a bound on how far a box
-  // coordinate of the tree is from it, in units of t of a unit direction (for the cull limit's
-  // widening).
-  struct Origin {
-    float up[3], down[3];
-    double reach;
-    float tnear0;  // the rays' tmin, widened as the cull limit is
-    Origin(const Eigen::Vector3d& origin, const Aabb& bounds, double tmin);
-  };
-
   WideBoxRay() = default;
+  using WideSlabRay<3>::WideSlabRay;  // from a walk's Origin
   // bounds: the box of everything the ray will be tested against (a mesh's), for the reach.
   WideBoxRay(const Ray& ray, const Aabb& bounds);
-  // A unit direction from a walk's origin.
-  WideBoxRay(const Origin& origin, const Eigen::Vector3d& dir) {
-    reach_ = origin.reach;
-    tnear0_ = origin.tnear0;
-    for (int k = 0; k < 3; ++k) setAxis(k, dir[k], origin.up[k], origin.down[k]);
-  }
 
   // The same test for one box given by its float corners.
   bool enters(const float lo[3], const float hi[3], float cull) const;
 };
+
+// Orders a node's children (entries with a `near` distance) farthest first, so that pushed onto a
+// stack in this order the nearest is walked next. Insertion sort: a walk has at most a dozen.
+template <class Entry>
+void sortFarthestFirst(Entry* entries, int n) {
+  for (int j = 1; j < n; ++j) {
+    const Entry moving = entries[j];
+    int i = j;
+    for (; i > 0 && entries[i - 1].near < moving.near; --i) entries[i] = entries[i - 1];
+    entries[i] = moving;
+  }
+}
 
 // Walks the subtree `start` for one ray, nearest box first, and calls leaf(slot) for every triangle
 // slot of each leaf the ray enters before the cull limit of *tmax. leaf may lower *tmax (an
