@@ -24,42 +24,43 @@ void OcclusionTiles::reset(int rows, int cols, float start) {
   padded_cols_ = fine_cols_ * kFineWidth;
   coarse_rows_ = (rows + kCoarseRings - 1) / kCoarseRings;
   coarse_cols_ = (cols + kCoarseWidth - 1) / kCoarseWidth;
-  range_.assign(static_cast<std::size_t>(rows_) * padded_cols_, 0.0f);
-  for (int r = 0; r < rows_; ++r) {
-    std::fill_n(range_.begin() + static_cast<std::size_t>(r) * padded_cols_, cols_, start);
-  }
-  fine_max_.assign(static_cast<std::size_t>(rows_) * fine_cols_, start);
-  fine_stale_.assign(fine_max_.size(), 0);
-  coarse_max_.assign(static_cast<std::size_t>(coarse_rows_) * coarse_cols_, start);
-  coarse_stale_.assign(coarse_max_.size(), 0);
+  range_.assign(static_cast<std::size_t>(rows_) * fine_cols_, FineTile{});
+  for (int r = 0; r < rows_; ++r)
+    std::fill_n(ranges() + static_cast<std::size_t>(r) * padded_cols_, cols_, start);
+  Block fresh;
+  std::fill_n(fresh.fine_max, kFinePerBlock, start);
+  std::fill_n(fresh.fine_stale, kFinePerBlock, 0);
+  fresh.coarse_max = start;
+  fresh.coarse_stale = 0;
+  blocks_.assign(static_cast<std::size_t>(coarse_rows_) * coarse_cols_, fresh);
 }
 
 float OcclusionTiles::fineMax(int row, int tile) const {
-  const std::size_t i = static_cast<std::size_t>(row) * fine_cols_ + tile;
-  if (fine_stale_[i]) {
-    const float* t = &range_[static_cast<std::size_t>(row) * padded_cols_ + tile * kFineWidth];
+  Block& b = block(row, tile);
+  const int i = fineSlot(row, tile);
+  if (b.fine_stale[i]) {
+    const float* t = this->row(row) + tile * kFineWidth;
     const __m128 m = _mm_max_ps(_mm_max_ps(_mm_loadu_ps(t), _mm_loadu_ps(t + 4)),
                                 _mm_max_ps(_mm_loadu_ps(t + 8), _mm_loadu_ps(t + 12)));
-    fine_max_[i] = maxOf(m);
-    fine_stale_[i] = 0;
+    b.fine_max[i] = maxOf(m);
+    b.fine_stale[i] = 0;
   }
-  return fine_max_[i];
+  return b.fine_max[i];
 }
 
 float OcclusionTiles::coarseMax(int tile_row, int tile) const {
-  const std::size_t i = static_cast<std::size_t>(tile_row) * coarse_cols_ + tile;
-  if (coarse_stale_[i]) {
+  Block& b = block(tile_row * kCoarseRings, tile * kFinePerCoarse);
+  if (b.coarse_stale) {
     float m = 0;
     const int row_end = std::min(rows_, (tile_row + 1) * kCoarseRings);
-    const int fine_per_coarse = kCoarseWidth / kFineWidth;
-    const int fine_end = std::min(fine_cols_, (tile + 1) * fine_per_coarse);
+    const int fine_end = std::min(fine_cols_, (tile + 1) * kFinePerCoarse);
     for (int row = tile_row * kCoarseRings; row < row_end; ++row) {
-      for (int k = tile * fine_per_coarse; k < fine_end; ++k) m = std::max(m, fineMax(row, k));
+      for (int k = tile * kFinePerCoarse; k < fine_end; ++k) m = std::max(m, fineMax(row, k));
     }
-    coarse_max_[i] = m;
-    coarse_stale_[i] = 0;
+    b.coarse_max = m;
+    b.coarse_stale = 0;
   }
-  return coarse_max_[i];
+  return b.coarse_max;
 }
 
 bool OcclusionTiles::anyOpenInRows(const BeamRect& rect, float near) const {

@@ -7,7 +7,9 @@
 //
 // Ranges only ever decrease while a scan is cast, so a stale maximum is still an upper bound: a hit
 // only marks its tiles stale, and a read refreshes the stale tiles it reads. Threads that cast
-// separate pieces of the columns (whole coarse tiles each) never share a tile.
+// separate pieces of the scan (whole coarse tiles each) never share a tile, nor a cache line of
+// the tiles' bookkeeping: each coarse tile keeps its own and its fine tiles' in one block of whole
+// cache lines (written by two cores, one shared line would bounce between them on every hit).
 #pragma once
 
 #include <emmintrin.h>
@@ -37,12 +39,13 @@ class OcclusionTiles {
   // rows x cols beams, every range `start` (the farthest hit a beam can keep: tmax, rounded up).
   void reset(int rows, int cols, float start);
   // The ranges of one row, padded to whole fine tiles (the padding holds 0: never open).
-  const float* row(int r) const { return &range_[static_cast<std::size_t>(r) * padded_cols_]; }
+  const float* row(int r) const { return ranges() + static_cast<std::size_t>(r) * padded_cols_; }
   // The beam at (row, col) hit something at `range` (rounded up), nearer than before.
   void lower(int row, int col, float range) {
-    range_[static_cast<std::size_t>(row) * padded_cols_ + col] = range;
-    fine_stale_[static_cast<std::size_t>(row) * fine_cols_ + col / kFineWidth] = 1;
-    coarse_stale_[(row / kCoarseRings) * coarse_cols_ + col / kCoarseWidth] = 1;
+    ranges()[static_cast<std::size_t>(row) * padded_cols_ + col] = range;
+    Block& b = block(row, col / kFineWidth);
+    b.fine_stale[fineSlot(row, col / kFineWidth)] = 1;
+    b.coarse_stale = 1;
   }
   // False only if every beam in rect has a range below `near` (so nothing at distance >= near can
   // be seen through rect). May answer true when that holds too (a coarse tile overlaps the rect's
@@ -59,13 +62,13 @@ class OcclusionTiles {
   float fineMax(int row, int tile) const;
   bool anyOpenInRows(const BeamRect& rect, float near) const;
   // Beams first..last of a row, four at a time, against near; whole fine tiles by their maximum.
-  bool anyOpenInRow(int row, int first, int last, float near) const {
-    const float* r = &range_[static_cast<std::size_t>(row) * padded_cols_];
+  bool anyOpenInRow(int row_index, int first, int last, float near) const {
+    const float* r = row(row_index);
     const int t_lo = first / kFineWidth, t_hi = last / kFineWidth;
     if (t_lo != t_hi) {
       if (chunkOpen(r, first, t_lo * kFineWidth + kFineWidth - 1, near)) return true;
       for (int t = t_lo + 1; t < t_hi; ++t) {
-        if (!(fineMax(row, t) < near)) return true;  // written so that NaN counts as open
+        if (!(fineMax(row_index, t) < near)) return true;  // written so that NaN counts as open
       }
       first = t_hi * kFineWidth;
     }
@@ -85,11 +88,35 @@ class OcclusionTiles {
     return open != 0;
   }
 
+  static constexpr int kFinePerCoarse = kCoarseWidth / kFineWidth;
+  static constexpr int kFinePerBlock = kCoarseRings * kFinePerCoarse;
+  // A coarse tile's bookkeeping and its fine tiles' (row-major within the tile), in whole cache
+  // lines. The maxima are refreshed when read (a query that reads a stale tile writes it).
+  struct alignas(64) Block {
+    float fine_max[kFinePerBlock];
+    char fine_stale[kFinePerBlock];
+    float coarse_max;
+    char coarse_stale;
+  };
+  Block& block(int row, int fine_tile) const {
+    return blocks_[static_cast<std::size_t>(row / kCoarseRings) * coarse_cols_ +
+                   fine_tile / kFinePerCoarse];
+  }
+  static int fineSlot(int row, int fine_tile) {
+    return (row % kCoarseRings) * kFinePerCoarse + fine_tile % kFinePerCoarse;
+  }
+
+  // The ranges, rows_ x padded_cols_, a row in whole fine tiles of one cache line each.
+  struct alignas(64) FineTile {
+    float range[kFineWidth];
+  };
+  static_assert(sizeof(FineTile) == kFineWidth * sizeof(float), "a fine tile is one cache line");
+  float* ranges() { return range_.data()->range; }
+  const float* ranges() const { return range_.data()->range; }
+
   int rows_ = 0, cols_ = 0, padded_cols_ = 0, fine_cols_ = 0, coarse_rows_ = 0, coarse_cols_ = 0;
-  std::vector<float> range_;  // rows_ x padded_cols_
-  // The tiles' maxima, refreshed when read (a query that reads a stale tile writes it: mutable).
-  mutable std::vector<float> fine_max_, coarse_max_;
-  mutable std::vector<char> fine_stale_, coarse_stale_;
+  std::vector<FineTile> range_;
+  mutable std::vector<Block> blocks_;  // coarse_rows_ x coarse_cols_
 };
 
 }  // namespace core
