@@ -105,6 +105,12 @@ void BeamSet::prepareRows() {
     row_sin_.push_back(static_cast<float>(std::sin(e)));
     smallest_row_cos_ = std::min(smallest_row_cos_, row_cos_.back());
   }
+  row_tan_below_.clear();
+  row_tan_above_.clear();
+  for (const double t : tangents) {
+    row_tan_below_.push_back(floatBelow(t));
+    row_tan_above_.push_back(floatAbove(t));
+  }
   row_elevation_.build(std::move(elevations));
   row_tan_.build(std::move(tangents));
   column_cos_.assign(padded_cols_, 0.0f);

@@ -277,6 +277,45 @@ TEST(ColumnRaster, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
   }
 }
 
+// A rect of the grid gets the candidates the whole grid gets inside it, no more and no fewer: the
+// raster skips the columns whose bounds miss the rect's rows before it looks rows up, and that
+// must change nothing.
+TEST(ColumnRaster, ARectGetsTheWholeGridsCandidatesInsideIt) {
+  Rng rng(53);
+  std::vector<double> rings;
+  for (int r = 0; r < 64; ++r) rings.push_back(-0.26 + 0.52 * r / 63);
+  const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 256), rings);
+  core::CastConfig config;
+  config.tmax = 25;
+  FreshBeams fresh(pattern, config);
+  core::BeamSet& beams = fresh.beams;
+  setRandomRanges(rng, &beams);
+  long long inside = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const FilterCase t = randomTriangle(rng);
+    const core::ColumnRaster raster(beams, t.a, t.b, t.c);
+    std::set<int> whole, part;
+    core::BeamRect rect;
+    rect.row_lo = static_cast<int>(uniform(rng, 0, beams.rows()));
+    rect.row_hi = std::min(beams.rows() - 1, rect.row_lo + static_cast<int>(uniform(rng, 0, 12)));
+    rect.col_lo = static_cast<int>(uniform(rng, 0, beams.cols()));
+    rect.col_hi = std::min(beams.cols() - 1, rect.col_lo + static_cast<int>(uniform(rng, 0, 40)));
+    raster.forEachCandidate(beams, beams.all(), [&](int row, int col) {
+      if (row >= rect.row_lo && row <= rect.row_hi && col >= rect.col_lo && col <= rect.col_hi) {
+        whole.insert(beams.beam(row, col));
+      }
+    });
+    raster.forEachCandidate(beams, rect, [&](int row, int col) {
+      EXPECT_TRUE(row >= rect.row_lo && row <= rect.row_hi && col >= rect.col_lo &&
+                  col <= rect.col_hi);
+      part.insert(beams.beam(row, col));
+    });
+    ASSERT_EQ(whole, part) << "triangle " << i;
+    inside += static_cast<long long>(part.size());
+  }
+  EXPECT_GT(inside, 1000);
+}
+
 TEST(OcclusionTiles, AWindowWithAnOpenBeamIsNeverClosed) {
   Rng rng(31);
   for (const int rows : {1, 5, 17}) {

@@ -137,6 +137,9 @@ class BeamSet {
   float rowCos(int row) const { return row_cos_[row]; }
   float rowSin(int row) const { return row_sin_[row]; }
   float smallestRowCos() const { return smallest_row_cos_; }
+  // A row's tan of the elevation rounded to float down and up.
+  float rowTanBelow(int row) const { return row_tan_below_[row]; }
+  float rowTanAbove(int row) const { return row_tan_above_[row]; }
   void rowsWithTan(double lo, double hi, int* row_lo, int* row_hi) const {
     row_tan_.find(lo, hi, row_lo, row_hi);
   }
@@ -193,7 +196,7 @@ class BeamSet {
   std::vector<int> beam_of_row_;      // the ring of each row
   RowTable row_elevation_, row_tan_;  // of the rows, ascending
   bool column_raster_ = false;
-  std::vector<float> column_cos_, column_sin_, row_cos_, row_sin_;
+  std::vector<float> column_cos_, column_sin_, row_cos_, row_sin_, row_tan_below_, row_tan_above_;
   float smallest_row_cos_ = 1;
   // Columns: the fan's start, increment and the index pad for rounding; one_turn_: the fan spans
   // at most a turn, so forEachColumnRange needs at most the turns before and after.

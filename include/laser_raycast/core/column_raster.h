@@ -62,6 +62,8 @@ void ColumnRaster::forEachCandidate(const BeamSet& beams, const BeamRect& rect, 
   const float* cos_a = beams.columnCos();
   const float* sin_a = beams.columnSin();
   const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  const __m128 rows_tan_lo = _mm_set1_ps(beams.rowTanBelow(rect.row_lo));
+  const __m128 rows_tan_hi = _mm_set1_ps(beams.rowTanAbove(rect.row_hi));
   for (int base = rect.col_lo & ~3; base <= rect.col_hi; base += 4) {
     const __m128 ca = _mm_loadu_ps(cos_a + base), sa = _mm_loadu_ps(sin_a + base);
     __m128 lo = _mm_sub_ps(_mm_setzero_ps(), inf), hi = inf;
@@ -77,14 +79,21 @@ void ColumnRaster::forEachCandidate(const BeamSet& beams, const BeamRect& rect, 
           _mm_and_ps(flat_[k], _mm_cmplt_ps(h, _mm_sub_ps(_mm_setzero_ps(), edge_margin_)));
       lo = _mm_or_ps(_mm_and_ps(out, inf), _mm_andnot_ps(out, lo));
     }
+    // The columns whose bounds meet the rect's rows' (float bounds on their tan E): only those
+    // need the rows looked up.
+    int mask = _mm_movemask_ps(
+        _mm_and_ps(_mm_cmple_ps(lo, hi),
+                   _mm_and_ps(_mm_cmpnlt_ps(rows_tan_hi, lo), _mm_cmpnlt_ps(hi, rows_tan_lo))));
+    const int first = std::max(base, rect.col_lo), last = std::min(base + 3, rect.col_hi);
+    mask &= (0xF << (first - base)) & (0xF >> (base + 3 - last));
+    if (!mask) continue;
     alignas(16) float lo_v[4], hi_v[4], hn_v[4];
     _mm_store_ps(lo_v, lo);
     _mm_store_ps(hi_v, hi);
     _mm_store_ps(hn_v, _mm_add_ps(_mm_mul_ps(nx_, ca), _mm_mul_ps(ny_, sa)));
-    const int first = std::max(base, rect.col_lo), last = std::min(base + 3, rect.col_hi);
-    for (int col = first; col <= last; ++col) {
-      const int j = col - base;
-      if (!(lo_v[j] <= hi_v[j])) continue;
+    for (; mask; mask &= mask - 1) {
+      const int j = __builtin_ctz(static_cast<unsigned>(mask));
+      const int col = base + j;
       int row_lo, row_hi;
       beams.rowsWithTan(lo_v[j], hi_v[j], &row_lo, &row_hi);
       row_lo = std::max(row_lo, rect.row_lo);
