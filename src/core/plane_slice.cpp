@@ -80,6 +80,11 @@ std::unique_ptr<PlaneSlice> PlaneSlice::build(const Scene& scene, const SceneInd
   }
   slice->tree = Bvh::buildOverBoxes(boxes);
   slice->wide = WideBvh(slice->tree, {});
+  // The items in the tree's slot order: a leaf's are side by side, with no look-up in between.
+  std::vector<Item> by_slot;
+  by_slot.reserve(slice->items.size());
+  for (const std::uint32_t id : slice->tree.triangleIds()) by_slot.push_back(slice->items[id]);
+  slice->items = std::move(by_slot);
   return slice;
 }
 

@@ -75,7 +75,7 @@ class SliceWalk {
       if (!beams_.anyOpen(e.rect, e.near)) continue;  // hidden behind nearer hits
       if (e.ref.isLeaf()) {
         for (std::uint32_t i = e.ref.index; i < e.ref.index + e.ref.count; ++i) {
-          testItem(slice_.items[slice_.tree.triangleIds()[i]], e.rect, e.near);
+          testItem(slice_.items[i], e.rect, e.near);
         }
       } else if (e.rect.beams() <= kTraceBeams) {
         traceRect(e);
@@ -180,7 +180,6 @@ class SliceWalk {
   // Each open beam of the rect through the node's subtree, one ray at a time: box tests in plane
   // coordinates, each item tested as testItem tests it.
   void traceRect(const Entry& e) {
-    const auto& ids = slice_.tree.triangleIds();
     const auto& dirs = beams_.pattern().directions();
     for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
       const double range = beams_.range(0, col);
@@ -191,7 +190,7 @@ class SliceWalk {
       const double dx = dirs[col].x(), dy = dirs[col].y();
       const PlaneRay ray(*origin_, inverse_ * Eigen::Vector2d(dx, dy));
       traceWide(slice_.wide, e.ref, ray, &tmax, [&](std::uint32_t i) {
-        const PlaneSlice::Item& item = slice_.items[ids[i]];
+        const PlaneSlice::Item& item = slice_.items[i];
         (*cast_)[item.body].store(1, std::memory_order_relaxed);
         if (item.slot == PlaneSlice::kPrimitive) {
           castPrimitiveItem(item.body, BeamRect{0, 0, col, col});

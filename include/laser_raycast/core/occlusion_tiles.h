@@ -51,7 +51,9 @@ class OcclusionTiles {
   // be seen through rect). May answer true when that holds too (a coarse tile overlaps the rect's
   // border), never false when some beam is at near or farther.
   bool anyOpen(const BeamRect& rect, float near) const {
-    if (rect.row_lo == rect.row_hi && rect.col_hi - rect.col_lo < kFineWidth) {
+    // A narrow window of one row, or any window of a one-row scan (a planar fan: its coarse tiles
+    // are the row's own, so a window of it is read through them, exactly).
+    if (rect.row_lo == rect.row_hi && (rect.col_hi - rect.col_lo < kFineWidth || rows_ == 1)) {
       return !rect.empty() && anyOpenInRow(rect.row_lo, rect.col_lo, rect.col_hi, near);
     }
     return anyOpenInRows(rect, near);
@@ -61,14 +63,22 @@ class OcclusionTiles {
   float coarseMax(int tile_row, int tile) const;
   float fineMax(int row, int tile) const;
   bool anyOpenInRows(const BeamRect& rect, float near) const;
-  // Beams first..last of a row, four at a time, against near; whole fine tiles by their maximum.
+  // Beams first..last of a row, four at a time, against near; whole fine tiles by their maximum,
+  // and in a one-row scan whole coarse tiles by theirs.
   bool anyOpenInRow(int row_index, int first, int last, float near) const {
     const float* r = row(row_index);
     const int t_lo = first / kFineWidth, t_hi = last / kFineWidth;
     if (t_lo != t_hi) {
       if (chunkOpen(r, first, t_lo * kFineWidth + kFineWidth - 1, near)) return true;
-      for (int t = t_lo + 1; t < t_hi; ++t) {
-        if (!(fineMax(row_index, t) < near)) return true;  // written so that NaN counts as open
+      for (int t = t_lo + 1; t < t_hi;) {
+        // Written so that NaN counts as open.
+        if (rows_ == 1 && t % kFinePerCoarse == 0 && t + kFinePerCoarse <= t_hi) {
+          if (!(coarseMax(0, t / kFinePerCoarse) < near)) return true;
+          t += kFinePerCoarse;
+        } else {
+          if (!(fineMax(row_index, t) < near)) return true;
+          ++t;
+        }
       }
       first = t_hi * kFineWidth;
     }

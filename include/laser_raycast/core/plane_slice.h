@@ -33,9 +33,9 @@ struct PlaneSlice {
     int body;              // index into Scene::bodies()
     std::uint32_t slot;    // the triangle's slot in the body's mesh BVH, or kPrimitive
   };
-  std::vector<Item> items;
-  Bvh tree;      // over the items' boxes (plane coordinates, z = 0): item i is items[i]
-  WideBvh wide;  // the walk's layout of tree
+  std::vector<Item> items;  // in the order of tree's slots: the item of slot s is items[s]
+  Bvh tree;                 // over the items' boxes (plane coordinates, z = 0)
+  WideBvh wide;             // the walk's layout of tree
 
   // The group's bodies crossing frame's plane. The WideBvh refers to the Bvh: a slice stays where
   // it was built.
