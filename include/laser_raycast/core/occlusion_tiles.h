@@ -63,6 +63,10 @@ class OcclusionTiles {
   float coarseMax(int tile_row, int tile) const;
   float fineMax(int row, int tile) const;
   bool anyOpenInRows(const BeamRect& rect, float near) const;
+  // Windows narrower than this are read beam by beam, four at a time, row after row (cheaper than
+  // their tiles' maxima, which may need refreshing).
+  static constexpr int kDirectColumns = 32;
+  bool anyOpenDirect(const BeamRect& rect, float near) const;
   // Beams first..last of a row, four at a time, against near; whole fine tiles by their maximum,
   // and in a one-row scan whole coarse tiles by theirs.
   bool anyOpenInRow(int row_index, int first, int last, float near) const {
