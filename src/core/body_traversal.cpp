@@ -221,10 +221,17 @@ class MeshWalk {
   // A back face of a closed component that the sensor sees from outside: never the nearest hit of a
   // beam (hiddenBackFace), so never tested. Only for the 3D tests: a planar fan's segments are
   // cheap, and kept slices (which must skip what the walk skips) would pay more to decide.
-  bool hidden(std::uint32_t slot) const { return closed_ && hiddenClosed(slot); }
+  // The answer depends on the slot alone for the whole walk, and neighbouring beams ask about the
+  // same slots: the last answers are kept by slot.
+  bool hidden(std::uint32_t slot) { return closed_ && hiddenClosed(slot); }
   // Out of line: the tests that ask stay small inline.
-  __attribute__((noinline)) bool hiddenClosed(std::uint32_t slot) const {
-    return hiddenBackFace(mesh_, slot, eye_, config_.tmin);
+  __attribute__((noinline)) bool hiddenClosed(std::uint32_t slot) {
+    HiddenAnswer& a = hidden_answers_[slot % kHiddenAnswers];
+    if (a.slot != slot) {
+      a.slot = slot;
+      a.hidden = hiddenBackFace(mesh_, slot, eye_, config_.tmin);
+    }
+    return a.hidden;
   }
 
   // The slot's segment in the scan plane against one beam, as slicing tests it.
@@ -351,6 +358,12 @@ class MeshWalk {
     SensorTriangle triangle;
   };
   std::array<CachedTriangle, kCachedTriangles> cache_;
+  static constexpr std::uint32_t kHiddenAnswers = 256;
+  struct HiddenAnswer {
+    std::uint32_t slot = std::numeric_limits<std::uint32_t>::max();
+    bool hidden = false;
+  };
+  std::array<HiddenAnswer, kHiddenAnswers> hidden_answers_;
   bool closed_;  // the mesh has closed components
   const ViewFrame frame_;
   const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame
