@@ -28,6 +28,29 @@ constexpr long long kLeafDirectBeams = 8;
 constexpr std::uint32_t kPlainSliceTriangles = 64;
 constexpr double kPlainSliceBeamsPerTriangle = 0.5;
 
+// The last values computed for triangle slots, by slot (a direct-mapped cache of N entries), for
+// a walk whose beams ask about the same slots again and again.
+template <class T, std::uint32_t N>
+class SlotCache {
+ public:
+  template <class Make>
+  const T& get(std::uint32_t slot, Make&& make) {
+    Entry& e = entries_[slot % N];
+    if (e.slot != slot) {
+      e.slot = slot;
+      e.value = make();
+    }
+    return e.value;
+  }
+
+ private:
+  struct Entry {
+    std::uint32_t slot = std::numeric_limits<std::uint32_t>::max();
+    T value{};
+  };
+  std::array<Entry, N> entries_;
+};
+
 template <TriangleMethod M>
 class MeshWalk {
  public:
@@ -49,7 +72,6 @@ class MeshWalk {
         tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
         frame_(active.sensor_from_body, planar_, config.tmax),
         origin_(active.sensor_in_body, mesh.bvh().bounds(), config.tmin) {
-    eye_ = active.sensor_in_body;
     closed_ = !slicing_ && mesh.hasClosedComponents();
     if (slicing_) {
       // Cut in the frame's plane coordinates when the walk gives them (as a kept slice is).
@@ -159,12 +181,7 @@ class MeshWalk {
 
   // The same through a small cache: the beams traced through one node meet the same leaves.
   const SensorTriangle& cachedTriangle(std::uint32_t slot) {
-    CachedTriangle& c = cache_[slot % kCachedTriangles];
-    if (c.slot != slot) {
-      c.slot = slot;
-      c.triangle = sensorTriangle(slot);
-    }
-    return c.triangle;
+    return triangles_.get(slot, [&] { return sensorTriangle(slot); });
   }
 
   Eigen::Vector3d sensorNormal(std::uint32_t triangle) const {
@@ -226,12 +243,8 @@ class MeshWalk {
   bool hidden(std::uint32_t slot) { return closed_ && hiddenClosed(slot); }
   // Out of line: the tests that ask stay small inline.
   __attribute__((noinline)) bool hiddenClosed(std::uint32_t slot) {
-    HiddenAnswer& a = hidden_answers_[slot % kHiddenAnswers];
-    if (a.slot != slot) {
-      a.slot = slot;
-      a.hidden = hiddenBackFace(mesh_, slot, eye_, config_.tmin);
-    }
-    return a.hidden;
+    return hidden_.get(
+        slot, [&] { return hiddenBackFace(mesh_, slot, active_.sensor_in_body, config_.tmin); });
   }
 
   // The slot's segment in the scan plane against one beam, as slicing tests it.
@@ -351,19 +364,8 @@ class MeshWalk {
   const Eigen::Matrix3d rot_, abs_rot_;
   const Eigen::Vector3d trans_;
   const bool planar_, slicing_, tracing_only_;
-  Eigen::Vector3d eye_;  // the sensor in the mesh frame, for hidden()
-  static constexpr std::uint32_t kCachedTriangles = 64;
-  struct CachedTriangle {
-    std::uint32_t slot = std::numeric_limits<std::uint32_t>::max();
-    SensorTriangle triangle;
-  };
-  std::array<CachedTriangle, kCachedTriangles> cache_;
-  static constexpr std::uint32_t kHiddenAnswers = 256;
-  struct HiddenAnswer {
-    std::uint32_t slot = std::numeric_limits<std::uint32_t>::max();
-    bool hidden = false;
-  };
-  std::array<HiddenAnswer, kHiddenAnswers> hidden_answers_;
+  SlotCache<SensorTriangle, 64> triangles_;
+  SlotCache<bool, 256> hidden_;
   bool closed_;  // the mesh has closed components
   const ViewFrame frame_;
   const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame

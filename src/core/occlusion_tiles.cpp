@@ -76,37 +76,12 @@ bool OcclusionTiles::anyOpenInRows(const BeamRect& rect, float near) const {
     }
     return false;
   }
-  if (rect.col_hi - rect.col_lo < kDirectColumns) return anyOpenDirect(rect, near);
+  const bool direct = rect.col_hi - rect.col_lo < kDirectColumns;
   for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-    if (anyOpenInRow(row, rect.col_lo, rect.col_hi, near)) return true;
-  }
-  return false;
-}
-
-bool OcclusionTiles::anyOpenDirect(const BeamRect& rect, float near) const {
-  // Every row has the same columns: the lanes of the first and last group of four that lie in
-  // the rect, as masks, once.
-  // Lane j of a load from kLanes + 4 - f is set iff j >= f; from kLanes + 7 - l, iff j <= l.
-  static const std::int32_t kLanes[12] = {0, 0, 0, 0, -1, -1, -1, -1, 0, 0, 0, 0};
-  const int base0 = rect.col_lo & ~3, last = (rect.col_hi & ~3) - base0;
-  auto lanes = [](const std::int32_t* p) {
-    return _mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
-  };
-  const __m128 from = lanes(kLanes + 4 - (rect.col_lo - base0));
-  const __m128 to = lanes(kLanes + 7 - (rect.col_hi - base0 - last));
-  const __m128 limit = _mm_set1_ps(near);
-  for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-    const float* r = this->row(row) + base0;
-    // Not less than: a NaN (a beam that could not be cast) counts as open.
-    __m128 open = _mm_and_ps(_mm_cmpnlt_ps(_mm_loadu_ps(r), limit), from);
-    if (last == 0) {
-      open = _mm_and_ps(open, to);
-    } else {
-      for (int b = 4; b < last; b += 4)
-        open = _mm_or_ps(open, _mm_cmpnlt_ps(_mm_loadu_ps(r + b), limit));
-      open = _mm_or_ps(open, _mm_and_ps(_mm_cmpnlt_ps(_mm_loadu_ps(r + last), limit), to));
+    if (direct ? chunkOpen(this->row(row), rect.col_lo, rect.col_hi, near)
+               : anyOpenInRow(row, rect.col_lo, rect.col_hi, near)) {
+      return true;
     }
-    if (_mm_movemask_ps(open)) return true;
   }
   return false;
 }

@@ -58,7 +58,7 @@ class SliceWalk {
       stack_.push_back(Entry{slice_.wide.root(), rect, floatBelow(view.near)});
     });
     walk();
-    castDeferred();
+    deferred_.cast(beams_, scene_, config_);
   }
 
  private:
@@ -160,21 +160,11 @@ class SliceWalk {
     if (!(a.view.near <= config_.tmax) || !a.view.crosses) return;
     beams_.forEachRect(a.view, rect, [&](const BeamRect& r) {
       if (deferLargePrimitive(a)) {
-        deferred_.emplace_back(a, r);
+        deferred_.add(a, r);
       } else if (beams_.anyOpen(r, a.view.near)) {
         castPrimitive(beams_, scene_, a, config_, r);
       }
     });
-  }
-
-  void castDeferred() {
-    std::stable_sort(deferred_.begin(), deferred_.end(), [](const auto& x, const auto& y) {
-      return x.first.view.near < y.first.view.near;
-    });
-    for (const auto& [a, r] : deferred_) {
-      if (beams_.anyOpen(r, a.view.near)) castPrimitive(beams_, scene_, a, config_, r);
-    }
-    deferred_.clear();
   }
 
   // Each open beam of the rect through the node's subtree, one ray at a time: box tests in plane
@@ -239,7 +229,7 @@ class SliceWalk {
   Eigen::Matrix2d inverse_;
   std::optional<PlaneRay::Origin> origin_;
   std::vector<Entry> stack_;
-  std::vector<std::pair<Caster::ActiveBody, BeamRect>> deferred_;  // cast after the walk
+  DeferredPrimitives deferred_;  // cast after the walk
 };
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <emmintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -96,6 +97,16 @@ void castShape(BeamSet& beams, const Primitive& shape, const Caster::ActiveBody&
 }
 
 }  // namespace
+
+void DeferredPrimitives::cast(BeamSet& beams, const Scene& scene, const CastConfig& config) {
+  std::stable_sort(items_.begin(), items_.end(), [](const auto& x, const auto& y) {
+    return x.first.view.near < y.first.view.near;
+  });
+  for (const auto& [a, rect] : items_) {
+    if (beams.anyOpen(rect, a.view.near)) castPrimitive(beams, scene, a, config, rect);
+  }
+  items_.clear();
+}
 
 void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& a,
                    const CastConfig& config, const BeamRect& rect) {

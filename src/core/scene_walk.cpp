@@ -48,7 +48,7 @@ class GroupWalk {
         const Caster::ActiveBody& a = bodies_[e.body];
         (*cast_)[a.index].store(1, std::memory_order_relaxed);
         if (isPrimitive(a.index) && deferLargePrimitive(a)) {
-          deferred_.push_back(e);
+          deferred_.add(a, e.rect);
         } else {
           castBody(beams_, scene_, a, config_, e.rect);
         }
@@ -61,18 +61,14 @@ class GroupWalk {
       }
     }
     // Large primitives, nearest first, once everything nearer has had its turn.
-    for (const Entry& e : deferred_) {
-      if (beams_.anyOpen(e.rect, e.near))
-        castBody(beams_, scene_, bodies_[e.body], config_, e.rect);
-    }
-    deferred_.clear();
+    deferred_.cast(beams_, scene_, config_);
   }
 
+ private:
   bool isPrimitive(int body) const {
     return !std::holds_alternative<std::shared_ptr<const Mesh>>(scene_.bodies()[body].shape);
   }
 
- private:
   // A node of the tree, or a body ready to be cast (body >= 0: its index in bodies_).
   struct Entry {
     WideBvh::Ref ref;
@@ -136,7 +132,7 @@ class GroupWalk {
   }
   std::vector<Entry> heap_;
   std::vector<Caster::ActiveBody> bodies_;  // placed this walk
-  std::vector<Entry> deferred_;             // large primitives, in the order their turn came
+  DeferredPrimitives deferred_;             // large primitives, cast after the walk
 };
 
 }  // namespace

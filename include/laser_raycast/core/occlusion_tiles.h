@@ -66,7 +66,6 @@ class OcclusionTiles {
   // Windows narrower than this are read beam by beam, four at a time, row after row (cheaper than
   // their tiles' maxima, which may need refreshing).
   static constexpr int kDirectColumns = 32;
-  bool anyOpenDirect(const BeamRect& rect, float near) const;
   // Beams first..last of a row, four at a time, against near; whole fine tiles by their maximum,
   // and in a one-row scan whole coarse tiles by theirs.
   bool anyOpenInRow(int row_index, int first, int last, float near) const {
@@ -88,19 +87,29 @@ class OcclusionTiles {
     }
     return chunkOpen(r, first, last, near);
   }
+  // Beams first..last of a row, four at a time: the lanes of the first and last group that lie in
+  // the range are picked by masks.
   static bool chunkOpen(const float* r, int first, int last, float near) {
+    const int base = first & ~3, end = (last & ~3) - base;
     const __m128 limit = _mm_set1_ps(near);
-    const int base0 = first & ~3;
-    int open = 0;
-    for (int base = base0; base <= last; base += 4) {
-      // Not less than: a NaN (a beam that could not be cast) counts as open.
-      int m = _mm_movemask_ps(_mm_cmpnlt_ps(_mm_loadu_ps(r + base), limit));
-      if (base == base0) m &= 0xF << (first - base);
-      if (base + 3 > last) m &= 0xF >> (base + 3 - last);
-      open |= m;
+    r += base;
+    // Not less than: a NaN (a beam that could not be cast) counts as open.
+    __m128 open = _mm_and_ps(_mm_cmpnlt_ps(_mm_loadu_ps(r), limit), lanesFrom(first - base));
+    if (end == 0) return _mm_movemask_ps(_mm_and_ps(open, lanesTo(last - base))) != 0;
+    for (int b = 4; b < end; b += 4) {
+      open = _mm_or_ps(open, _mm_cmpnlt_ps(_mm_loadu_ps(r + b), limit));
     }
-    return open != 0;
+    open = _mm_or_ps(
+        open, _mm_and_ps(_mm_cmpnlt_ps(_mm_loadu_ps(r + end), limit), lanesTo(last - base - end)));
+    return _mm_movemask_ps(open) != 0;
   }
+  // Lanes j >= f, and j <= l, of four (f, l in [0, 3]).
+  static __m128 lanesFrom(int f) { return lanes(kLanes + 4 - f); }
+  static __m128 lanesTo(int l) { return lanes(kLanes + 7 - l); }
+  static __m128 lanes(const std::int32_t* p) {
+    return _mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+  }
+  static constexpr std::int32_t kLanes[12] = {0, 0, 0, 0, -1, -1, -1, -1, 0, 0, 0, 0};
 
   static constexpr int kFinePerCoarse = kCoarseWidth / kFineWidth;
   static constexpr int kFinePerBlock = kCoarseRings * kFinePerCoarse;

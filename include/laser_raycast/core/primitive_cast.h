@@ -3,6 +3,9 @@
 // test (primitives.h) for the beams let through.
 #pragma once
 
+#include <utility>
+#include <vector>
+
 #include "laser_raycast/core/beam_set.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/scene.h"
@@ -15,6 +18,17 @@ namespace core {
 // beside it), so taken nearest first it would be tested with every beam before the nearer things in
 // front of most of it. Only speed depends on it.
 inline bool deferLargePrimitive(const Caster::ActiveBody& a) { return a.radius > a.view.near; }
+
+// The primitives a walk deferred (deferLargePrimitive) with the beams it met them with; cast()
+// casts them once the walk is done, nearest first, each over its beams if any is still open.
+class DeferredPrimitives {
+ public:
+  void add(const Caster::ActiveBody& a, const BeamRect& rect) { items_.emplace_back(a, rect); }
+  void cast(BeamSet& beams, const Scene& scene, const CastConfig& config);
+
+ private:
+  std::vector<std::pair<Caster::ActiveBody, BeamRect>> items_;
+};
 
 // Casts the open beams of rect against the primitive body active.index of scene.
 void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& active,
