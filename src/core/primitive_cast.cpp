@@ -66,15 +66,19 @@ class BoxPrefilter {
 template <class Primitive>
 void castShape(BeamSet& beams, const Primitive& shape, const Caster::ActiveBody& a,
                const BoxPrefilter& filter, const CastConfig& config, const BeamRect& rect) {
+  const __m128 near = _mm_set1_ps(floatBelow(a.view.near));
   for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
     const float* x = beams.directionX(row);
     const float* y = beams.directionY(row);
     const float* range = beams.rangeAbove(row);
     const __m128 z = _mm_set1_ps(beams.directionZ(row));
     for (int base = rect.col_lo & ~3; base <= rect.col_hi; base += 4) {
-      int open = ~filter.misses(_mm_loadu_ps(x + base), _mm_loadu_ps(y + base), z,
-                                _mm_loadu_ps(range + base)) &
-                 0xF;
+      const __m128 r = _mm_loadu_ps(range + base);
+      // Beams whose range (rounded up) is below the primitive's nearest distance are closed to it:
+      // skipped before the pre-test (not less than: NaN counts as open).
+      int open = _mm_movemask_ps(_mm_cmpnlt_ps(r, near));
+      if (!open) continue;
+      open &= ~filter.misses(_mm_loadu_ps(x + base), _mm_loadu_ps(y + base), z, r);
       while (open) {
         const int col = base + __builtin_ctz(static_cast<unsigned>(open));
         open &= open - 1;

@@ -235,5 +235,60 @@ TEST(Caster, RandomScenesMatchBruteForce) {
   }
 }
 
+// A room of primitives as a warehouse builds one: floor, roof and walls (large for their distance,
+// so the walk casts them after everything else, over beams mostly closed by then), and clutter
+// that stands in the floor and against the walls, so that many beams first hit something just
+// beyond the floor's or a wall's nearest distance and the large primitive must still win them.
+// Rings from random poses, against the brute force, with occlusion culling on and off.
+TEST(Caster, RoomsOfPrimitivesWithClutterMatchBruteForce) {
+  Rng rng(4321);
+  long long hits = 0;
+  for (int trial = 0; trial < 8; ++trial) {
+    Scene scene = sceneWithFrame();
+    const double half = uniform(rng, 3, 8), height = uniform(rng, 2, 4);
+    addBody(&scene, Box{Eigen::Vector3d(2 * half, 2 * half, 0.2)}, 0,
+            pose(Eigen::Vector3d(0, 0, -0.1)));  // floor
+    addBody(&scene, Box{Eigen::Vector3d(2 * half, 2 * half, 0.2)}, 0,
+            pose(Eigen::Vector3d(0, 0, height + 0.1)));  // roof
+    for (const double side : {-1.0, 1.0}) {
+      addBody(&scene, Box{Eigen::Vector3d(2 * half, 0.2, height)}, 0,
+              pose(Eigen::Vector3d(0, side * (half + 0.1), height / 2)));
+      addBody(&scene, Box{Eigen::Vector3d(0.2, 2 * half, height)}, 0,
+              pose(Eigen::Vector3d(side * (half + 0.1), 0, height / 2)));
+    }
+    for (int k = 0; k < 30; ++k) {
+      // Sunk into the floor (centre near z = 0) or pushed into a wall.
+      Eigen::Vector3d at(uniform(rng, -half, half), uniform(rng, -half, half),
+                         uniform(rng, -0.2, 0.3));
+      if (k % 3 == 2) at.x() = (k % 2 ? 1 : -1) * (half + uniform(rng, -0.3, 0.1));
+      const auto p = pose(at, randomRotation(rng).toRotationMatrix());
+      if (k % 3 == 0)
+        addBody(&scene, Box{Eigen::Vector3d(uniform(rng, 0.2, 1.2), uniform(rng, 0.2, 1.2), 0.4)},
+                0, p);
+      if (k % 3 == 1) addBody(&scene, Cylinder{uniform(rng, 0.1, 0.5), uniform(rng, 0.3, 1)}, 0, p);
+      if (k % 3 == 2) addBody(&scene, Sphere{uniform(rng, 0.2, 0.6)}, 0, p);
+    }
+    const FramePoses poses = FramePoses::identity(scene);
+    const auto sensor =
+        pose(Eigen::Vector3d(uniform(rng, -half, half) * 0.8, uniform(rng, -half, half) * 0.8,
+                             uniform(rng, 0.2, 1.0)),
+             rpy(uniform(rng, -0.1, 0.1), uniform(rng, -0.1, 0.1), uniform(rng, -3, 3)));
+    std::vector<double> elevations;
+    for (int r = 0; r < 24; ++r) elevations.push_back(-0.9 + 1.3 * r / 23);
+    const ScanPattern rings(fanBySamples(-M_PI, M_PI, 360), elevations);
+    CastConfig base = config(true, 30);
+    const auto truth = bruteForce(scene, poses, sensor, rings, base);
+    for (const bool culling : {true, false}) {
+      CastConfig cfg = base;
+      cfg.occlusion_culling = culling;
+      expectMatchesTruth(cast(scene, poses, sensor, rings, cfg), truth, 1e-9,
+                         "trial " + std::to_string(trial));
+      if (HasFatalFailure()) return;
+    }
+    for (const auto& t : truth) hits += std::isfinite(t.t);
+  }
+  EXPECT_GT(hits, 8 * 360 * 24 * 9 / 10);
+}
+
 }  // namespace
 }  // namespace laser_raycast_test
