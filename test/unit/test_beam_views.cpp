@@ -279,7 +279,8 @@ TEST(ColumnRaster, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
 
 // A rect of the grid gets the candidates the whole grid gets inside it, no more and no fewer: the
 // raster skips the columns whose bounds miss the rect's rows before it looks rows up, and that
-// must change nothing.
+// must change nothing. The whole grid (64 rows) is scanned column by column and the rects (at most
+// 13 rows) row by row, so this also holds the two scans to the same candidates.
 TEST(ColumnRaster, ARectGetsTheWholeGridsCandidatesInsideIt) {
   Rng rng(53);
   std::vector<double> rings;
