@@ -17,9 +17,15 @@ namespace {
 // The walk's choices below change only how beams and triangles are paired, never a triangle's test,
 // so they change only the speed. Their values come from the benchmark's scenes.
 
-// An inner node whose window holds at most this many beams has them traced through its subtree one
-// ray at a time instead of its children's windows being computed.
+// An inner node whose window holds at most kTraceBeams beams has them traced through its subtree
+// one ray at a time instead of its children's windows being computed; so does one with at most
+// kTraceBeamsDense beams of a 3D pattern and at least one triangle below it for every
+// kBeamsPerTriangle of them (a detailed part: its triangles would each be rasterised for a few
+// beams, a beam traced meets only the few on its way). Thin geometry seen across many beams (a wall
+// of two triangles) keeps being rasterised, and a planar fan's nodes keep being sliced.
 constexpr long long kTraceBeams = 12;
+constexpr long long kTraceBeamsDense = 96;
+constexpr long long kBeamsPerTriangle = 2;
 // A leaf whose window holds at most this many beams has them tested against each of its triangles;
 // more are rasterised (3D) against each triangle's edge planes first.
 constexpr long long kLeafDirectBeams = 8;
@@ -135,7 +141,8 @@ class MeshWalk {
     } else if (slicing_ && e.triangles <= kPlainSliceTriangles &&
                beams >= kPlainSliceBeamsPerTriangle * e.triangles) {
       sliceSubtree(e);
-    } else if (beams <= kTraceBeams) {
+    } else if (beams <= kTraceBeams || (!planar_ && beams <= kTraceBeamsDense &&
+                                        e.triangles * kBeamsPerTriangle >= beams)) {
       traceRect(e);
     } else {
       expand(e);
