@@ -225,14 +225,29 @@ void Caster::castBodies(const Scene& scene, const ScanPattern& pattern, const Ca
     const int rows = beams_->all().row_hi + 1;
     const int height = bandRows(rows, column_pieces, threads);
     const int bands = (rows + height - 1) / height;
-    pool_->run(column_pieces * bands, [&](int i) {
+    // The pieces in the order the threads take them; the last `threads` of them are cut into
+    // single coarse tiles, so that the threads run out of work at about the same time.
+    pieces_.clear();
+    const int whole = column_pieces * bands;
+    for (int i = 0; i < whole; ++i) {
       BeamRect piece = beams_->all();
       piece.col_lo = (i / bands) * width;
       piece.col_hi = std::min(columns - 1, piece.col_lo + width - 1);
       piece.row_lo = (i % bands) * height;
       piece.row_hi = std::min(rows - 1, piece.row_lo + height - 1);
-      castWithin(piece);
-    });
+      if (i < whole - threads) {
+        pieces_.push_back(piece);
+        continue;
+      }
+      for (int c = piece.col_lo; c <= piece.col_hi; c += OcclusionTiles::kCoarseWidth) {
+        for (int r = piece.row_lo; r <= piece.row_hi; r += OcclusionTiles::kCoarseRings) {
+          pieces_.push_back(
+              BeamRect{r, std::min(piece.row_hi, r + OcclusionTiles::kCoarseRings - 1), c,
+                       std::min(piece.col_hi, c + OcclusionTiles::kCoarseWidth - 1)});
+        }
+      }
+    }
+    pool_->run(static_cast<int>(pieces_.size()), [&](int i) { castWithin(pieces_[i]); });
   }
   int cast = 0;
   for (const auto& mark : cast_) cast += mark.load(std::memory_order_relaxed);
