@@ -45,6 +45,33 @@ int bandRows(int rows, int column_pieces, int threads) {
   return std::max(unit, (height + unit - 1) / unit * unit);
 }
 
+// The pieces of a scan (rows x columns beams) for `threads` threads, in the order the threads take
+// them: columns first, then bands of rings (chunkColumns, bandRows); the last piece per thread is
+// cut into single coarse tiles, so that the threads run out of work at about the same time.
+std::vector<BeamRect> cutPieces(int rows, int columns, int threads) {
+  const int width = chunkColumns(columns, threads);
+  const int column_pieces = (columns + width - 1) / width;
+  const int height = bandRows(rows, column_pieces, threads);
+  const int bands = (rows + height - 1) / height;
+  const int whole = column_pieces * bands;
+  std::vector<BeamRect> pieces;
+  for (int i = 0; i < whole; ++i) {
+    const int col_lo = (i / bands) * width, row_lo = (i % bands) * height;
+    const BeamRect piece{row_lo, std::min(rows - 1, row_lo + height - 1), col_lo,
+                         std::min(columns - 1, col_lo + width - 1)};
+    const bool cut = i >= whole - threads;
+    const int tile_cols = cut ? OcclusionTiles::kCoarseWidth : width;
+    const int tile_rows = cut ? OcclusionTiles::kCoarseRings : height;
+    for (int c = piece.col_lo; c <= piece.col_hi; c += tile_cols) {
+      for (int r = piece.row_lo; r <= piece.row_hi; r += tile_rows) {
+        pieces.push_back(BeamRect{r, std::min(piece.row_hi, r + tile_rows - 1), c,
+                                  std::min(piece.col_hi, c + tile_cols - 1)});
+      }
+    }
+  }
+  return pieces;
+}
+
 }  // namespace
 
 void CastConfig::validate() const {
@@ -219,35 +246,9 @@ void Caster::castBodies(const Scene& scene, const ScanPattern& pattern, const Ca
     castWithin(beams_->all());
   } else {
     if (!pool_ || pool_->threads() != threads) pool_ = std::make_unique<ThreadPool>(threads);
-    const int columns = pattern.azimuthCount();
-    const int width = chunkColumns(columns, threads);
-    const int column_pieces = (columns + width - 1) / width;
-    const int rows = beams_->all().row_hi + 1;
-    const int height = bandRows(rows, column_pieces, threads);
-    const int bands = (rows + height - 1) / height;
-    // The pieces in the order the threads take them; the last `threads` of them are cut into
-    // single coarse tiles, so that the threads run out of work at about the same time.
-    pieces_.clear();
-    const int whole = column_pieces * bands;
-    for (int i = 0; i < whole; ++i) {
-      BeamRect piece = beams_->all();
-      piece.col_lo = (i / bands) * width;
-      piece.col_hi = std::min(columns - 1, piece.col_lo + width - 1);
-      piece.row_lo = (i % bands) * height;
-      piece.row_hi = std::min(rows - 1, piece.row_lo + height - 1);
-      if (i < whole - threads) {
-        pieces_.push_back(piece);
-        continue;
-      }
-      for (int c = piece.col_lo; c <= piece.col_hi; c += OcclusionTiles::kCoarseWidth) {
-        for (int r = piece.row_lo; r <= piece.row_hi; r += OcclusionTiles::kCoarseRings) {
-          pieces_.push_back(
-              BeamRect{r, std::min(piece.row_hi, r + OcclusionTiles::kCoarseRings - 1), c,
-                       std::min(piece.col_hi, c + OcclusionTiles::kCoarseWidth - 1)});
-        }
-      }
-    }
-    pool_->run(static_cast<int>(pieces_.size()), [&](int i) { castWithin(pieces_[i]); });
+    const std::vector<BeamRect> pieces =
+        cutPieces(beams_->all().row_hi + 1, pattern.azimuthCount(), threads);
+    pool_->run(static_cast<int>(pieces.size()), [&](int i) { castWithin(pieces[i]); });
   }
   int cast = 0;
   for (const auto& mark : cast_) cast += mark.load(std::memory_order_relaxed);

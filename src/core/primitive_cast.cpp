@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "laser_raycast/core/primitives.h"
+#include "laser_raycast/core/simd_math.h"
 
 namespace laser_raycast {
 namespace core {
@@ -17,8 +18,6 @@ namespace {
 // its exact value; the directions' absolute error is below kDirectionError.
 constexpr float kMargin = 1e-5f;
 constexpr float kDirectionError = 1e-6f;
-
-inline __m128 absPs(__m128 x) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), x); }
 
 // Which beams of four certainly miss the primitive's box (body frame, centred, half extents h), or
 // meet it only beyond their current range. A beam d (sensor frame) is d_b = R d in the body frame,
@@ -52,7 +51,7 @@ class BoxPrefilter {
       const __m128 away = _mm_cmpgt_ps(_mm_mul_ps(d, side_[i]), error);
       // Entering it no sooner than gap / (|d| + error): beyond the range.
       const __m128 beyond = _mm_cmpgt_ps(_mm_mul_ps(gap_[i], _mm_set1_ps(1 - kMargin)),
-                                         _mm_mul_ps(range, _mm_add_ps(absPs(d), error)));
+                                         _mm_mul_ps(range, _mm_add_ps(simd::absPs(d), error)));
       miss = _mm_or_ps(miss, _mm_or_ps(away, _mm_and_ps(beyond, _mm_cmpgt_ps(gap_[i], zero))));
     }
     return _mm_movemask_ps(miss);

@@ -70,7 +70,6 @@ struct ScanResult {
 };
 
 class BeamSet;
-struct BeamRect;
 struct PlaneFrame;
 class PlaneSliceCache;
 class ThreadPool;
@@ -153,7 +152,6 @@ class Caster {
   std::vector<std::atomic<char>> cast_;      // per body: cast against this scan (for the stats)
   std::unique_ptr<BeamSet> beams_;           // the walk's per-scan state, kept to reuse its memory
   std::unique_ptr<ThreadPool> pool_;         // for CastConfig::threads > 1, kept between casts
-  std::vector<BeamRect> pieces_;             // a threaded cast's pieces of work
   std::unique_ptr<PlaneSliceCache> planes_;  // CastConfig::plane_cache, kept between casts
   std::optional<ReuseKey> previous_;         // the inputs of result_, if it is complete
 };

@@ -22,6 +22,7 @@
 #include <cmath>
 
 #include "laser_raycast/core/beam_set.h"
+#include "laser_raycast/core/simd_math.h"
 
 namespace laser_raycast {
 namespace core {
@@ -52,7 +53,6 @@ class ColumnRaster {
   };
   // The groups are gathered, then scanned, this many at a time (an array on the stack).
   static constexpr int kChunkGroups = 16;
-  static __m128 absPs(__m128 x) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), x); }
   template <class F>
   void scanRows(const BeamSet& beams, const BeamRect& rect, const Group* groups, int n,
                 F&& f) const;
@@ -146,7 +146,7 @@ void ColumnRaster::scanRows(const BeamSet& beams, const BeamRect& rect, const Gr
       // The row's tan E within the column's bounds, as scanColumns looks rows up: for a float
       // bound x, tan E >= x exactly iff tan E rounded down is, and <= x iff rounded up is. And
       // not clearly beyond the beam's range; written so that a NaN range is never held back.
-      const __m128 along = _mm_add_ps(absPs(_mm_add_ps(_mm_mul_ps(cos_e, g.hn), z)), margin);
+      const __m128 along = _mm_add_ps(simd::absPs(_mm_add_ps(_mm_mul_ps(cos_e, g.hn), z)), margin);
       const __m128 in =
           _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(tan_lo, g.lo), _mm_cmple_ps(tan_hi, g.hi)),
                      _mm_cmpngt_ps(distance, _mm_mul_ps(_mm_loadu_ps(range + g.base), along)));

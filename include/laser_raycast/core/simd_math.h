@@ -1,4 +1,5 @@
-// Small SSE2 helpers shared by the float view computations (node_views.cpp, plane_views.cpp).
+// Small SSE2 helpers shared by the float computations in front of the exact tests (node_views.cpp,
+// plane_views.cpp, column_raster.h, primitive_cast.cpp).
 #pragma once
 
 #include <emmintrin.h>
