@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -256,6 +257,43 @@ TEST(FloatRounding, BelowAndAboveBracketTheDouble) {
   EXPECT_LT(core::floatBelow(0.1), 0.1);
   EXPECT_GT(core::floatAbove(0.1), 0.1);
   EXPECT_TRUE(std::isnan(core::floatBelow(std::numeric_limits<double>::quiet_NaN())));
+}
+
+// floatBelow is the float nearest below, as std::nextafter steps to it, across every range of
+// magnitudes: subnormals, signed zeros, beyond the largest float, infinities.
+TEST(FloatRounding, BelowIsTheNearestFloatNotAbove) {
+  const float kInf = std::numeric_limits<float>::infinity();
+  auto reference = [&](double x) {
+    const float f = static_cast<float>(x);
+    return f > x ? std::nextafter(f, -kInf) : f;
+  };
+  auto same = [](float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  Rng rng(5);
+  std::vector<double> xs = {0.0,
+                            -0.0,
+                            1e-46,
+                            -1e-46,
+                            1e-300,
+                            -1e-300,
+                            1e39,
+                            -1e39,
+                            3.5e38,
+                            -3.5e38,
+                            1e-38,
+                            -1e-38,
+                            0.1,
+                            -0.1,
+                            HUGE_VAL,
+                            -HUGE_VAL,
+                            double(std::numeric_limits<float>::max()),
+                            double(std::numeric_limits<float>::denorm_min())};
+  for (int i = 0; i < 200000; ++i) {
+    xs.push_back((i % 2 ? 1 : -1) * std::pow(10.0, uniform(rng, -48, 40)));
+  }
+  for (double x : xs) {
+    EXPECT_TRUE(same(core::floatBelow(x), reference(x))) << x;
+    EXPECT_TRUE(same(core::floatAbove(x), -reference(-x))) << x;
+  }
 }
 
 }  // namespace

@@ -30,19 +30,17 @@ namespace core {
 // beyond x: x itself if it is a float. Finite x only (infinities and NaN pass through).
 inline float floatBelow(double x) {
   const float f = static_cast<float>(x);
-  if (!(f > x)) return f;
-  // f > x: step one float towards -inf (f is finite and not -max here).
+  // Stepping one float towards -inf is adding one to the bits of a negative float and subtracting
+  // one from those of a positive one; +0 steps as -0 does, to the negative smallest subnormal.
+  // Without branches: whether f rounded above x is a coin toss that a branch would mispredict.
   std::uint32_t bits;
   std::memcpy(&bits, &f, sizeof bits);
-  if (f > 0) {
-    --bits;
-  } else if (f < 0) {
-    ++bits;
-  } else {
-    bits = 0x80000001u;  // -0 and +0 step to the negative smallest subnormal
-  }
+  const std::uint32_t signed_bits = bits | (static_cast<std::uint32_t>(f == 0) << 31);
+  const std::uint32_t stepped = signed_bits + ((signed_bits >> 31) << 1) - 1;
+  const std::uint32_t above = 0u - static_cast<std::uint32_t>(f > x);  // all ones or none
+  const std::uint32_t result = bits ^ ((bits ^ stepped) & above);
   float g;
-  std::memcpy(&g, &bits, sizeof g);
+  std::memcpy(&g, &result, sizeof g);
   return g;
 }
 inline float floatAbove(double x) { return -floatBelow(-x); }
@@ -212,15 +210,18 @@ class WideSlabRay {
     // Adding +0 turns -0 into +0, so a zero component gives +inf and counts as positive (see
     // SlabRay): a ray lying in a slab plane then gives NaN there, which never narrows the interval.
     const double d = dir + 0.0;
-    const bool positive = !(d < 0);
+    // Picked by indexing with the sign, not by branches (the signs of a fan's beams alternate).
+    const int positive = !(d < 0);
     const auto axis = static_cast<std::uint32_t>(k * WideBvh::kWidth * sizeof(float));
-    near_offset_[k] = (positive ? kLo : kHi) + axis;
-    far_offset_[k] = (positive ? kHi : kLo) + axis;
+    const std::uint32_t planes[2] = {kHi + axis, kLo + axis};
+    near_offset_[k] = planes[positive];
+    far_offset_[k] = planes[1 - positive];
     // The near plane minus the origin must not come out larger than exact, nor the far one
     // smaller: for a positive direction that is the origin rounded up for the near plane (lo) and
     // down for the far plane (hi); for a negative one the other way round.
-    origin_near_[k] = positive ? origin_up : origin_down;
-    origin_far_[k] = positive ? origin_down : origin_up;
+    const float origins[2] = {origin_down, origin_up};
+    origin_near_[k] = origins[positive];
+    origin_far_[k] = origins[1 - positive];
     inv_dir_[k] = static_cast<float>(1.0 / d);
   }
 
@@ -257,6 +258,32 @@ void sortFarthestFirst(Entry* entries, int n) {
   }
 }
 
+// The order a ray visits the children it enters, nearest first, without branches: the children's
+// sort keys (t_entry's bits, children not entered after every one entered; the low two bits hold
+// the child, so that keys differ) sorted farthest first by a network of five exchanges. Which of
+// two boxes is entered first is a coin toss that a branch would mispredict.
+inline void orderChildren(int mask, const float t_entry[4], std::uint32_t key[4]) {
+  constexpr std::uint32_t kNotEntered = 0xFFFFFFFCu;
+  for (int k = 0; k < 4; ++k) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &t_entry[k], sizeof bits);
+    // Positive floats order as their bits; the rest count as 0. Masks, not selects: GCC branches.
+    bits &= ~3u & (0u - static_cast<std::uint32_t>(t_entry[k] > 0));
+    const std::uint32_t entered = 0u - static_cast<std::uint32_t>((mask >> k) & 1);
+    key[k] = (bits & entered) | (kNotEntered & ~entered) | static_cast<std::uint32_t>(k);
+  }
+  auto exchange = [&](int i, int j) {
+    const std::uint32_t a = key[i], b = key[j];
+    key[i] = a > b ? a : b;
+    key[j] = a > b ? b : a;
+  };
+  exchange(0, 1);
+  exchange(2, 3);
+  exchange(0, 2);
+  exchange(1, 3);
+  exchange(1, 2);
+}
+
 // Walks the subtree `start` for one ray, nearest box first, and calls leaf(slot) for every triangle
 // slot of each leaf the ray enters before the cull limit of *tmax. leaf may lower *tmax (an
 // improving hit), which culls the boxes beyond. The start's own box is not tested. BoxRay: a
@@ -269,37 +296,46 @@ void traceWide(const WideBvh& bvh, WideBvh::Ref start, const BoxRay& ray, double
     WideBvh::Ref ref;
     float t_entry;
   };
+  // A node pushes at most three children (it goes on into the fourth): three a level, and room for
+  // the three unconditional stores of the deepest level.
   Entry stack[64 * (WideBvh::kWidth - 1) + 1];
   int top = 0;
-  stack[top++] = Entry{start, -std::numeric_limits<float>::infinity()};
   float cull = ray.cullLimit(*tmax);
   const WideBvh::Node* nodes = bvh.nodes().data();
-  while (top > 0) {
-    const Entry entry = stack[--top];
-    if (entry.t_entry > cull) continue;
-    if (entry.ref.isLeaf()) {
+  WideBvh::Ref current = start;
+  for (;;) {
+    if (current.isLeaf()) {
       const double before = *tmax;
-      for (std::uint32_t slot = entry.ref.index; slot < entry.ref.index + entry.ref.count; ++slot) {
+      for (std::uint32_t slot = current.index; slot < current.index + current.count; ++slot) {
         leaf(slot);
       }
       if (*tmax != before) cull = ray.cullLimit(*tmax);
-      continue;
+    } else {
+      const WideBvh::Node& node = nodes[current.index];
+      alignas(16) float t_entry[4];
+      const int mask = ray.enter(node, cull, t_entry);
+      if (mask) {
+        // Go on into the nearest child entered; push the others farthest first, so that the
+        // nearest of them comes next. Keys of children not entered sort first and are not kept.
+        std::uint32_t key[4];
+        orderChildren(mask, t_entry, key);
+        for (int j = 0; j < 3; ++j) {
+          const int k = static_cast<int>(key[j] & 3);
+          stack[top] = Entry{node.child(k), t_entry[k]};
+          top += (mask >> k) & 1;
+        }
+        current = node.child(static_cast<int>(key[3] & 3));
+        continue;
+      }
     }
-    const WideBvh::Node& node = nodes[entry.ref.index];
-    alignas(16) float t_entry[4];
-    int mask = ray.enter(node, cull, t_entry);
-    // Push the children entered, farthest first, so that the nearest is visited next.
-    int order[4], n = 0;
-    while (mask) {
-      const int k = __builtin_ctz(static_cast<unsigned>(mask));
-      mask &= mask - 1;
-      int j = n++;
-      for (; j > 0 && t_entry[order[j - 1]] < t_entry[k]; --j) order[j] = order[j - 1];
-      order[j] = k;
-    }
-    for (int j = 0; j < n; ++j) {
-      const int k = order[j];
-      stack[top++] = Entry{node.child(k), t_entry[k]};
+    // Next, the nearest pushed child still before the cull limit.
+    for (;;) {
+      if (top == 0) return;
+      const Entry& entry = stack[--top];
+      if (!(entry.t_entry > cull)) {
+        current = entry.ref;
+        break;
+      }
     }
   }
 }
