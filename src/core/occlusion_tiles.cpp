@@ -76,6 +76,12 @@ bool OcclusionTiles::anyOpenInRows(const BeamRect& rect, float near) const {
     }
     return false;
   }
+  if (rect.col_hi - rect.col_lo < kFineWidth) {
+    for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
+      if (narrowOpen(this->row(row), rect.col_lo, rect.col_hi, near)) return true;
+    }
+    return false;
+  }
   const bool direct = rect.col_hi - rect.col_lo < kDirectColumns;
   for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
     if (direct ? chunkOpen(this->row(row), rect.col_lo, rect.col_hi, near)

@@ -14,6 +14,7 @@
 
 #include <emmintrin.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -51,9 +52,13 @@ class OcclusionTiles {
   // be seen through rect). May answer true when that holds too (a coarse tile overlaps the rect's
   // border), never false when some beam is at near or farther.
   bool anyOpen(const BeamRect& rect, float near) const {
-    // A narrow window of one row, or any window of a one-row scan (a planar fan: its coarse tiles
-    // are the row's own, so a window of it is read through them, exactly).
-    if (rect.row_lo == rect.row_hi && (rect.col_hi - rect.col_lo < kFineWidth || rows_ == 1)) {
+    // A narrow window of one row, without branches; any other window of a one-row scan (a planar
+    // fan: its coarse tiles are the row's own, so a window of it is read through them, exactly).
+    const bool one_row = rect.row_lo == rect.row_hi;
+    if (one_row & (rect.col_hi - rect.col_lo < kFineWidth)) {
+      return narrowOpen(row(rect.row_lo), rect.col_lo, rect.col_hi, near);
+    }
+    if (one_row & (rows_ == 1)) {
       return !rect.empty() && anyOpenInRow(rect.row_lo, rect.col_lo, rect.col_hi, near);
     }
     return anyOpenInRows(rect, near);
@@ -101,6 +106,29 @@ class OcclusionTiles {
     }
     open = _mm_or_ps(
         open, _mm_and_ps(_mm_cmpnlt_ps(_mm_loadu_ps(r + end), limit), lanesTo(last - base - end)));
+    return _mm_movemask_ps(open) != 0;
+  }
+  // Beams first..last of a row, fewer than kFineWidth (none if last < first), as five groups of
+  // four whatever their number, each lane masked by its column: where a window starts and how wide
+  // it is are coin tosses that the branches of chunkOpen's loop would mispredict. Groups past the
+  // one holding last read that one again, so that nothing beyond it is read (another thread's).
+  static bool narrowOpen(const float* r, int first, int last, float near) {
+    static_assert(kFineWidth <= 17, "five groups of four cover a narrow window from first & ~3");
+    if (last < first) return false;
+    const int base = first & ~3, end = last & ~3;
+    const __m128 limit = _mm_set1_ps(near);
+    const __m128i after_first = _mm_set1_epi32(first - 1), before_last = _mm_set1_epi32(last + 1);
+    const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+    __m128 open = _mm_setzero_ps();
+    for (int g = 0; g < 5; ++g) {
+      const int at = std::min(base + 4 * g, end);
+      const __m128i column = _mm_add_epi32(_mm_set1_epi32(at), lane);
+      const __m128i in =
+          _mm_and_si128(_mm_cmpgt_epi32(column, after_first), _mm_cmpgt_epi32(before_last, column));
+      // Not less than: a NaN (a beam that could not be cast) counts as open.
+      const __m128 beam_open = _mm_cmpnlt_ps(_mm_loadu_ps(r + at), limit);
+      open = _mm_or_ps(open, _mm_and_ps(_mm_castsi128_ps(in), beam_open));
+    }
     return _mm_movemask_ps(open) != 0;
   }
   // Lanes j >= f, and j <= l, of four (f, l in [0, 3]).
