@@ -30,8 +30,9 @@
 #include "laser_raycast/core/enum_names.h"
 #include "laser_raycast/core/ray.h"
 
-// Triangle tests sit in the innermost loops of the BVH walks; GCC and Clang would otherwise keep
-// the larger ones out of line there.
+// Triangle tests, box tests and the edge functions sit in the innermost loops of the BVH walks;
+// GCC and Clang would otherwise keep the larger ones out of line there (a 3D traced beam called
+// WideSlabRay::enter for every node).
 #if defined(__GNUC__)
 #define LASER_RAYCAST_HOT_INLINE __attribute__((always_inline)) inline
 #else
@@ -134,7 +135,7 @@ inline double exactSignDifferenceOfProducts(double a, double b, double c, double
 // evaluation that used the exact sign in one triangle and the rounded one in its neighbour could
 // let a ray slip between.
 template <typename T>
-inline T edgeFunction(T a, T b, T c, T d) {
+LASER_RAYCAST_HOT_INLINE T edgeFunction(T a, T b, T c, T d) {
   const T ab = a * b;
   const T cd = c * d;
   const T e = ab - cd;

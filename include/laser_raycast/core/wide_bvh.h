@@ -176,12 +176,13 @@ class WideSlabRay {
 
   // The box cull limit for a far limit tmax: widened as BvhT::traverse does (a hit's t and its
   // box's entry and exit round differently).
-  float cullLimit(double tmax) const {
+  LASER_RAYCAST_HOT_INLINE float cullLimit(double tmax) const {
     return floatAbove(tmax + (std::abs(tmax) + reach_) * kWiden);
   }
   // The children of node that the ray enters at or before `cull` (bit k for child k), and where
   // (t_entry[k]; meaningful for the children entered).
-  int enter(const WideBvh::Node& node, float cull, float t_entry[4]) const {
+  LASER_RAYCAST_HOT_INLINE int enter(const WideBvh::Node& node, float cull,
+                                     float t_entry[4]) const {
     const char* base = reinterpret_cast<const char*>(&node);
     __m128 tnear = _mm_set1_ps(tnear0_);
     __m128 tfar = _mm_set1_ps(std::numeric_limits<float>::infinity());
@@ -262,7 +263,8 @@ void sortFarthestFirst(Entry* entries, int n) {
 // sort keys (t_entry's bits, children not entered after every one entered; the low two bits hold
 // the child, so that keys differ) sorted farthest first by a network of five exchanges. Which of
 // two boxes is entered first is a coin toss that a branch would mispredict.
-inline void orderChildren(int mask, const float t_entry[4], std::uint32_t key[4]) {
+LASER_RAYCAST_HOT_INLINE void orderChildren(int mask, const float t_entry[4],
+                                            std::uint32_t key[4]) {
   constexpr std::uint32_t kNotEntered = 0xFFFFFFFCu;
   for (int k = 0; k < 4; ++k) {
     std::uint32_t bits;
