@@ -12,6 +12,7 @@ namespace {
 
 using simd::absPs;
 using simd::atan2Ps;
+using simd::CornerTangents;
 using simd::kViewSlack;
 using simd::selectPs;
 
@@ -42,16 +43,17 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewFrame& f) {
     eb[k] = _mm_mul_ps(_mm_sub_ps(hi, lo), half_ps);
   }
   // The sensor-frame centre c and half extents e of the child boxes, e widened by the rounding.
-  __m128 c[3], e[3];
+  __m128 c[3], e[3], mag[3];
   for (int i = 0; i < 3; ++i) {
-    __m128 ci = f.trans_[i], ei = _mm_setzero_ps(), mag = f.abs_trans_[i];
+    __m128 ci = f.trans_[i], ei = _mm_setzero_ps(), m = f.abs_trans_[i];
     for (int k = 0; k < 3; ++k) {
       ci = _mm_add_ps(ci, _mm_mul_ps(f.rot_[i][k], cb[k]));
       ei = _mm_add_ps(ei, _mm_mul_ps(f.abs_rot_[i][k], eb[k]));
-      mag = _mm_add_ps(mag, _mm_mul_ps(f.abs_rot_[i][k], _mm_add_ps(absPs(cb[k]), eb[k])));
+      m = _mm_add_ps(m, _mm_mul_ps(f.abs_rot_[i][k], _mm_add_ps(absPs(cb[k]), eb[k])));
     }
     c[i] = ci;
-    e[i] = _mm_add_ps(ei, _mm_mul_ps(slack, _mm_add_ps(mag, ei)));
+    mag[i] = m;
+    e[i] = _mm_add_ps(ei, _mm_mul_ps(slack, _mm_add_ps(m, ei)));
   }
   // Nearest distance: the norm of the gap between the sensor and the box, lowered by the slack.
   // If the squares overflow, the largest gap is still a lower bound.
@@ -82,10 +84,30 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewFrame& f) {
   const __m128 limited = _mm_cmpgt_ps(rho2, _mm_mul_ps(r2, _mm_set1_ps(1 + 8 * kViewSlack)));
   const __m128 denom = _mm_sqrt_ps(_mm_max_ps(_mm_sub_ps(rho2, r2), _mm_set1_ps(1e-30f)));
   __m128 half = _mm_mul_ps(_mm_div_ps(_mm_sqrt_ps(r2), denom), _mm_set1_ps(1 + 8 * kViewSlack));
+  __m128 center = atan2Ps(c[1], c[0]);
+  // The circle is loose (up to 1.4 times a square box's azimuths, many times a long box's seen end
+  // on): the corners' x, y narrow it (simd::CornerTangents). A corner is the centre plus or minus
+  // the three rotated half extents; each of its x, y is a few roundings off, at most the slack
+  // times that axis's magnitude.
+  __m128 px[3], py[3];
+  for (int k = 0; k < 3; ++k) {
+    px[k] = _mm_mul_ps(f.rot_[0][k], eb[k]);
+    py[k] = _mm_mul_ps(f.rot_[1][k], eb[k]);
+  }
+  CornerTangents corners;
+  for (int s = 0; s < 8; ++s) {
+    __m128 x = c[0], y = c[1];
+    for (int k = 0; k < 3; ++k) {
+      x = (s >> k) & 1 ? _mm_add_ps(x, px[k]) : _mm_sub_ps(x, px[k]);
+      y = (s >> k) & 1 ? _mm_add_ps(y, py[k]) : _mm_sub_ps(y, py[k]);
+    }
+    corners.add(x, y, c[0], c[1], rho2);
+  }
+  corners.narrow(_mm_mul_ps(slack, _mm_add_ps(mag[0], mag[1])), rho2, &center, &half);
   half = _mm_add_ps(half, _mm_set1_ps(static_cast<float>(2 * kBearingError)));
   const __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
   _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
-  _mm_store_ps(az_center, atan2Ps(c[1], c[0]));
+  _mm_store_ps(az_center, center);
   if (f.planar_) return;
 
   // Elevations: a point of the box has height in [z_lo, z_hi] and horizontal distance in

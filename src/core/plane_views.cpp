@@ -13,6 +13,7 @@ namespace {
 
 using simd::absPs;
 using simd::atan2Ps;
+using simd::CornerTangents;
 using simd::kViewSlack;
 using simd::selectPs;
 
@@ -20,59 +21,6 @@ using simd::selectPs;
 inline __m128 floorPs(__m128 x) {
   const __m128 t = _mm_cvtepi32_ps(_mm_cvttps_epi32(x));
   return _mm_sub_ps(t, _mm_and_ps(_mm_cmpgt_ps(t, x), _mm_set1_ps(1.0f)));
-}
-
-// The circle around a box bounds its bearings loosely: for a long box seen end on, many times
-// wider than the box. Its corners bound them tightly: seen from the sensor, the bearings of a box
-// that does not hold the sensor span those of its corners. Each corner's bearing relative to the
-// centre's direction u = (sx, sy), delta, is bounded by tan delta = (u x c) / (u . c), which is
-// farther from 0 than delta on either side; a window [min, max] of those around the centre's
-// bearing holds the box's (u points into the box, so its extreme bearings lie on both sides of u,
-// but for u's rounding, a turn of 1e-7 rad, where tan delta and delta agree far below the pad).
-// Where a corner is 60 degrees or more off u (dot < |u| |c| / 2; near the sensor), the circle's
-// half-width is kept.
-//
-// The rounding: a corner in the sensor frame is off by at most the slack times the magnitudes
-// (mx, my, as for the box's extents), which turns it by at most that over its distance (no less
-// than nearest); the float cross and dot products, the division and u's own rounding (u is only
-// the reference direction: the centre's bearing is computed from the same floats) add a few ulps
-// of tan 60 degrees, far below kCornerError.
-void tightenToCorners(__m128 lo_x, __m128 lo_y, __m128 hi_x, __m128 hi_y, __m128 sx, __m128 sy,
-                      __m128 mx, __m128 my, __m128 nearest, const __m128 (&map)[6], __m128* center,
-                      __m128* half) {
-  constexpr float kCornerError = 1e-5f;
-  const __m128 xs[2] = {lo_x, hi_x}, ys[2] = {lo_y, hi_y};
-  const __m128 quarter_u2 =
-      _mm_mul_ps(_mm_set1_ps(0.25f), _mm_add_ps(_mm_mul_ps(sx, sx), _mm_mul_ps(sy, sy)));
-  __m128 lo = _mm_set1_ps(std::numeric_limits<float>::infinity());
-  __m128 hi = _mm_sub_ps(_mm_setzero_ps(), lo);
-  __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
-  for (int i = 0; i < 4; ++i) {
-    const __m128 x = xs[i & 1], y = ys[i >> 1];
-    // map: a, b, c, d, tx, ty (PlaneFrame's, in float).
-    const __m128 cx = _mm_add_ps(_mm_add_ps(_mm_mul_ps(map[0], x), _mm_mul_ps(map[1], y)), map[4]);
-    const __m128 cy = _mm_add_ps(_mm_add_ps(_mm_mul_ps(map[2], x), _mm_mul_ps(map[3], y)), map[5]);
-    const __m128 cross = _mm_sub_ps(_mm_mul_ps(sx, cy), _mm_mul_ps(sy, cx));
-    const __m128 dot = _mm_add_ps(_mm_mul_ps(sx, cx), _mm_mul_ps(sy, cy));
-    // dot > 0 and dot^2 > |u|^2 |c|^2 / 4 (NaN: not ok).
-    const __m128 c2 = _mm_add_ps(_mm_mul_ps(cx, cx), _mm_mul_ps(cy, cy));
-    ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(dot, _mm_setzero_ps()),
-                                   _mm_cmpgt_ps(_mm_mul_ps(dot, dot), _mm_mul_ps(quarter_u2, c2))));
-    const __m128 t = _mm_div_ps(cross, dot);
-    lo = _mm_min_ps(lo, t);
-    hi = _mm_max_ps(hi, t);
-  }
-  // The corners' turn by their rounding: slack times the magnitudes over the nearest distance.
-  const __m128 shift =
-      _mm_div_ps(_mm_mul_ps(_mm_set1_ps(4 * kViewSlack), _mm_add_ps(mx, my)), nearest);
-  const __m128 pad = _mm_add_ps(shift, _mm_set1_ps(kCornerError));
-  const __m128 tight_half = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(hi, lo), _mm_set1_ps(0.5f)), pad);
-  const __m128 tight_center =
-      _mm_add_ps(*center, _mm_mul_ps(_mm_add_ps(lo, hi), _mm_set1_ps(0.5f)));
-  // Only where every corner was usable, the pad is finite and the result is tighter.
-  ok = _mm_and_ps(ok, _mm_cmplt_ps(tight_half, *half));
-  *center = selectPs(ok, tight_center, *center);
-  *half = selectPs(ok, tight_half, *half);
 }
 
 }  // namespace
@@ -143,7 +91,7 @@ void PlaneViews::compute(const WideBvh::Node& node, const PlaneViewFrame& f) {
 
   // Bearings: the box lies in a disc of radius r around (sx, sy); seen from the sensor the disc
   // spans half-angle asin(r / rho) <= r / sqrt(rho^2 - r^2), unless it holds the sensor (or nearly:
-  // then every bearing). The box's corners narrow that where they can (tightenToCorners).
+  // then every bearing).
   const __m128 rho2 = _mm_add_ps(_mm_mul_ps(sx, sx), _mm_mul_ps(sy, sy));
   const __m128 r2 = _mm_add_ps(_mm_mul_ps(wx, wx), _mm_mul_ps(wy, wy));
   const __m128 widen = _mm_set1_ps(1 + 8 * kViewSlack);
@@ -151,8 +99,18 @@ void PlaneViews::compute(const WideBvh::Node& node, const PlaneViewFrame& f) {
   const __m128 denom = _mm_sqrt_ps(_mm_max_ps(_mm_sub_ps(rho2, r2), _mm_set1_ps(1e-30f)));
   __m128 half = _mm_mul_ps(_mm_div_ps(_mm_sqrt_ps(r2), denom), widen);
   __m128 center = atan2Ps(sy, sx);
-  const __m128 map[6] = {f.a_, f.b_, f.c_, f.d_, f.tx_, f.ty_};
-  tightenToCorners(lo_x, lo_y, hi_x, hi_y, sx, sy, mx, my, nearest, map, &center, &half);
+  // The circle is loose (up to 1.4 times a square box's bearings, many times a long box's seen
+  // end on): the box's corners narrow it (simd::CornerTangents). Each corner in the sensor's x, y
+  // is a few roundings off, at most the slack times the magnitudes mx, my.
+  CornerTangents corners;
+  const __m128 xs[2] = {lo_x, hi_x}, ys[2] = {lo_y, hi_y};
+  for (int i = 0; i < 4; ++i) {
+    const __m128 x = xs[i & 1], y = ys[i >> 1];
+    corners.add(_mm_add_ps(_mm_add_ps(_mm_mul_ps(f.a_, x), _mm_mul_ps(f.b_, y)), f.tx_),
+                _mm_add_ps(_mm_add_ps(_mm_mul_ps(f.c_, x), _mm_mul_ps(f.d_, y)), f.ty_), sx, sy,
+                rho2);
+  }
+  corners.narrow(_mm_mul_ps(slack, _mm_add_ps(mx, my)), rho2, &center, &half);
   half = _mm_add_ps(half, _mm_set1_ps(static_cast<float>(2 * kBearingError)));
   const __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
   _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
