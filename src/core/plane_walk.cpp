@@ -167,42 +167,74 @@ class SliceWalk {
     });
   }
 
-  // Each open beam of the rect through the node's subtree, one ray at a time: box tests in plane
-  // coordinates, each item tested as testItem tests it.
+  // A beam traced through a subtree: its ray in plane coordinates and its nearest item so far.
+  struct Traced {
+    int col;
+    double dx, dy, tmax;
+    const PlaneSlice::Item* best;
+    double best_t;
+    PlaneRay ray;
+  };
+
+  // The test of a traced beam against a leaf's item.
+  auto leafTest(Traced* b) {
+    return [this, b](std::uint32_t i) {
+      const PlaneSlice::Item& item = slice_.items[i];
+      (*cast_)[item.body].store(1, std::memory_order_relaxed);
+      if (item.slot == PlaneSlice::kPrimitive) {
+        castPrimitiveItem(item.body, BeamRect{0, 0, b->col, b->col});
+        b->tmax = std::min(b->tmax, beams_.range(0, b->col));
+        return;
+      }
+      Eigen::Vector2d front;
+      if (config_.cull_backfaces) front = frontOf(item);
+      double t;
+      if (!beamCrossesSegment(b->dx, b->dy, plane_.toSensor(item.p), plane_.toSensor(item.q),
+                              config_.tmin, b->tmax, config_.cull_backfaces ? &front : nullptr,
+                              &t)) {
+        return;
+      }
+      if (t < b->best_t || (t == b->best_t && before(item, *b->best))) {
+        b->best = &item;
+        b->best_t = t;
+        b->tmax = t;
+      }
+    };
+  }
+
+  // Each open beam of the rect through the node's subtree, two at a time (their walks side by
+  // side): box tests in plane coordinates, each item tested as testItem tests it.
   void traceRect(const Entry& e) {
     const auto& dirs = beams_.pattern().directions();
+    Traced pair[2];
+    int n = 0;
     for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
       const double range = beams_.range(0, col);
       if (!(range >= e.near)) continue;
-      double tmax = std::min(config_.tmax, range);
-      const PlaneSlice::Item* best = nullptr;
-      double best_t = std::numeric_limits<double>::infinity();
-      const double dx = dirs[col].x(), dy = dirs[col].y();
-      const PlaneRay ray(*origin_, inverse_ * Eigen::Vector2d(dx, dy));
-      traceWide(slice_.wide, e.ref, ray, &tmax, [&](std::uint32_t i) {
-        const PlaneSlice::Item& item = slice_.items[i];
-        (*cast_)[item.body].store(1, std::memory_order_relaxed);
-        if (item.slot == PlaneSlice::kPrimitive) {
-          castPrimitiveItem(item.body, BeamRect{0, 0, col, col});
-          tmax = std::min(tmax, beams_.range(0, col));
-          return;
-        }
-        Eigen::Vector2d front;
-        if (config_.cull_backfaces) front = frontOf(item);
-        double t;
-        if (!beamCrossesSegment(dx, dy, plane_.toSensor(item.p), plane_.toSensor(item.q),
-                                config_.tmin, tmax, config_.cull_backfaces ? &front : nullptr,
-                                &t)) {
-          return;
-        }
-        if (t < best_t || (t == best_t && before(item, *best))) {
-          best = &item;
-          best_t = t;
-          tmax = t;
-        }
-      });
-      if (best) offerSegmentHit(col, best_t, *best);
+      Traced& b = pair[n++];
+      b.col = col;
+      b.dx = dirs[col].x();
+      b.dy = dirs[col].y();
+      b.tmax = std::min(config_.tmax, range);
+      b.best = nullptr;
+      b.best_t = std::numeric_limits<double>::infinity();
+      b.ray = PlaneRay(*origin_, inverse_ * Eigen::Vector2d(b.dx, b.dy));
+      if (n == 2) {
+        traceWidePair(slice_.wide, e.ref, pair[0].ray, &pair[0].tmax, leafTest(&pair[0]),
+                      pair[1].ray, &pair[1].tmax, leafTest(&pair[1]));
+        finish(pair[0]);
+        finish(pair[1]);
+        n = 0;
+      }
     }
+    if (n == 1) {
+      traceWide(slice_.wide, e.ref, pair[0].ray, &pair[0].tmax, leafTest(&pair[0]));
+      finish(pair[0]);
+    }
+  }
+
+  void finish(const Traced& b) {
+    if (b.best) offerSegmentHit(b.col, b.best_t, *b.best);
   }
 
   // The tie rule of BeamSet::offer: the lower body, then the lower triangle.

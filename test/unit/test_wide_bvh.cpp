@@ -192,6 +192,64 @@ TEST(WideRay, NearestHitEqualsBruteForceForEveryMethod) {
   EXPECT_GT(hits, 600);
 }
 
+// Two rays walked side by side (traceWidePair) visit the same leaves in the same order, and keep
+// the same nearest hits, as each walked alone (traceWide).
+TEST(WideWalk, APairOfWalksVisitsWhatEachWalkAloneVisits) {
+  Rng rng(29);
+  int hits = 0;
+  for (int scene = 0; scene < 4; ++scene) {
+    const Soup s = scene % 2 ? spreadSoup(rng, 800) : clusteredSoup(rng, 800);
+    const core::Mesh mesh(s.vertices, s.triangles);
+    const WideBvh& w = mesh.wideBvh();
+    const auto& slots = mesh.bvh().triangleVertices();
+    struct Walked {
+      std::vector<std::uint32_t> visits;
+      double tmax;
+      std::optional<double> t;
+    };
+    for (int i = 0; i < 200; ++i) {
+      core::Ray rays[2];
+      const Eigen::Vector3d origin = uniformInCube(rng, 14);
+      for (core::Ray& ray : rays) {
+        ray.origin = origin;
+        ray.dir = randomUnitVector(rng);
+        ray.tmin = 0;
+        ray.tmax = i % 4 == 0 ? uniform(rng, 1, 40) : kInf;
+      }
+      // (The boxes' rays are built from each ray alone: the pair shares nothing but the tree.)
+      const core::WideBoxRay box[2] = {core::WideBoxRay(rays[0], mesh.bvh().bounds()),
+                                       core::WideBoxRay(rays[1], mesh.bvh().bounds())};
+      const core::PreparedRay<double, TriangleMethod::kWatertight> prepared[2] = {
+          core::PreparedRay<double, TriangleMethod::kWatertight>(rays[0], false),
+          core::PreparedRay<double, TriangleMethod::kWatertight>(rays[1], false)};
+      auto leaf = [&](int k, Walked* walked) {
+        return [&, k, walked](std::uint32_t slot) {
+          walked->visits.push_back(slot);
+          const auto& v = slots[slot];
+          const auto hit = prepared[k].intersect(v[0], v[1], v[2], walked->tmax);
+          if (hit && (!walked->t || hit->t < *walked->t)) {
+            walked->t = hit->t;
+            walked->tmax = hit->t;
+          }
+        };
+      };
+      Walked alone[2], paired[2];
+      for (int k = 0; k < 2; ++k) {
+        alone[k].tmax = paired[k].tmax = rays[k].tmax;
+        core::traceWide(w, w.root(), box[k], &alone[k].tmax, leaf(k, &alone[k]));
+      }
+      core::traceWidePair(w, w.root(), box[0], &paired[0].tmax, leaf(0, &paired[0]), box[1],
+                          &paired[1].tmax, leaf(1, &paired[1]));
+      for (int k = 0; k < 2; ++k) {
+        ASSERT_EQ(alone[k].visits, paired[k].visits) << "ray " << k << " of pair " << i;
+        ASSERT_EQ(alone[k].t, paired[k].t) << "ray " << k << " of pair " << i;
+        hits += alone[k].t.has_value();
+      }
+    }
+  }
+  EXPECT_GT(hits, 100);
+}
+
 // Axis-aligned rays and rays lying exactly in box faces (the float boxes are rounded outward, and
 // a ray in a slab plane gives NaN there): a grid of axis-aligned squares, rays along the grid
 // lines.

@@ -286,36 +286,32 @@ LASER_RAYCAST_HOT_INLINE void orderChildren(int mask, const float t_entry[4],
   exchange(1, 2);
 }
 
-// Walks the subtree `start` for one ray, nearest box first, and calls leaf(slot) for every triangle
-// slot of each leaf the ray enters before the cull limit of *tmax. leaf may lower *tmax (an
-// improving hit), which culls the boxes beyond. The start's own box is not tested. BoxRay: a
-// WideBoxRay, or a ray with the same two members (cullLimit, enter) for other boxes.
-template <class BoxRay, class Leaf>
-void traceWide(const WideBvh& bvh, WideBvh::Ref start, const BoxRay& ray, double* tmax,
-               Leaf&& leaf) {
-  if (start.isEmpty()) return;
-  struct Entry {
-    WideBvh::Ref ref;
-    float t_entry;
-  };
-  // A node pushes at most three children (it goes on into the fourth): three a level, and room for
-  // the three unconditional stores of the deepest level.
-  Entry stack[64 * (WideBvh::kWidth - 1) + 1];
-  int top = 0;
-  float cull = ray.cullLimit(*tmax);
-  const WideBvh::Node* nodes = bvh.nodes().data();
-  WideBvh::Ref current = start;
-  for (;;) {
-    if (current.isLeaf()) {
-      const double before = *tmax;
-      for (std::uint32_t slot = current.index; slot < current.index + current.count; ++slot) {
+// One ray's walk of a subtree, nearest box first, a step at a time (traceWide, traceWidePair): each
+// step visits a node or a leaf, calling leaf(slot) for every triangle slot of a leaf the ray enters
+// before the cull limit of *tmax. leaf may lower *tmax (an improving hit), which culls the boxes
+// beyond. The start's own box is not tested. BoxRay: a WideBoxRay, or a ray with the same two
+// members (cullLimit, enter) for other boxes.
+template <class BoxRay>
+class WideWalk {
+ public:
+  WideWalk(const WideBvh& bvh, WideBvh::Ref start, const BoxRay& ray, double* tmax)
+      : nodes_(bvh.nodes().data()), ray_(ray), tmax_(tmax), current_(start) {
+    cull_ = ray.cullLimit(*tmax);
+  }
+
+  // One node or leaf; false once the walk is over.
+  template <class Leaf>
+  LASER_RAYCAST_HOT_INLINE bool step(Leaf&& leaf) {
+    if (current_.isLeaf()) {
+      const double before = *tmax_;
+      for (std::uint32_t slot = current_.index; slot < current_.index + current_.count; ++slot) {
         leaf(slot);
       }
-      if (*tmax != before) cull = ray.cullLimit(*tmax);
+      if (*tmax_ != before) cull_ = ray_.cullLimit(*tmax_);
     } else {
-      const WideBvh::Node& node = nodes[current.index];
+      const WideBvh::Node& node = nodes_[current_.index];
       alignas(16) float t_entry[4];
-      const int mask = ray.enter(node, cull, t_entry);
+      const int mask = ray_.enter(node, cull_, t_entry);
       if (mask) {
         // Go on into the nearest child entered; push the others farthest first, so that the
         // nearest of them comes next. Keys of children not entered sort first and are not kept.
@@ -323,23 +319,64 @@ void traceWide(const WideBvh& bvh, WideBvh::Ref start, const BoxRay& ray, double
         orderChildren(mask, t_entry, key);
         for (int j = 0; j < 3; ++j) {
           const int k = static_cast<int>(key[j] & 3);
-          stack[top] = Entry{node.child(k), t_entry[k]};
-          top += (mask >> k) & 1;
+          stack_[top_] = Entry{node.child(k), t_entry[k]};
+          top_ += (mask >> k) & 1;
         }
-        current = node.child(static_cast<int>(key[3] & 3));
-        continue;
+        current_ = node.child(static_cast<int>(key[3] & 3));
+        return true;
       }
     }
     // Next, the nearest pushed child still before the cull limit.
     for (;;) {
-      if (top == 0) return;
-      const Entry& entry = stack[--top];
-      if (!(entry.t_entry > cull)) {
-        current = entry.ref;
-        break;
+      if (top_ == 0) return false;
+      const Entry& entry = stack_[--top_];
+      if (!(entry.t_entry > cull_)) {
+        current_ = entry.ref;
+        return true;
       }
     }
   }
+
+ private:
+  struct Entry {
+    WideBvh::Ref ref;
+    float t_entry;
+  };
+  const WideBvh::Node* nodes_;
+  const BoxRay& ray_;
+  double* tmax_;
+  float cull_;
+  WideBvh::Ref current_;
+  int top_ = 0;
+  // A node pushes at most three children (it goes on into the fourth): three a level, and room
+  // for the three unconditional stores of the deepest level.
+  Entry stack_[64 * (WideBvh::kWidth - 1) + 1];
+};
+
+// Walks the subtree `start` for one ray (WideWalk).
+template <class BoxRay, class Leaf>
+void traceWide(const WideBvh& bvh, WideBvh::Ref start, const BoxRay& ray, double* tmax,
+               Leaf&& leaf) {
+  if (start.isEmpty()) return;
+  WideWalk<BoxRay> walk(bvh, start, ray, tmax);
+  while (walk.step(leaf)) {
+  }
+}
+
+// Two rays' walks of one subtree, a step of each in turn: each is a chain of dependent loads and
+// tests, and side by side the processor overlaps them. The same visits as two traceWide calls.
+template <class BoxRay, class LeafA, class LeafB>
+void traceWidePair(const WideBvh& bvh, WideBvh::Ref start, const BoxRay& ray_a, double* tmax_a,
+                   LeafA&& leaf_a, const BoxRay& ray_b, double* tmax_b, LeafB&& leaf_b) {
+  if (start.isEmpty()) return;
+  WideWalk<BoxRay> a(bvh, start, ray_a, tmax_a), b(bvh, start, ray_b, tmax_b);
+  bool more_a = true, more_b = true;
+  while (more_a & more_b) {
+    more_a = a.step(leaf_a);
+    more_b = b.step(leaf_b);
+  }
+  while (more_a) more_a = a.step(leaf_a);
+  while (more_b) more_b = b.step(leaf_b);
 }
 
 // A ray prepared for the wide BVH (WideBoxRay) together with the exact triangle test. Every test of
