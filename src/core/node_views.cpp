@@ -16,6 +16,29 @@ using simd::CornerTangents;
 using simd::kViewSlack;
 using simd::selectPs;
 
+// Elevations: a point of a box (sensor-frame centre c, half extents e) has height in [z_lo, z_hi]
+// and horizontal distance in [rho_min, rho_max] (rho2, r2: the squares of the centre's horizontal
+// distance and of the xy extent's radius); its elevation atan2(z, rho) is largest at the top and
+// the nearest distance (the farthest if the top is below the sensor), smallest likewise.
+void storeElevations(const __m128 c[3], const __m128 e[3], __m128 rho2, __m128 r2, float* el_lo,
+                     float* el_hi) {
+  const __m128 slack = _mm_set1_ps(kViewSlack);
+  const __m128 one_minus = _mm_set1_ps(1 - 8 * kViewSlack),
+               one_plus = _mm_set1_ps(1 + 8 * kViewSlack);
+  const __m128 rho = _mm_sqrt_ps(rho2), r = _mm_sqrt_ps(r2);
+  const __m128 rho_min = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(rho, r), one_minus), _mm_setzero_ps());
+  const __m128 rho_max = _mm_mul_ps(_mm_add_ps(rho, r), one_plus);
+  const __m128 z_slack = _mm_mul_ps(slack, _mm_add_ps(absPs(c[2]), e[2]));
+  const __m128 z_lo = _mm_sub_ps(_mm_sub_ps(c[2], e[2]), z_slack);
+  const __m128 z_hi = _mm_add_ps(_mm_add_ps(c[2], e[2]), z_slack);
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 pad = _mm_set1_ps(static_cast<float>(kBearingError));
+  const __m128 hi_angle = atan2Ps(z_hi, selectPs(_mm_cmpgt_ps(z_hi, zero), rho_min, rho_max));
+  const __m128 lo_angle = atan2Ps(z_lo, selectPs(_mm_cmplt_ps(z_lo, zero), rho_min, rho_max));
+  _mm_store_ps(el_hi, _mm_add_ps(hi_angle, pad));
+  _mm_store_ps(el_lo, _mm_sub_ps(lo_angle, pad));
+}
+
 }  // namespace
 
 ViewFrame::ViewFrame(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax)
@@ -109,24 +132,7 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewFrame& f) {
   _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
   _mm_store_ps(az_center, center);
   if (f.planar_) return;
-
-  // Elevations: a point of the box has height in [z_lo, z_hi] and horizontal distance in
-  // [rho_min, rho_max]; its elevation atan2(z, rho) is largest at the top and the nearest distance
-  // (the farthest if the top is below the sensor), smallest likewise.
-  const __m128 one_minus = _mm_set1_ps(1 - 8 * kViewSlack),
-               one_plus = _mm_set1_ps(1 + 8 * kViewSlack);
-  const __m128 rho = _mm_sqrt_ps(rho2), r = _mm_sqrt_ps(r2);
-  const __m128 rho_min = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(rho, r), one_minus), _mm_setzero_ps());
-  const __m128 rho_max = _mm_mul_ps(_mm_add_ps(rho, r), one_plus);
-  const __m128 z_slack = _mm_mul_ps(slack, _mm_add_ps(absPs(c[2]), e[2]));
-  const __m128 z_lo = _mm_sub_ps(_mm_sub_ps(c[2], e[2]), z_slack);
-  const __m128 z_hi = _mm_add_ps(_mm_add_ps(c[2], e[2]), z_slack);
-  const __m128 zero = _mm_setzero_ps();
-  const __m128 pad = _mm_set1_ps(static_cast<float>(kBearingError));
-  const __m128 hi_angle = atan2Ps(z_hi, selectPs(_mm_cmpgt_ps(z_hi, zero), rho_min, rho_max));
-  const __m128 lo_angle = atan2Ps(z_lo, selectPs(_mm_cmplt_ps(z_lo, zero), rho_min, rho_max));
-  _mm_store_ps(el_hi, _mm_add_ps(hi_angle, pad));
-  _mm_store_ps(el_lo, _mm_sub_ps(lo_angle, pad));
+  storeElevations(c, e, rho2, r2, el_lo, el_hi);
 }
 
 int planeMask(const WideBvh::Node& node, const ViewFrame& f) {
