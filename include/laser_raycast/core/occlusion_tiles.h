@@ -44,8 +44,9 @@ class OcclusionTiles {
   // The beam at (row, col) hit something at `range` (rounded up), nearer than before.
   void lower(int row, int col, float range) {
     ranges()[static_cast<std::size_t>(row) * padded_cols_ + col] = range;
-    Block& b = block(row, col / kFineWidth);
-    b.fine_stale[fineSlot(row, col / kFineWidth)] = 1;
+    const int tile = static_cast<int>(static_cast<unsigned>(col) / kFineWidth);
+    Block& b = block(row, tile);
+    b.fine_stale[fineSlot(row, tile)] = 1;
     b.coarse_stale = 1;
   }
   // False only if every beam in rect has a range below `near` (so nothing at distance >= near can
@@ -75,13 +76,17 @@ class OcclusionTiles {
   // and in a one-row scan whole coarse tiles by theirs.
   bool anyOpenInRow(int row_index, int first, int last, float near) const {
     const float* r = row(row_index);
-    const int t_lo = first / kFineWidth, t_hi = last / kFineWidth;
+    // (Columns and tiles are never negative: unsigned, the divisions are shifts.)
+    const int t_lo = static_cast<int>(static_cast<unsigned>(first) / kFineWidth);
+    const int t_hi = static_cast<int>(static_cast<unsigned>(last) / kFineWidth);
     if (t_lo != t_hi) {
       if (chunkOpen(r, first, t_lo * kFineWidth + kFineWidth - 1, near)) return true;
       for (int t = t_lo + 1; t < t_hi;) {
         // Written so that NaN counts as open.
-        if (rows_ == 1 && t % kFinePerCoarse == 0 && t + kFinePerCoarse <= t_hi) {
-          if (!(coarseMax(0, t / kFinePerCoarse) < near)) return true;
+        if (rows_ == 1 && static_cast<unsigned>(t) % kFinePerCoarse == 0 &&
+            t + kFinePerCoarse <= t_hi) {
+          if (!(coarseMax(0, static_cast<int>(static_cast<unsigned>(t) / kFinePerCoarse)) < near))
+            return true;
           t += kFinePerCoarse;
         } else {
           if (!(fineMax(row_index, t) < near)) return true;
@@ -149,12 +154,16 @@ class OcclusionTiles {
     float coarse_max;
     char coarse_stale;
   };
+  // (Rows and tiles are never negative: unsigned, their divisions and remainders are shifts and
+  // masks.)
   Block& block(int row, int fine_tile) const {
-    return blocks_[static_cast<std::size_t>(row / kCoarseRings) * coarse_cols_ +
-                   fine_tile / kFinePerCoarse];
+    return blocks_[static_cast<std::size_t>(static_cast<unsigned>(row) / kCoarseRings) *
+                       coarse_cols_ +
+                   static_cast<unsigned>(fine_tile) / kFinePerCoarse];
   }
   static int fineSlot(int row, int fine_tile) {
-    return (row % kCoarseRings) * kFinePerCoarse + fine_tile % kFinePerCoarse;
+    return static_cast<int>((static_cast<unsigned>(row) % kCoarseRings) * kFinePerCoarse +
+                            static_cast<unsigned>(fine_tile) % kFinePerCoarse);
   }
 
   // The ranges, rows_ x padded_cols_, a row in whole fine tiles of one cache line each.
