@@ -354,5 +354,44 @@ TEST(FloatRounding, BelowIsTheNearestFloatNotAbove) {
   }
 }
 
+// A walk's cull limit (WideSlabRay::cullLimit) is never nearer than the far limit it is given,
+// widened as the box tests need (by 64 epsilon of the limit and of the ray's reach), and at most a
+// few floats beyond that: across subnormal, tiny, huge (beyond the floats: +inf) and negative
+// limits.
+TEST(FloatRounding, CullLimitIsNeverNearerThanTheWidenedLimit) {
+  const float kFloatInf = std::numeric_limits<float>::infinity();
+  const Eigen::Vector3d half(3, 2, 1);
+  core::Ray ray;
+  ray.origin = Eigen::Vector3d(0.5, -0.25, 0.125);
+  ray.dir = Eigen::Vector3d(1, 2, 2).normalized();
+  ray.tmin = 0;
+  ray.tmax = kInf;
+  core::Aabb bounds;
+  bounds.grow(-half);
+  bounds.grow(half);
+  const core::WideBoxRay box(ray, bounds);
+  // The reach the ray works with: the largest coordinate distance from its origin to the box (3.5,
+  // along x) over the largest component of its direction.
+  const double reach = 3.5 / ray.dir.cwiseAbs().maxCoeff();
+  Rng rng(9);
+  std::vector<double> ts = {0.0, -0.0, 1e-46, -1e-46, 1e-300, 1e-38, 0.1, 1.0, 3e38, -5.0};
+  for (int i = 0; i < 100000; ++i) {
+    // (Negative limits below the largest float's negative round to -inf: nothing is entered.)
+    ts.push_back(i % 8 ? std::pow(10.0, uniform(rng, -48, 39))
+                       : -std::pow(10.0, uniform(rng, -48, 38)));
+  }
+  for (const double t : ts) {
+    const double widened = t + (std::abs(t) + reach) * 64 * std::numeric_limits<double>::epsilon();
+    const float cull = box.cullLimit(t);
+    ASSERT_GE(double(cull), widened) << t;
+    // Not looser than four floats above the widened limit.
+    float bound = core::floatAbove(widened);
+    for (int k = 0; k < 4; ++k) bound = std::nextafter(bound, kFloatInf);
+    ASSERT_LE(cull, bound) << t;
+  }
+  EXPECT_EQ(box.cullLimit(kInf), kFloatInf);
+  EXPECT_TRUE(std::isnan(box.cullLimit(std::numeric_limits<double>::quiet_NaN())));
+}
+
 }  // namespace
 }  // namespace laser_raycast_test

@@ -176,8 +176,12 @@ class WideSlabRay {
 
   // The box cull limit for a far limit tmax: widened as BvhT::traverse does (a hit's t and its
   // box's entry and exit round differently).
+  // Rounded up to float by widening once more (by 2^-23 relative, and a little absolute for the
+  // subnormals) and rounding to nearest, which never lands below: cheaper than floatAbove, and
+  // the limit only needs to be no nearer than the widened one.
   LASER_RAYCAST_HOT_INLINE float cullLimit(double tmax) const {
-    return floatAbove(tmax + (std::abs(tmax) + reach_) * kWiden);
+    const double widened = tmax + (std::abs(tmax) + reach_) * kWiden;
+    return static_cast<float>(widened + std::abs(widened) * 0x1p-23 + 0x1p-140);
   }
   // The children of node that the ray enters at or before `cull` (bit k for child k), and where
   // (t_entry[k]; meaningful for the children entered).
