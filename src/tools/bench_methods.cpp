@@ -216,11 +216,15 @@ double median(std::vector<double> values) {
 
 int firstPass(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
               std::vector<double>* dist, double min_batch_seconds) {
-  const auto start = std::chrono::steady_clock::now();
+  // The first pass may build what the method keeps between passes (the caster's scene index and
+  // kept slices): the batch is sized from a second one, which is what a timed pass costs.
   pass(w, rays, dist);
-  const double first =
+  std::vector<double> scratch(dist->size());
+  const auto start = std::chrono::steady_clock::now();
+  pass(w, rays, &scratch);
+  const double second =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return std::max(1, static_cast<int>(std::ceil(min_batch_seconds / std::max(first, 1e-9))));
+  return std::max(1, static_cast<int>(std::ceil(min_batch_seconds / std::max(second, 1e-9))));
 }
 
 double timeBatches(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,

@@ -82,8 +82,9 @@ std::vector<std::string> coreMethodNames();
 // The median of values (the upper one of an even count); values must not be empty.
 double median(std::vector<double> values);
 
-// Runs pass once over rays (warming caches; its result is kept in dist) and returns how many
-// passes a batch needs to last at least min_batch_seconds.
+// Runs pass twice over rays (warming caches and building what the method keeps; the first
+// result is kept in dist) and returns how many passes, timed as the second, a batch needs to last
+// at least min_batch_seconds.
 int firstPass(const Pass& pass, const WorkloadRays& w, const std::vector<int>& rays,
               std::vector<double>* dist, double min_batch_seconds);
 // Times `reps` batches of per_batch passes; returns the median seconds per pass. Single-threaded,
