@@ -44,7 +44,7 @@ class OcclusionTiles {
   // The beam at (row, col) hit something at `range` (rounded up), nearer than before.
   void lower(int row, int col, float range) {
     ranges()[static_cast<std::size_t>(row) * padded_cols_ + col] = range;
-    const int tile = static_cast<int>(static_cast<unsigned>(col) / kFineWidth);
+    const int tile = quotient(col, kFineWidth);
     Block& b = block(row, tile);
     b.fine_stale[fineSlot(row, tile)] = 1;
     b.coarse_stale = 1;
@@ -76,17 +76,13 @@ class OcclusionTiles {
   // and in a one-row scan whole coarse tiles by theirs.
   bool anyOpenInRow(int row_index, int first, int last, float near) const {
     const float* r = row(row_index);
-    // (Columns and tiles are never negative: unsigned, the divisions are shifts.)
-    const int t_lo = static_cast<int>(static_cast<unsigned>(first) / kFineWidth);
-    const int t_hi = static_cast<int>(static_cast<unsigned>(last) / kFineWidth);
+    const int t_lo = quotient(first, kFineWidth), t_hi = quotient(last, kFineWidth);
     if (t_lo != t_hi) {
       if (chunkOpen(r, first, t_lo * kFineWidth + kFineWidth - 1, near)) return true;
       for (int t = t_lo + 1; t < t_hi;) {
         // Written so that NaN counts as open.
-        if (rows_ == 1 && static_cast<unsigned>(t) % kFinePerCoarse == 0 &&
-            t + kFinePerCoarse <= t_hi) {
-          if (!(coarseMax(0, static_cast<int>(static_cast<unsigned>(t) / kFinePerCoarse)) < near))
-            return true;
+        if (rows_ == 1 && remainder(t, kFinePerCoarse) == 0 && t + kFinePerCoarse <= t_hi) {
+          if (!(coarseMax(0, quotient(t, kFinePerCoarse)) < near)) return true;
           t += kFinePerCoarse;
         } else {
           if (!(fineMax(row_index, t) < near)) return true;
@@ -154,16 +150,21 @@ class OcclusionTiles {
     float coarse_max;
     char coarse_stale;
   };
-  // (Rows and tiles are never negative: unsigned, their divisions and remainders are shifts and
-  // masks.)
+  // Quotient and remainder of a row, column or tile index (never negative) by a power of two:
+  // taken unsigned, they are a shift and a mask, without signed division's fix-ups (every hit
+  // finds its tile).
+  static int quotient(int index, int by) {
+    return static_cast<int>(static_cast<unsigned>(index) / static_cast<unsigned>(by));
+  }
+  static int remainder(int index, int by) {
+    return static_cast<int>(static_cast<unsigned>(index) % static_cast<unsigned>(by));
+  }
   Block& block(int row, int fine_tile) const {
-    return blocks_[static_cast<std::size_t>(static_cast<unsigned>(row) / kCoarseRings) *
-                       coarse_cols_ +
-                   static_cast<unsigned>(fine_tile) / kFinePerCoarse];
+    return blocks_[static_cast<std::size_t>(quotient(row, kCoarseRings)) * coarse_cols_ +
+                   quotient(fine_tile, kFinePerCoarse)];
   }
   static int fineSlot(int row, int fine_tile) {
-    return static_cast<int>((static_cast<unsigned>(row) % kCoarseRings) * kFinePerCoarse +
-                            static_cast<unsigned>(fine_tile) % kFinePerCoarse);
+    return remainder(row, kCoarseRings) * kFinePerCoarse + remainder(fine_tile, kFinePerCoarse);
   }
 
   // The ranges, rows_ x padded_cols_, a row in whole fine tiles of one cache line each.

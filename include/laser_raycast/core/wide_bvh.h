@@ -175,10 +175,10 @@ class WideSlabRay {
   }
 
   // The box cull limit for a far limit tmax: widened as BvhT::traverse does (a hit's t and its
-  // box's entry and exit round differently).
-  // Rounded up to float by widening once more (by 2^-23 relative, and a little absolute for the
-  // subnormals) and rounding to nearest, which never lands below: cheaper than floatAbove, and
-  // the limit only needs to be no nearer than the widened one.
+  // box's entry and exit round differently), then taken to float no nearer than that: widened
+  // once more by 2^-23 relative (twice a float's relative rounding) and 2^-140 (above the
+  // subnormals' rounding of 2^-150) and rounded to nearest, which cannot land below it. Cheaper
+  // than floatAbove's bit step.
   LASER_RAYCAST_HOT_INLINE float cullLimit(double tmax) const {
     const double widened = tmax + (std::abs(tmax) + reach_) * kWiden;
     return static_cast<float>(widened + std::abs(widened) * 0x1p-23 + 0x1p-140);
