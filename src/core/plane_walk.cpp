@@ -45,6 +45,7 @@ class SliceWalk {
     inverse_ << plane.d / det, -plane.b / det, -plane.c / det, plane.a / det;
     origin_.emplace(-(inverse_ * Eigen::Vector2d(plane.tx, plane.ty)), slice.tree.bounds(),
                     config.tmin);
+    stack_.reserve(256);  // room for most walks: it would grow four or five times a scan
   }
 
   void run(const BeamRect& within) {
@@ -70,34 +71,50 @@ class SliceWalk {
 
   void walk() {
     while (!stack_.empty()) {
-      const Entry e = stack_.back();
+      Entry e = stack_.back();
       stack_.pop_back();
-      if (!beams_.anyOpen(e.rect, e.near)) continue;  // hidden behind nearer hits
-      if (e.ref.isLeaf()) {
-        for (std::uint32_t i = e.ref.index; i < e.ref.index + e.ref.count; ++i) {
-          testItem(slice_.items[i], e.rect, e.near);
+      // The nearest child of an expanded node goes on at once, without a round trip through the
+      // stack.
+      while (beams_.anyOpen(e.rect, e.near)) {  // else hidden behind nearer hits
+        if (e.ref.isLeaf()) {
+          for (std::uint32_t i = e.ref.index; i < e.ref.index + e.ref.count; ++i) {
+            testItem(slice_.items[i], e.rect, e.near);
+          }
+          break;
         }
-      } else if (e.rect.beams() <= kTraceBeams) {
-        traceRect(e);
-      } else {
-        expand(e);
+        if (e.rect.beams() <= kTraceBeams) {
+          traceRect(e);
+          break;
+        }
+        if (!expand(&e)) break;
       }
     }
   }
 
  private:
-  void expand(const Entry& e) {
+  // Replaces *entry by the nearest of its node's children that may be seen in its window, after
+  // pushing the others, farthest first; false if there is none.
+  bool expand(Entry* entry) {
+    const Entry e = *entry;
     const WideBvh::Node& node = slice_.wide.nodes()[e.ref.index];
     PlaneViews views;
     views.compute(node, views_);
-    Entry children[4 * 3];  // a child's view may wrap into several rects
+    // The children's windows, field by field (a child's view may wrap into several windows).
+    constexpr int kMax = 4 * 3;
+    int child[kMax], lo[kMax], hi[kMax];
+    float near[kMax];
     int n = 0;
     for (int k = 0; k < WideBvh::kWidth; ++k) {
       if (!(views.mask & (1 << k))) continue;
       auto add = [&](int first, int last) {
-        const int lo = std::max(first, e.rect.col_lo), hi = std::min(last, e.rect.col_hi);
-        if (lo <= hi && n < 12)
-          children[n++] = Entry{node.child(k), BeamRect{0, 0, lo, hi}, views.near[k]};
+        const int l = std::max(first, e.rect.col_lo), h = std::min(last, e.rect.col_hi);
+        if (l <= h && n < kMax) {
+          child[n] = k;
+          lo[n] = l;
+          hi[n] = h;
+          near[n] = views.near[k];
+          ++n;
+        }
       };
       if (views.columns_known & (1 << k)) {
         add(views.col_lo[k], views.col_hi[k]);
@@ -107,8 +124,15 @@ class SliceWalk {
         beams_.forEachColumnRange(views.az_center[k], views.az_half[k], add);
       }
     }
-    sortFarthestFirst(children, n);
-    stack_.insert(stack_.end(), children, children + n);
+    if (n == 0) return false;
+    int order[kMax];
+    sortFarthestFirst(near, order, n);
+    auto childEntry = [&](int j) {
+      return Entry{node.child(child[j]), BeamRect{0, 0, lo[j], hi[j]}, near[j]};
+    };
+    for (int i = 0; i + 1 < n; ++i) stack_.push_back(childEntry(order[i]));
+    *entry = childEntry(order[n - 1]);
+    return true;
   }
 
   // The body's pose relative to the sensor.

@@ -393,5 +393,24 @@ TEST(FloatRounding, CullLimitIsNeverNearerThanTheWidenedLimit) {
   EXPECT_TRUE(std::isnan(box.cullLimit(std::numeric_limits<double>::quiet_NaN())));
 }
 
+// The children's order as indices (sortFarthestFirst over their distances) is the order a stable
+// sort, farthest first, gives: ties keep their order, every index appears once. Random distances
+// with many ties, 0 to 12 children.
+TEST(ChildOrder, IndicesAreFarthestFirstAndStable) {
+  Rng rng(17);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int n = trial % 13;
+    float near[12];
+    for (int j = 0; j < n; ++j) near[j] = static_cast<float>(std::floor(uniform(rng, 0, 4)));
+    int order[12];
+    core::sortFarthestFirst(near, order, n);
+    std::vector<int> expected(n);
+    for (int j = 0; j < n; ++j) expected[j] = j;
+    std::stable_sort(expected.begin(), expected.end(),
+                     [&](int a, int b) { return near[a] > near[b]; });
+    ASSERT_TRUE(std::equal(expected.begin(), expected.end(), order)) << "trial " << trial;
+  }
+}
+
 }  // namespace
 }  // namespace laser_raycast_test

@@ -263,6 +263,17 @@ void sortFarthestFirst(Entry* entries, int n) {
   }
 }
 
+// The same order as indices into near[0, n) (order[0] the farthest), for entries kept field by
+// field: sorting whole entries just written reads them back across their fields' stores, which the
+// processor cannot forward and waits for.
+inline void sortFarthestFirst(const float* near, int* order, int n) {
+  for (int j = 0; j < n; ++j) {
+    int i = j;
+    for (; i > 0 && near[order[i - 1]] < near[j]; --i) order[i] = order[i - 1];
+    order[i] = j;
+  }
+}
+
 // The order a ray visits the children it enters, nearest first, without branches: the children's
 // sort keys (t_entry's bits, children not entered after every one entered; the low two bits hold
 // the child, so that keys differ) sorted farthest first by a network of five exchanges. Which of
