@@ -39,11 +39,28 @@ class BoxPrefilter {
     }
   }
 
+  // A cylinder's tube (radius r about the body's z axis) as well: a beam whose line passes farther
+  // from the axis than r misses it. The line's distance from the axis is |o x d| / |d| in x, y;
+  // the float cross product is off by at most 3 |o| kDirectionError (the directions' error and its
+  // own rounding), |d| by 2 kDirectionError, and kMargin covers the exact test's rounding at the
+  // tube's rim. So a beam is let through unless |o x d| > r' (|d| + 2 error) + 3 |o| error.
+  void addTube(const Caster::ActiveBody& a, double radius) {
+    tube_ = true;
+    const double ox = a.sensor_in_body.x(), oy = a.sensor_in_body.y();
+    ox_ = _mm_set1_ps(static_cast<float>(ox));
+    oy_ = _mm_set1_ps(static_cast<float>(oy));
+    const double r = radius * (1 + kMargin), o = std::hypot(ox, oy);
+    tube_r_ = _mm_set1_ps(static_cast<float>(r));
+    tube_pad_ =
+        _mm_set1_ps(static_cast<float>((2 * r + 3 * o) * kDirectionError + kMargin * (r + o)));
+  }
+
   // Bit j: beam j of the four (directions x, y, z; ranges rounded up) cannot hit.
   int misses(__m128 dx, __m128 dy, __m128 dz, __m128 range) const {
     const __m128 error = _mm_set1_ps(kDirectionError);
     const __m128 zero = _mm_setzero_ps();
     __m128 miss = zero;
+    __m128 body[3];  // the directions in the body's frame
     for (int i = 0; i < 3; ++i) {
       const __m128 d = _mm_add_ps(_mm_add_ps(_mm_mul_ps(r_[i][0], dx), _mm_mul_ps(r_[i][1], dy)),
                                   _mm_mul_ps(r_[i][2], dz));
@@ -53,12 +70,23 @@ class BoxPrefilter {
       const __m128 beyond = _mm_cmpgt_ps(_mm_mul_ps(gap_[i], _mm_set1_ps(1 - kMargin)),
                                          _mm_mul_ps(range, _mm_add_ps(simd::absPs(d), error)));
       miss = _mm_or_ps(miss, _mm_or_ps(away, _mm_and_ps(beyond, _mm_cmpgt_ps(gap_[i], zero))));
+      body[i] = d;
+    }
+    if (tube_) {
+      const __m128 cross =
+          simd::absPs(_mm_sub_ps(_mm_mul_ps(ox_, body[1]), _mm_mul_ps(oy_, body[0])));
+      const __m128 speed =
+          _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(body[0], body[0]), _mm_mul_ps(body[1], body[1])));
+      miss =
+          _mm_or_ps(miss, _mm_cmpgt_ps(cross, _mm_add_ps(_mm_mul_ps(tube_r_, speed), tube_pad_)));
     }
     return _mm_movemask_ps(miss);
   }
 
  private:
   __m128 r_[3][3], gap_[3], side_[3];
+  bool tube_ = false;
+  __m128 ox_, oy_, tube_r_, tube_pad_;
 };
 
 // The open beams of rect that the pre-test lets through against one primitive, analytically.
@@ -114,10 +142,11 @@ void DeferredPrimitives::cast(BeamSet& beams, const Scene& scene, const CastConf
 void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& a,
                    const CastConfig& config, const BeamRect& rect) {
   const Shape& shape = scene.bodies()[a.index].shape;
-  const BoxPrefilter filter(a, scene.boxHalf(a.index));
+  BoxPrefilter filter(a, scene.boxHalf(a.index));
   if (const auto* box = std::get_if<Box>(&shape)) {
     castShape(beams, *box, a, filter, config, rect);
   } else if (const auto* cylinder = std::get_if<Cylinder>(&shape)) {
+    filter.addTube(a, cylinder->radius);
     castShape(beams, *cylinder, a, filter, config, rect);
   } else if (const auto* sphere = std::get_if<Sphere>(&shape)) {
     castShape(beams, *sphere, a, filter, config, rect);

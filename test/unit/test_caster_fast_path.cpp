@@ -235,6 +235,46 @@ TEST(Caster, RandomScenesMatchBruteForce) {
   }
 }
 
+// Beams grazing an upright cylinder's side, where the tube's pre-test (a beam line's distance from
+// the axis, in float) decides what the exact test sees: fans of 2001 beams within 1e-6 rad of
+// each silhouette bearing, from near and far, for thin and thick cylinders, planar and in rings
+// just off the plane, against the brute force.
+TEST(Caster, BeamsGrazingACylinderMatchBruteForce) {
+  Rng rng(77);
+  int hits = 0, misses = 0;
+  for (const double distance : {0.7, 4.0, 45.0}) {
+    for (const double radius : {0.03, 0.4, 2.0}) {
+      if (radius >= distance) continue;
+      Scene scene = sceneWithFrame();
+      const double bearing = uniform(rng, -3, 3);
+      addBody(&scene, Cylinder{radius, 1.0}, 0,
+              pose(Eigen::Vector3d(distance * std::cos(bearing), distance * std::sin(bearing),
+                                   uniform(rng, -0.3, 0.3)),
+                   yaw(uniform(rng, -3, 3))));
+      const FramePoses poses = FramePoses::identity(scene);
+      const CastConfig base = config(true, 100);
+      for (const double side : {-1.0, 1.0}) {
+        const double tangent = bearing + side * std::asin(radius / distance);
+        const ScanPattern planar(fanBySamples(tangent - 1e-6, tangent + 1e-6, 2001));
+        const ScanPattern rings(fanBySamples(tangent - 1e-6, tangent + 1e-6, 2001),
+                                {-0.01, 0.0, 0.02});
+        for (const ScanPattern* pattern : {&planar, &rings}) {
+          const auto truth =
+              bruteForce(scene, poses, Eigen::Isometry3d::Identity(), *pattern, base);
+          for (const auto& t : truth) (std::isfinite(t.t) ? hits : misses) += 1;
+          expectMatchesTruth(
+              cast(scene, poses, Eigen::Isometry3d::Identity(), *pattern, base), truth, 1e-9,
+              "distance " + std::to_string(distance) + " radius " + std::to_string(radius));
+          if (HasFatalFailure()) return;
+        }
+      }
+    }
+  }
+  // The fans straddle the silhouettes: both kinds of beam are there.
+  EXPECT_GT(hits, 1000);
+  EXPECT_GT(misses, 1000);
+}
+
 // A room of primitives as a warehouse builds one: floor, roof and walls (large for their distance,
 // so the walk casts them after everything else, over beams mostly closed by then), and clutter
 // that stands in the floor and against the walls, so that many beams first hit something just
