@@ -206,7 +206,9 @@ class SliceWalk {
       const PlaneSlice::Item& item = slice_.items[i];
       (*cast_)[item.body].store(1, std::memory_order_relaxed);
       if (item.slot == PlaneSlice::kPrimitive) {
-        castPrimitiveItem(item.body, BeamRect{0, 0, b->col, b->col});
+        Caster::ActiveBody a = activeBody(scene_, item.body, sensor_from_frame_);
+        placeSensorInBody(&a);
+        castPrimitiveBeam(beams_, scene_, a, config_, 0, b->col);
         b->tmax = std::min(b->tmax, beams_.range(0, b->col));
         return;
       }

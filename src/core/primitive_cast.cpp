@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <type_traits>
+#include <variant>
 
 #include "laser_raycast/core/primitives.h"
 #include "laser_raycast/core/simd_math.h"
@@ -89,6 +91,23 @@ class BoxPrefilter {
   __m128 ox_, oy_, tube_r_, tube_pad_;
 };
 
+// One beam (its range so far: current) against the primitive, analytically: every hit of a beam on
+// a primitive is found here.
+template <class Primitive>
+void testBeam(BeamSet& beams, const Primitive& shape, const Caster::ActiveBody& a,
+              const CastConfig& config, int row, int col, double current) {
+  Ray ray;
+  ray.origin = a.sensor_in_body;
+  ray.dir = a.body_from_sensor_rot * beams.direction(row, col);
+  ray.tmin = config.tmin;
+  ray.tmax = std::min(config.tmax, current);
+  // The beams are valid rays (a unit direction, a finite pose): no check needed.
+  const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
+  if (!hit) return;
+  beams.offer(row, col, hit->t, a.index, -1,
+              [&] { return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal); });
+}
+
 // The open beams of rect that the pre-test lets through against one primitive, analytically.
 template <class Primitive>
 void castShape(BeamSet& beams, const Primitive& shape, const Caster::ActiveBody& a,
@@ -111,17 +130,7 @@ void castShape(BeamSet& beams, const Primitive& shape, const Caster::ActiveBody&
         open &= open - 1;
         if (col < rect.col_lo || col > rect.col_hi) continue;
         const double current = beams.range(row, col);
-        if (!(current >= a.view.near)) continue;
-        Ray ray;
-        ray.origin = a.sensor_in_body;
-        ray.dir = a.body_from_sensor_rot * beams.direction(row, col);
-        ray.tmin = config.tmin;
-        ray.tmax = std::min(config.tmax, current);
-        // The beams are valid rays (a unit direction, a finite pose): no check needed.
-        const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
-        if (!hit) continue;
-        beams.offer(row, col, hit->t, a.index, -1,
-                    [&] { return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal); });
+        if (current >= a.view.near) testBeam(beams, shape, a, config, row, col, current);
       }
     }
   }
@@ -151,6 +160,20 @@ void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody&
   } else if (const auto* sphere = std::get_if<Sphere>(&shape)) {
     castShape(beams, *sphere, a, filter, config, rect);
   }
+}
+
+void castPrimitiveBeam(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& a,
+                       const CastConfig& config, int row, int col) {
+  const double current = beams.range(row, col);
+  if (std::isnan(current)) return;  // a beam that could not be cast, as castShape skips it
+  std::visit(
+      [&](const auto& shape) {
+        using S = std::decay_t<decltype(shape)>;
+        if constexpr (!std::is_same_v<S, std::shared_ptr<const Mesh>>) {
+          testBeam(beams, shape, a, config, row, col, current);
+        }
+      },
+      scene.bodies()[a.index].shape);
 }
 
 }  // namespace core

@@ -147,12 +147,16 @@ Caster::ActiveBody activeBody(const Scene& scene, int index,
   return a;
 }
 
+void placeSensorInBody(Caster::ActiveBody* a) {
+  a->body_from_sensor_rot = a->sensor_from_body.linear().transpose();
+  a->sensor_in_body = -(a->body_from_sensor_rot * a->sensor_from_body.translation());
+}
+
 void viewActiveBody(const Scene& scene, double angle_min, bool elevations, Caster::ActiveBody* a) {
   const Eigen::Matrix3d& rot = a->sensor_from_body.linear();
   a->view = boxView(scene.boxCenter(a->index), scene.boxHalf(a->index), rot, rot.cwiseAbs(),
                     a->sensor_from_body.translation(), angle_min, elevations);
-  a->body_from_sensor_rot = rot.transpose();
-  a->sensor_in_body = -(a->body_from_sensor_rot * a->sensor_from_body.translation());
+  placeSensorInBody(a);
 }
 
 void castGroup(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "cast_reference.h"
@@ -72,6 +73,47 @@ TEST(PlaneSlice, KeptSlicesNeverChangeAResult) {
   }
   EXPECT_GT(kept, 100);
   EXPECT_GT(hits, 10000);
+}
+
+// A field of small primitives as a warehouse's barrels and crates (upright and tilted cylinders,
+// boxes, spheres, near and far): a kept slice's walk meets many of them with one traced beam at a
+// time, and must find what a fresh cut finds, bit for bit, and what the brute force finds.
+TEST(PlaneSlice, SmallPrimitivesThroughKeptSlices) {
+  Rng rng(67);
+  RandomScene rs;
+  core::Scene& scene = rs.scene;
+  scene.addFrame("world");
+  scene.addLabel("clutter");
+  for (int i = 0; i < 1200; ++i) {
+    const Eigen::Vector3d at(uniform(rng, -25, 25), uniform(rng, -25, 25), uniform(rng, -0.3, 0.3));
+    const Eigen::Matrix3d turn =
+        i % 2 ? yaw(uniform(rng, -M_PI, M_PI)) : randomRotation(rng).toRotationMatrix();
+    const Eigen::Isometry3d p = pose(at, turn);
+    if (i % 3 == 0) addBody(&scene, core::Cylinder{uniform(rng, 0.02, 0.25), 1.0}, 0, p);
+    if (i % 3 == 1) {
+      addBody(&scene,
+              core::Box{Eigen::Vector3d(uniform(rng, 0.04, 0.4), uniform(rng, 0.04, 0.4), 1.0)}, 0,
+              p);
+    }
+    if (i % 3 == 2) addBody(&scene, core::Sphere{uniform(rng, 0.04, 0.25)}, 0, p);
+  }
+  rs.poses = core::FramePoses::identity(scene);
+  const core::ScanPattern pattern(fanBySamples(-2.35, 2.35, 1081));
+  const core::CastConfig cfg = config(true, 40.0);
+  core::Caster caster;
+  int kept = 0, hits = 0;
+  for (int cast = 0; cast < 8; ++cast) {
+    const Eigen::Isometry3d sensor = onTheFloor(rng, 0.0);
+    const core::ScanResult& r = caster.cast(scene, rs.poses, sensor, pattern, cfg);
+    kept += r.stats.kept_slices;
+    expectSameBits(castFresh(rs, sensor, pattern, cfg), r, "small primitives");
+    expectMatchesTruth(r, bruteForce(scene, rs.poses, sensor, pattern, cfg), 1e-9,
+                       "cast " + std::to_string(cast));
+    for (const double range : r.range) hits += std::isfinite(range);
+    if (HasFailure()) return;
+  }
+  EXPECT_GE(kept, 7);
+  EXPECT_GT(hits, 8 * 1081 / 2);
 }
 
 // A tilting sensor meets a new plane every scan: nothing is kept, and nothing changes.

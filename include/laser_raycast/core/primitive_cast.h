@@ -33,6 +33,10 @@ class DeferredPrimitives {
 // Casts the open beams of rect against the primitive body active.index of scene.
 void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& active,
                    const CastConfig& config, const BeamRect& rect);
+// The same for one beam, by the exact test alone (for one beam the view and the pre-test cost more
+// than they save). Needs only active's pose and sensor_in_body (placeSensorInBody, scene_walk.h).
+void castPrimitiveBeam(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& active,
+                       const CastConfig& config, int row, int col);
 
 }  // namespace core
 }  // namespace laser_raycast
