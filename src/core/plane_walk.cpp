@@ -95,8 +95,9 @@ class SliceWalk {
   // Replaces *entry by the nearest of its node's children that may be seen in its window, after
   // pushing the others, farthest first; false if there is none.
   bool expand(Entry* entry) {
-    const Entry e = *entry;
-    const WideBvh::Node& node = slice_.wide.nodes()[e.ref.index];
+    // Only the fields needed, not the whole entry: it was just written field by field.
+    const WideBvh::Node& node = slice_.wide.nodes()[entry->ref.index];
+    const int col_lo = entry->rect.col_lo, col_hi = entry->rect.col_hi;
     PlaneViews views;
     views.compute(node, views_);
     // The children's windows, field by field (a child's view may wrap into several windows).
@@ -107,7 +108,7 @@ class SliceWalk {
     for (int k = 0; k < WideBvh::kWidth; ++k) {
       if (!(views.mask & (1 << k))) continue;
       auto add = [&](int first, int last) {
-        const int l = std::max(first, e.rect.col_lo), h = std::min(last, e.rect.col_hi);
+        const int l = std::max(first, col_lo), h = std::min(last, col_hi);
         if (l <= h && n < kMax) {
           child[n] = k;
           lo[n] = l;
@@ -119,7 +120,7 @@ class SliceWalk {
       if (views.columns_known & (1 << k)) {
         add(views.col_lo[k], views.col_hi[k]);
       } else if (!(views.az_half[k] >= 0)) {
-        add(e.rect.col_lo, e.rect.col_hi);
+        add(col_lo, col_hi);
       } else {
         beams_.forEachColumnRange(views.az_center[k], views.az_half[k], add);
       }
