@@ -60,7 +60,7 @@ class SlotCache {
 template <TriangleMethod M>
 class MeshWalk {
  public:
-  MeshWalk(BeamSet& beams, const Mesh& mesh, const Caster::ActiveBody& active,
+  MeshWalk(BeamSet& beams, const Mesh& mesh, const PlacedBody& active,
            const CastConfig& config)
       : beams_(beams),
         mesh_(mesh),
@@ -366,7 +366,7 @@ class MeshWalk {
   const WideBvh& wide_;
   const std::vector<std::array<Eigen::Vector3d, 3>>& slots_;
   const std::vector<std::uint32_t>& ids_;
-  const Caster::ActiveBody& active_;
+  const PlacedBody& active_;
   const CastConfig& config_;
   const Eigen::Matrix3d rot_, abs_rot_;
   const Eigen::Vector3d trans_;
@@ -383,7 +383,7 @@ class MeshWalk {
 
 }  // namespace
 
-void castBody(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& active,
+void castBody(BeamSet& beams, const Scene& scene, const PlacedBody& active,
               const CastConfig& config, const BeamRect& within) {
   const Body& body = scene.bodies()[active.index];
   const auto* mesh = std::get_if<std::shared_ptr<const Mesh>>(&body.shape);

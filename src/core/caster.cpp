@@ -1,10 +1,15 @@
 #include "laser_raycast/core/caster.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include "laser_raycast/core/beam_set.h"
 #include "laser_raycast/core/beam_window.h"
@@ -12,6 +17,7 @@
 #include "laser_raycast/core/plane_slice.h"
 #include "laser_raycast/core/plane_walk.h"
 #include "laser_raycast/core/pose.h"
+#include "laser_raycast/core/scene_index.h"
 #include "laser_raycast/core/scene_walk.h"
 #include "laser_raycast/core/thread_pool.h"
 
@@ -72,82 +78,44 @@ std::vector<BeamRect> cutPieces(int rows, int columns, int threads) {
   return pieces;
 }
 
-}  // namespace
 
-void CastConfig::validate() const {
-  std::ostringstream msg;
-  if (!(std::isfinite(tmin) && tmin >= 0)) {
-    msg << "tmin must be finite and >= 0, got " << tmin;
-  } else if (!(tmax > tmin)) {
-    msg << "tmax (" << tmax << " m) must be greater than tmin (" << tmin << " m)";
-  } else if (threads < 0 || threads > CastConfig::kMaxThreads) {
-    msg << "threads must be in [0, " << CastConfig::kMaxThreads << "] (0: every core), got "
-        << threads;
-  } else {
-    return;
+// What a result was computed from: if all of it is equal, the result is too.
+struct ReuseKey {
+  std::uint64_t scene_version = 0;
+  CastConfig config;
+  double angle_min = 0, angle_increment = 0;
+  int azimuths = 0;
+  std::vector<double> elevations;
+  std::vector<Eigen::Isometry3d> sensor_from_frame;  // meaningful where valid
+  std::vector<char> valid;
+
+  bool operator==(const ReuseKey& o) const {
+    if (scene_version != o.scene_version || !(config == o.config) || angle_min != o.angle_min ||
+        angle_increment != o.angle_increment || azimuths != o.azimuths ||
+        elevations != o.elevations || valid != o.valid) {
+      return false;
+    }
+    for (std::size_t f = 0; f < sensor_from_frame.size(); ++f) {
+      if (valid[f] && sensor_from_frame[f].matrix() != o.sensor_from_frame[f].matrix()) {
+        return false;
+      }
+    }
+    return true;
   }
-  throw std::invalid_argument(msg.str());
-}
+};
 
-bool CastConfig::operator==(const CastConfig& o) const {
-  return method == o.method && cull_backfaces == o.cull_backfaces && tmin == o.tmin &&
-         tmax == o.tmax && planar_fast_path == o.planar_fast_path &&
-         raster_fast_path == o.raster_fast_path && occlusion_culling == o.occlusion_culling &&
-         plane_cache == o.plane_cache && compute_incidence == o.compute_incidence;
-}
-
-Caster::Caster() : beams_(std::make_unique<BeamSet>()) {}
-Caster::~Caster() = default;
-Caster::Caster(Caster&&) noexcept = default;
-Caster& Caster::operator=(Caster&&) noexcept = default;
-
-bool Caster::ReuseKey::operator==(const ReuseKey& o) const {
-  if (scene_version != o.scene_version || !(config == o.config) || angle_min != o.angle_min ||
-      angle_increment != o.angle_increment || azimuths != o.azimuths ||
-      elevations != o.elevations || valid != o.valid) {
-    return false;
-  }
-  for (std::size_t f = 0; f < sensor_from_frame.size(); ++f) {
-    if (valid[f] && sensor_from_frame[f].matrix() != o.sensor_from_frame[f].matrix()) return false;
-  }
-  return true;
-}
-
-const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
-                               const Eigen::Isometry3d& world_from_sensor,
-                               const ScanPattern& pattern, const CastConfig& config) {
-  config.validate();
-  const std::size_t frame_count = scene.frames().size();
-  if (poses.pose.size() != frame_count || poses.valid.size() != frame_count) {
-    std::ostringstream msg;
-    msg << "FramePoses has " << poses.pose.size() << " poses for a scene of " << frame_count
-        << " frames";
-    throw std::invalid_argument(msg.str());
-  }
-  const bool sensor_ok = isValidPose(world_from_sensor);
-  ReuseKey key = relativeInputs(scene, poses, world_from_sensor, pattern, config);
-  if (sensor_ok && previous_ && *previous_ == key) {
-    result_.stats.reused = true;
-    return result_;
-  }
-  previous_.reset();
-  resetResult(pattern.size(), static_cast<int>(scene.bodies().size()), sensor_ok,
-              config.compute_incidence);
-  if (!sensor_ok) return result_;
-
-  placeGroups(scene, key, pattern);
-  castBodies(scene, pattern, config);
-  if (config.compute_incidence) computeIncidence(pattern);
-  previous_ = std::move(key);
-  return result_;
-}
+// A scene frame with bodies this scan, with its pose in the sensor frame.
+struct PlacedGroup {
+  const SceneIndex::Group* group;
+  const Eigen::Isometry3d* sensor_from_frame;
+  double near;
+};
 
 // Every frame relative to the sensor, in double, once per scan (so that a scene far from the origin
 // loses nothing), together with everything else the result depends on.
-Caster::ReuseKey Caster::relativeInputs(const Scene& scene, const FramePoses& poses,
-                                        const Eigen::Isometry3d& world_from_sensor,
-                                        const ScanPattern& pattern,
-                                        const CastConfig& config) const {
+ReuseKey relativeInputs(const Scene& scene, const FramePoses& poses,
+                        const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
+                        const CastConfig& config) {
   const bool sensor_ok = isValidPose(world_from_sensor);
   const std::size_t frame_count = scene.frames().size();
   ReuseKey key;
@@ -168,30 +136,96 @@ Caster::ReuseKey Caster::relativeInputs(const Scene& scene, const FramePoses& po
   return key;
 }
 
-void Caster::resetResult(int beams, int bodies, bool sensor_ok, bool with_normals) {
-  result_.range.assign(beams, sensor_ok ? kInf : std::numeric_limits<double>::quiet_NaN());
-  result_.body.assign(beams, -1);
-  result_.triangle.assign(beams, -1);
+void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanResult* result) {
+  result->range.assign(beams, sensor_ok ? kInf : std::numeric_limits<double>::quiet_NaN());
+  result->body.assign(beams, -1);
+  result->triangle.assign(beams, -1);
   if (with_normals) {
-    result_.normal.assign(beams, Eigen::Vector3d::Zero());
+    result->normal.assign(beams, Eigen::Vector3d::Zero());
   } else {
-    result_.normal.clear();
+    result->normal.clear();
   }
-  result_.cos_incidence.clear();
-  result_.stats = CastStats{};
-  result_.stats.bodies = bodies;
+  result->cos_incidence.clear();
+  result->stats = CastStats{};
+  result->stats.bodies = bodies;
+}
+
+void computeIncidence(const ScanPattern& pattern, ScanResult* result) {
+  const auto& dirs = pattern.directions();
+  result->cos_incidence.assign(dirs.size(), 0.0);
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    if (result->body[i] < 0) continue;
+    result->cos_incidence[i] = std::min(1.0, std::abs(dirs[i].dot(result->normal[i])));
+  }
+}
+
+}  // namespace
+
+// What a caster keeps between casts: the scene's body trees (rebuilt when the scene changes), the
+// walk's per-scan state (kept to reuse its memory), the threads, the kept slices and the inputs of
+// the last result.
+struct Caster::State {
+  std::unique_ptr<SceneIndex> index;
+  std::vector<PlacedGroup> placed;
+  std::vector<std::atomic<char>> cast;  // per body: cast against this scan (for the stats)
+  BeamSet beams;
+  std::unique_ptr<ThreadPool> pool;           // for CastConfig::threads > 1
+  std::unique_ptr<PlaneSliceCache> planes;    // CastConfig::plane_cache
+  std::optional<ReuseKey> previous;           // the inputs of the result, if it is complete
+
+  void placeGroups(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,
+                   ScanResult* result);
+  void castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,
+                  ScanResult* result);
+};
+
+Caster::Caster() : state_(std::make_unique<State>()) {}
+Caster::~Caster() = default;
+Caster::Caster(Caster&&) noexcept = default;
+Caster& Caster::operator=(Caster&&) noexcept = default;
+
+void Caster::forget() { state_->previous.reset(); }
+
+const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
+                               const Eigen::Isometry3d& world_from_sensor,
+                               const ScanPattern& pattern, const CastConfig& config) {
+  config.validate();
+  const std::size_t frame_count = scene.frames().size();
+  if (poses.pose.size() != frame_count || poses.valid.size() != frame_count) {
+    std::ostringstream msg;
+    msg << "FramePoses has " << poses.pose.size() << " poses for a scene of " << frame_count
+        << " frames";
+    throw std::invalid_argument(msg.str());
+  }
+  const bool sensor_ok = isValidPose(world_from_sensor);
+  ReuseKey key = relativeInputs(scene, poses, world_from_sensor, pattern, config);
+  if (sensor_ok && state_->previous && *state_->previous == key) {
+    result_.stats.reused = true;
+    return result_;
+  }
+  state_->previous.reset();
+  resetResult(pattern.size(), static_cast<int>(scene.bodies().size()), sensor_ok,
+              config.compute_incidence, &result_);
+  if (!sensor_ok) return result_;
+
+  state_->placeGroups(scene, key, pattern, &result_);
+  state_->castBodies(scene, pattern, config, &result_);
+  if (config.compute_incidence) computeIncidence(pattern, &result_);
+  state_->previous = std::move(key);
+  return result_;
 }
 
 // Where each frame's body tree is this scan, nearest first; the bodies of frames without a pose
 // are skipped.
-void Caster::placeGroups(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern) {
-  if (!index_ || index_->sceneVersion() != scene.version()) {
-    index_ = std::make_unique<SceneIndex>(scene);
+void Caster::State::placeGroups(const Scene& scene, const ReuseKey& key,
+                                const ScanPattern& pattern, ScanResult* result) {
+  if (!index || index->sceneVersion() != scene.version()) {
+    index = std::make_unique<SceneIndex>(scene);
   }
-  placed_.clear();
-  for (const auto& group : index_->groups()) {
+  placed.clear();
+  for (const auto& group : index->groups()) {
     if (!key.valid[group->frame]) {
-      result_.stats.bodies_skipped += static_cast<int>(group->bodies.size());
+      result->stats.bodies_skipped += static_cast<int>(group->bodies.size());
       continue;
     }
     const Eigen::Isometry3d& pose = key.sensor_from_frame[group->frame];
@@ -199,42 +233,43 @@ void Caster::placeGroups(const Scene& scene, const ReuseKey& key, const ScanPatt
     const View view =
         boxView(bounds.center(), bounds.extent() * 0.5, pose.linear(), pose.linear().cwiseAbs(),
                 pose.translation(), pattern.angleMin(), !pattern.planar());
-    placed_.push_back(PlacedGroup{group.get(), &pose, view.near});
+    placed.push_back(PlacedGroup{group.get(), &pose, view.near});
   }
-  std::stable_sort(placed_.begin(), placed_.end(),
+  std::stable_sort(placed.begin(), placed.end(),
                    [](const PlacedGroup& a, const PlacedGroup& b) { return a.near < b.near; });
 }
 
 // Every frame's bodies, nearest frame first, against the open beams of the pattern; with threads,
 // each thread takes pieces of the pattern's columns (all rows) in turn.
-void Caster::castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config) {
-  beams_->reset(pattern, config, &result_);
+void Caster::State::castBodies(const Scene& scene, const ScanPattern& pattern,
+                               const CastConfig& config, ScanResult* result) {
+  beams.reset(pattern, config, result);
   const std::size_t bodies = scene.bodies().size();
-  if (cast_.size() != bodies) cast_ = std::vector<std::atomic<char>>(bodies);
-  for (auto& mark : cast_) mark.store(0, std::memory_order_relaxed);
-  PlaneSliceCache* planes = nullptr;
+  if (cast.size() != bodies) cast = std::vector<std::atomic<char>>(bodies);
+  for (auto& mark : cast) mark.store(0, std::memory_order_relaxed);
+  PlaneSliceCache* kept = nullptr;
   if (pattern.planar() && config.planar_fast_path && config.plane_cache) {
-    if (!planes_) planes_ = std::make_unique<PlaneSliceCache>();
-    planes_->newScan();
-    planes = planes_.get();
+    if (!planes) planes = std::make_unique<PlaneSliceCache>();
+    planes->newScan();
+    kept = planes.get();
   }
   // Planar fans: each frame's kept slice by this plane, where there is one.
   std::vector<std::pair<PlaneFrame, const PlaneSlice*>> slices;
   if (pattern.planar() && config.planar_fast_path) {
-    for (const PlacedGroup& p : placed_) {
+    for (const PlacedGroup& p : placed) {
       slices.emplace_back(PlaneFrame(*p.sensor_from_frame), nullptr);
-      if (planes) slices.back().second = planes->find(scene, *p.group, slices.back().first);
-      result_.stats.kept_slices += slices.back().second != nullptr;
+      if (kept) slices.back().second = kept->find(scene, *p.group, slices.back().first);
+      result->stats.kept_slices += slices.back().second != nullptr;
     }
   }
   auto castWithin = [&](const BeamRect& within) {
-    for (std::size_t g = 0; g < placed_.size(); ++g) {
-      const PlacedGroup& p = placed_[g];
+    for (std::size_t g = 0; g < placed.size(); ++g) {
+      const PlacedGroup& p = placed[g];
       if (g < slices.size() && slices[g].second) {
-        castSlice(*beams_, scene, *slices[g].second, slices[g].first, *p.sensor_from_frame, config,
-                  within, &cast_);
+        castSlice(beams, scene, *slices[g].second, slices[g].first, *p.sensor_from_frame, config,
+                  within, &cast);
       } else {
-        castGroup(*beams_, scene, *p.group, *p.sensor_from_frame, config, within, &cast_);
+        castGroup(beams, scene, *p.group, *p.sensor_from_frame, config, within, &cast);
       }
     }
   };
@@ -243,25 +278,16 @@ void Caster::castBodies(const Scene& scene, const ScanPattern& pattern, const Ca
   // Waking threads costs more than a small scan does: each gets at least kMinBeamsPerThread.
   threads = std::max(1, std::min(threads, pattern.size() / kMinBeamsPerThread));
   if (threads == 1) {
-    castWithin(beams_->all());
+    castWithin(beams.all());
   } else {
-    if (!pool_ || pool_->threads() != threads) pool_ = std::make_unique<ThreadPool>(threads);
+    if (!pool || pool->threads() != threads) pool = std::make_unique<ThreadPool>(threads);
     const std::vector<BeamRect> pieces =
-        cutPieces(beams_->all().row_hi + 1, pattern.azimuthCount(), threads);
-    pool_->run(static_cast<int>(pieces.size()), [&](int i) { castWithin(pieces[i]); });
+        cutPieces(beams.all().row_hi + 1, pattern.azimuthCount(), threads);
+    pool->run(static_cast<int>(pieces.size()), [&](int i) { castWithin(pieces[i]); });
   }
-  int cast = 0;
-  for (const auto& mark : cast_) cast += mark.load(std::memory_order_relaxed);
-  result_.stats.bodies_culled = static_cast<int>(bodies) - result_.stats.bodies_skipped - cast;
-}
-
-void Caster::computeIncidence(const ScanPattern& pattern) {
-  const auto& dirs = pattern.directions();
-  result_.cos_incidence.assign(dirs.size(), 0.0);
-  for (std::size_t i = 0; i < dirs.size(); ++i) {
-    if (result_.body[i] < 0) continue;
-    result_.cos_incidence[i] = std::min(1.0, std::abs(dirs[i].dot(result_.normal[i])));
-  }
+  int cast_count = 0;
+  for (const auto& mark : cast) cast_count += mark.load(std::memory_order_relaxed);
+  result->stats.bodies_culled = static_cast<int>(bodies) - result->stats.bodies_skipped - cast_count;
 }
 
 }  // namespace core

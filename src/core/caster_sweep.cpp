@@ -57,7 +57,7 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
     }
     out.stats.bodies_skipped = std::max(out.stats.bodies_skipped, r.stats.bodies_skipped);
   }
-  previous_.reset();  // a sweep is never reused, and the last single cast is not this one
+  forget();  // a sweep is never reused, and the last single cast is not this one
   result_ = std::move(out);
   return result_;
 }

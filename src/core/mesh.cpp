@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "laser_raycast/core/wide_bvh.h"
+
 namespace laser_raycast {
 namespace core {
 
@@ -52,9 +54,11 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
   std::vector<std::uint32_t> slot_component;
   slot_component.reserve(bvh_.triangleIds().size());
   for (const std::uint32_t id : bvh_.triangleIds()) slot_component.push_back(component_[id]);
-  wide_ = WideBvh(bvh_, slot_component);
+  wide_ = std::make_unique<const WideBvh>(bvh_, slot_component);
   findClosedComponents();
 }
+
+Mesh::~Mesh() = default;
 
 void Mesh::findClosedComponents() {
   component_bounds_.assign(component_count_, Aabb{});

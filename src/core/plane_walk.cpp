@@ -1,4 +1,5 @@
 #include "laser_raycast/core/plane_walk.h"
+#include "laser_raycast/core/placed_body.h"
 
 #include <algorithm>
 #include <limits>
@@ -180,8 +181,8 @@ class SliceWalk {
   // rect, or after the walk if it is large for its distance (a wall the sensor stands beside:
   // nearest first would test it with every beam before the nearer things in front of it).
   void castPrimitiveItem(int index, const BeamRect& rect) {
-    Caster::ActiveBody a = activeBody(scene_, index, sensor_from_frame_);
-    viewActiveBody(scene_, beams_.pattern().angleMin(), false, &a);
+    PlacedBody a = placeBody(scene_, index, sensor_from_frame_);
+    viewPlacedBody(scene_, beams_.pattern().angleMin(), false, &a);
     if (!(a.view.near <= config_.tmax) || !a.view.crosses) return;
     beams_.forEachRect(a.view, rect, [&](const BeamRect& r) {
       if (deferLargePrimitive(a)) {
@@ -207,7 +208,7 @@ class SliceWalk {
       const PlaneSlice::Item& item = slice_.items[i];
       (*cast_)[item.body].store(1, std::memory_order_relaxed);
       if (item.slot == PlaneSlice::kPrimitive) {
-        Caster::ActiveBody a = activeBody(scene_, item.body, sensor_from_frame_);
+        PlacedBody a = placeBody(scene_, item.body, sensor_from_frame_);
         placeSensorInBody(&a);
         castPrimitiveBeam(beams_, scene_, a, config_, 0, b->col);
         b->tmax = std::min(b->tmax, beams_.range(0, b->col));

@@ -29,7 +29,7 @@ constexpr float kDirectionError = 1e-6f;
 // enters the box before its range.
 class BoxPrefilter {
  public:
-  BoxPrefilter(const Caster::ActiveBody& a, const Eigen::Vector3d& half) {
+  BoxPrefilter(const PlacedBody& a, const Eigen::Vector3d& half) {
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) r_[i][j] = _mm_set1_ps(float(a.body_from_sensor_rot(i, j)));
       const double o = a.sensor_in_body[i];
@@ -46,7 +46,7 @@ class BoxPrefilter {
   // the float cross product is off by at most 3 |o| kDirectionError (the directions' error and its
   // own rounding), |d| by 2 kDirectionError, and kMargin covers the exact test's rounding at the
   // tube's rim. So a beam is let through unless |o x d| > r' (|d| + 2 error) + 3 |o| error.
-  void addTube(const Caster::ActiveBody& a, double radius) {
+  void addTube(const PlacedBody& a, double radius) {
     tube_ = true;
     const double ox = a.sensor_in_body.x(), oy = a.sensor_in_body.y();
     ox_ = _mm_set1_ps(static_cast<float>(ox));
@@ -94,7 +94,7 @@ class BoxPrefilter {
 // One beam (its range so far: current) against the primitive, analytically: every hit of a beam on
 // a primitive is found here.
 template <class Primitive>
-void testBeam(BeamSet& beams, const Primitive& shape, const Caster::ActiveBody& a,
+void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
               const CastConfig& config, int row, int col, double current) {
   Ray ray;
   ray.origin = a.sensor_in_body;
@@ -110,7 +110,7 @@ void testBeam(BeamSet& beams, const Primitive& shape, const Caster::ActiveBody& 
 
 // The open beams of rect that the pre-test lets through against one primitive, analytically.
 template <class Primitive>
-void castShape(BeamSet& beams, const Primitive& shape, const Caster::ActiveBody& a,
+void castShape(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
                const BoxPrefilter& filter, const CastConfig& config, const BeamRect& rect) {
   const __m128 near = _mm_set1_ps(floatBelow(a.view.near));
   for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
@@ -148,7 +148,7 @@ void DeferredPrimitives::cast(BeamSet& beams, const Scene& scene, const CastConf
   items_.clear();
 }
 
-void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& a,
+void castPrimitive(BeamSet& beams, const Scene& scene, const PlacedBody& a,
                    const CastConfig& config, const BeamRect& rect) {
   const Shape& shape = scene.bodies()[a.index].shape;
   BoxPrefilter filter(a, scene.boxHalf(a.index));
@@ -162,7 +162,7 @@ void castPrimitive(BeamSet& beams, const Scene& scene, const Caster::ActiveBody&
   }
 }
 
-void castPrimitiveBeam(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& a,
+void castPrimitiveBeam(BeamSet& beams, const Scene& scene, const PlacedBody& a,
                        const CastConfig& config, int row, int col) {
   const double current = beams.range(row, col);
   if (std::isnan(current)) return;  // a beam that could not be cast, as castShape skips it

@@ -1,4 +1,5 @@
 #include "laser_raycast/core/scene_walk.h"
+#include "laser_raycast/core/placed_body.h"
 
 #include <algorithm>
 #include <optional>
@@ -45,7 +46,7 @@ class GroupWalk {
       heap_.pop_back();
       if (!beams_.anyOpen(e.rect, e.near)) continue;  // hidden behind nearer hits
       if (e.body >= 0) {
-        const Caster::ActiveBody& a = bodies_[e.body];
+        const PlacedBody& a = bodies_[e.body];
         (*cast_)[a.index].store(1, std::memory_order_relaxed);
         if (isPrimitive(a.index) && deferLargePrimitive(a)) {
           deferred_.add(a, e.rect);
@@ -54,7 +55,7 @@ class GroupWalk {
         }
       } else if (e.ref.isLeaf()) {
         for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
-          placeBody(group_.bodies[group_.tree.triangleIds()[slot]], e.rect);
+          placeLeafBody(group_.bodies[group_.tree.triangleIds()[slot]], e.rect);
         }
       } else {
         expand(e);
@@ -95,13 +96,13 @@ class GroupWalk {
   // A body of a leaf: its pose relative to the sensor, then culled by its bounding sphere against
   // the search interval and by its box's view against the scan plane (planar fans) and the leaf's
   // beams; the rest waits its turn by its own nearest distance.
-  void placeBody(int index, const BeamRect& rect) {
+  void placeLeafBody(int index, const BeamRect& rect) {
     // The sphere first: a cheap answer for bodies out of range.
-    Caster::ActiveBody a = activeBody(scene_, index, sensor_from_frame_);
+    PlacedBody a = placeBody(scene_, index, sensor_from_frame_);
     const double dist = a.center.norm();
     const double slack = kWindowSlack * (dist + a.radius + config_.tmax);
     if (dist - a.radius > config_.tmax + slack || dist + a.radius < config_.tmin - slack) return;
-    viewActiveBody(scene_, beams_.pattern().angleMin(), !planar_, &a);
+    viewPlacedBody(scene_, beams_.pattern().angleMin(), !planar_, &a);
     if (!(a.view.near <= config_.tmax) || (planar_ && !a.view.crosses)) return;
     if (plane_) {
       a.plane = &*plane_;
@@ -131,33 +132,11 @@ class GroupWalk {
     std::push_heap(heap_.begin(), heap_.end(), farther);
   }
   std::vector<Entry> heap_;
-  std::vector<Caster::ActiveBody> bodies_;  // placed this walk
+  std::vector<PlacedBody> bodies_;  // placed this walk
   DeferredPrimitives deferred_;             // large primitives, cast after the walk
 };
 
 }  // namespace
-
-Caster::ActiveBody activeBody(const Scene& scene, int index,
-                              const Eigen::Isometry3d& sensor_from_frame) {
-  Caster::ActiveBody a;
-  a.index = index;
-  a.sensor_from_body = sensor_from_frame * scene.bodies()[index].frame_from_body;
-  a.center = a.sensor_from_body * scene.sphereCenter(index);
-  a.radius = scene.sphereRadius(index);
-  return a;
-}
-
-void placeSensorInBody(Caster::ActiveBody* a) {
-  a->body_from_sensor_rot = a->sensor_from_body.linear().transpose();
-  a->sensor_in_body = -(a->body_from_sensor_rot * a->sensor_from_body.translation());
-}
-
-void viewActiveBody(const Scene& scene, double angle_min, bool elevations, Caster::ActiveBody* a) {
-  const Eigen::Matrix3d& rot = a->sensor_from_body.linear();
-  a->view = boxView(scene.boxCenter(a->index), scene.boxHalf(a->index), rot, rot.cwiseAbs(),
-                    a->sensor_from_body.translation(), angle_min, elevations);
-  placeSensorInBody(a);
-}
 
 void castGroup(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,

@@ -16,10 +16,11 @@
 #include <vector>
 
 #include "laser_raycast/core/beam_window.h"
-#include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/cast_config.h"
 #include "laser_raycast/core/node_views.h"
 #include "laser_raycast/core/occlusion_tiles.h"
 #include "laser_raycast/core/scan_pattern.h"
+#include "laser_raycast/core/scan_result.h"
 #include "laser_raycast/core/triangle.h"
 #include "laser_raycast/core/wide_bvh.h"
 

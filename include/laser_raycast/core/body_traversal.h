@@ -13,7 +13,8 @@
 #pragma once
 
 #include "laser_raycast/core/beam_set.h"
-#include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/cast_config.h"
+#include "laser_raycast/core/placed_body.h"
 #include "laser_raycast/core/scene.h"
 
 namespace laser_raycast {
@@ -21,7 +22,7 @@ namespace core {
 
 // Casts the open beams of `within` (a rect of beams the body's bounding sphere can reach) against
 // the body active.index of scene.
-void castBody(BeamSet& beams, const Scene& scene, const Caster::ActiveBody& active,
+void castBody(BeamSet& beams, const Scene& scene, const PlacedBody& active,
               const CastConfig& config, const BeamRect& within);
 
 }  // namespace core

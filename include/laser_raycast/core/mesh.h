@@ -5,13 +5,15 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
-#include "laser_raycast/core/wide_bvh.h"
 
 namespace laser_raycast {
 namespace core {
+
+class WideBvh;
 
 class Mesh {
  public:
@@ -23,13 +25,14 @@ class Mesh {
   // The wide BVH refers to the binary one: a Mesh stays where it was built (share it by pointer).
   Mesh(const Mesh&) = delete;
   Mesh& operator=(const Mesh&) = delete;
+  ~Mesh();
 
   const std::vector<Eigen::Vector3d>& vertices() const { return vertices_; }
   const std::vector<TriangleIndices>& triangles() const { return triangles_; }
   const Bvh& bvh() const { return bvh_; }
   // The caster's BVH: 4-wide, over the same triangle slots; each connected component (triangles
   // joined by shared vertex indices) fills whole subtrees, and childGroup() names it.
-  const WideBvh& wideBvh() const { return wide_; }
+  const WideBvh& wideBvh() const { return *wide_; }
   // The connected component of each triangle, numbered from 0, and how many there are.
   const std::vector<std::uint32_t>& components() const { return component_; }
   std::uint32_t componentCount() const { return component_count_; }
@@ -70,7 +73,7 @@ class Mesh {
   std::vector<std::int8_t> slot_facing_;
   bool has_closed_ = false;
   Bvh bvh_;
-  WideBvh wide_;
+  std::unique_ptr<const WideBvh> wide_;  // refers to bvh_
 };
 
 // Whether the triangle in BVH slot `slot` is a back face of a closed component (slotFacing) as seen

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "laser_raycast/core/beam_set.h"
-#include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/cast_config.h"
 #include "laser_raycast/core/fan_slicer.h"
 #include "laser_raycast/core/plane_slice.h"
 

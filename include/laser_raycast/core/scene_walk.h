@@ -8,20 +8,11 @@
 #include <vector>
 
 #include "laser_raycast/core/beam_set.h"
-#include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/cast_config.h"
 #include "laser_raycast/core/scene_index.h"
 
 namespace laser_raycast {
 namespace core {
-
-// A body placed for a scan, in steps so that a walk can cull by the cheap one first: its pose
-// relative to the sensor and its bounding sphere there; then the sensor in the body's frame (what
-// the exact tests need, placeSensorInBody); then how its box looks from the sensor (with elevation
-// windows if `elevations`; viewActiveBody does both).
-Caster::ActiveBody activeBody(const Scene& scene, int index,
-                              const Eigen::Isometry3d& sensor_from_frame);
-void placeSensorInBody(Caster::ActiveBody* a);
-void viewActiveBody(const Scene& scene, double angle_min, bool elevations, Caster::ActiveBody* a);
 
 // Casts the open beams of `within` against the bodies of group, placed by sensor_from_frame. Sets
 // cast[b] for each body b it casts against (several walks may set them at once).
