@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "fan_specs.h"
-#include "laser_raycast/core/beam_window.h"
+#include "beams/beam_window.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "random.h"
 

@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "fan_specs.h"
-#include "laser_raycast/core/beam_set.h"
-#include "laser_raycast/core/plane_slice.h"
-#include "laser_raycast/core/plane_views.h"
+#include "beams/beam_set.h"
+#include "slice/plane_slice.h"
+#include "slice/plane_views.h"
 #include "random.h"
 
 namespace laser_raycast_test {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "laser_raycast/core/mesh.h"
-#include "laser_raycast/core/wide_bvh.h"
+#include "accel/wide_bvh.h"
 #include "mesh_builder.h"
 #include "random.h"
 #include "test_geometry.h"

@@ -1,0 +1,61 @@
+#include "beams/beam_window.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace laser_raycast {
+namespace core {
+
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+// A hit's t and the distance to its box round differently (as BvhT::traverse notes): a box's near
+// distance is lowered by this many ulps of the magnitudes involved before it hides anything.
+constexpr double kNearSlack = 64 * kEps;
+
+}  // namespace
+
+View sphereView(const Eigen::Vector3d& center, double radius, double angle_min) {
+  View v;
+  const double dist = center.norm();
+  const double slack = kWindowSlack * (dist + radius);
+  v.near = std::max(0.0, dist - radius - slack - kNearSlack * (dist + radius));
+  v.crosses = std::abs(center.z()) <= radius + slack;
+  v.azimuth_limited = azimuthWindow(center, radius, angle_min, &v.azimuth_start, &v.azimuth_width);
+  elevationWindow(center, radius, &v.elevation_lo, &v.elevation_hi);
+  return v;
+}
+
+View boxView(const Eigen::Vector3d& center, const Eigen::Vector3d& half, const Eigen::Matrix3d& rot,
+             const Eigen::Matrix3d& abs_rot, const Eigen::Vector3d& trans, double angle_min,
+             bool elevations) {
+  View v;
+  const Eigen::Vector3d c = rot * center + trans;
+  // The sensor-frame bounding box, widened for the rounding of c and e (a few ulps of the terms).
+  Eigen::Vector3d e = abs_rot * half;
+  e += 4 * kEps * (abs_rot * center.cwiseAbs() + trans.cwiseAbs() + e);
+  const Eigen::Vector3d gap = (c.cwiseAbs() - e).cwiseMax(0.0);
+  const double magnitude = c.cwiseAbs().sum() + e.sum();
+  v.near = std::max(0.0, gap.norm() * (1 - 4 * kEps) - kNearSlack * magnitude);
+  v.crosses = std::abs(c.z()) <= e.z();
+  const double r_xy = std::sqrt(e.x() * e.x() + e.y() * e.y()) * (1 + 4 * kEps);
+  v.azimuth_limited = azimuthWindow(c, r_xy, angle_min, &v.azimuth_start, &v.azimuth_width);
+  if (!elevations) {
+    v.elevation_lo = -M_PI / 2;
+    v.elevation_hi = M_PI / 2;
+    return v;
+  }
+  // Any point has height in [z_lo, z_hi] and horizontal distance in [rho_min, rho_max]; its
+  // elevation atan2(z, rho) is largest at the top and the nearest distance (farthest if the top is
+  // below the sensor), and likewise for the smallest.
+  const double rho = std::sqrt(c.x() * c.x() + c.y() * c.y());
+  const double rho_min = std::max(0.0, (rho - r_xy) * (1 - 4 * kEps));
+  const double rho_max = (rho + r_xy) * (1 + 4 * kEps);
+  const double z_lo = c.z() - e.z(), z_hi = c.z() + e.z();
+  v.elevation_hi = approxAtan2(z_hi, z_hi > 0 ? rho_min : rho_max) + kBearingError;
+  v.elevation_lo = approxAtan2(z_lo, z_lo < 0 ? rho_min : rho_max) - kBearingError;
+  return v;
+}
+
+}  // namespace core
+}  // namespace laser_raycast

@@ -1,0 +1,53 @@
+#include "beams/column_raster.h"
+
+#include <limits>
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+// |[a, b, c]| below this fraction of |a| |b| |c|: the triangle is seen nearly edge-on, and the edge
+// planes say little about which beams meet it.
+constexpr double kEdgeOnRatio = 1e-6;
+// Normals scaled to |m|_1 = 1 must stay far from float's underflow: a smaller triple product (a
+// triangle of a few 1e-19 m, or one seen within 1e-20 of edge-on) tests every beam.
+constexpr double kSmallest = 1e-30;
+
+}  // namespace
+
+ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                           const Eigen::Vector3d& c) {
+  // In double: a small or far triangle's edge normals cancel far beyond float's precision.
+  const Eigen::Vector3d m[3] = {b.cross(c), c.cross(a), a.cross(b)};
+  const double det = a.dot(m[0]);
+  const double abs_det = std::abs(det);
+  // The 1-norms bound the 2-norms from above, so this flags a few more triangles than the ratio
+  // says: they are tested with every beam of the rect.
+  all_ = !(abs_det > kEdgeOnRatio * a.lpNorm<1>() * b.lpNorm<1>() * c.lpNorm<1>()) ||
+         !(abs_det > kSmallest);
+  if (all_) return;
+  const double sign = det > 0 ? 1 : -1;
+  const __m128 ones = _mm_castsi128_ps(_mm_set1_epi32(-1)), none = _mm_setzero_ps();
+  for (int k = 0; k < 3; ++k) {
+    const double scale = sign / (std::abs(m[k].x()) + std::abs(m[k].y()) + std::abs(m[k].z()));
+    const float z = static_cast<float>(m[k].z() * scale);
+    mx_[k] = _mm_set1_ps(static_cast<float>(m[k].x() * scale));
+    my_[k] = _mm_set1_ps(static_cast<float>(m[k].y() * scale));
+    inv_mz_[k] = _mm_set1_ps(z != 0 ? 1 / z : 0.0f);
+    lower_[k] = z > 0 ? ones : none;
+    upper_[k] = z < 0 ? ones : none;
+    flat_[k] = z == 0 ? ones : none;
+  }
+  edge_margin_ = _mm_set1_ps(kMargin / beams.smallestRowCos());
+  // The plane's normal (b - a) x (c - a) is the sum of the edge normals, and its dot product with
+  // a is det.
+  const Eigen::Vector3d plane = m[0] + m[1] + m[2];
+  const double scale = 1 / (std::abs(plane.x()) + std::abs(plane.y()) + std::abs(plane.z()));
+  nx_ = _mm_set1_ps(static_cast<float>(plane.x() * scale));
+  ny_ = _mm_set1_ps(static_cast<float>(plane.y() * scale));
+  nz_ = static_cast<float>(plane.z() * scale);
+  plane_distance_ = static_cast<float>(abs_det * scale * (1 - kMargin));
+}
+
+}  // namespace core
+}  // namespace laser_raycast

@@ -1,0 +1,49 @@
+// How the four children of a wide BVH node look from the sensor, computed together in float with
+// SSE2 (the x86-64 baseline): each child's nearest distance, and the azimuth and elevation windows
+// its box can be seen in. Everything is conservative: every rounding and approximation widens a
+// window and lowers a distance, so a beam whose exact ray enters a child's box is always inside the
+// child's windows (the exact triangle tests at the leaves decide). The windows only decide how
+// much work is done.
+#pragma once
+
+#include <emmintrin.h>
+
+#include <Eigen/Geometry>
+
+#include "accel/wide_bvh.h"
+
+namespace laser_raycast {
+namespace core {
+
+// A body's pose relative to the sensor, prepared for node views.
+class ViewFrame {
+ public:
+  // planar: only whether a box meets the sensor's xy plane matters, not its elevations.
+  ViewFrame(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax);
+
+ private:
+  friend struct NodeViews;
+  friend int planeMask(const WideBvh::Node& node, const ViewFrame& frame);
+  __m128 rot_[3][3], abs_rot_[3][3], trans_[3], abs_trans_[3];
+  __m128 tmax_;
+  bool planar_;
+};
+
+struct NodeViews {
+  int mask;  // bit k: child k exists, may be nearer than tmax, and (planar) may meet the plane
+  alignas(16) float near[4];       // no point of the child's box is nearer to the sensor
+  alignas(16) float az_center[4];  // rad, the bearing of the box's centre
+  alignas(16) float az_half[4];    // rad; negative: the box may be seen at every azimuth
+  alignas(16) float el_lo[4];      // rad (not computed for planar frames)
+  alignas(16) float el_hi[4];
+
+  // Fills the views of node's children.
+  void compute(const WideBvh::Node& node, const ViewFrame& frame);
+};
+
+// Which of node's children may meet the sensor's xy plane (bit k for child k): the cheap part of
+// NodeViews, for walks that need nothing else.
+int planeMask(const WideBvh::Node& node, const ViewFrame& frame);
+
+}  // namespace core
+}  // namespace laser_raycast

@@ -1,0 +1,294 @@
+#include "laser_raycast/core/caster.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "beams/beam_set.h"
+#include "beams/beam_window.h"
+#include "walk/body_traversal.h"
+#include "slice/plane_slice.h"
+#include "walk/plane_walk.h"
+#include "laser_raycast/core/pose.h"
+#include "scene/scene_index.h"
+#include "walk/scene_walk.h"
+#include "util/thread_pool.h"
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A cast is split between threads only if each gets at least this many beams: a 2D fan of a few
+// thousand beams is cast in tens of microseconds, about what handing work to another thread costs.
+constexpr int kMinBeamsPerThread = 4096;
+
+// Columns per piece of work when a cast is split between threads: whole coarse occlusion tiles, so
+// that no tile is written by two threads, and several pieces per thread to even out the load.
+constexpr int kPiecesPerThread = 8;
+int chunkColumns(int columns, int threads) {
+  const int unit = OcclusionTiles::kCoarseWidth;
+  const int pieces = threads * kPiecesPerThread;
+  const int width = (columns + pieces - 1) / pieces;
+  return std::max(unit, (width + unit - 1) / unit * unit);
+}
+
+// Rows per piece: whole coarse tile rows, so that with the column pieces there are about
+// kPiecesPerThread pieces per thread. Each piece walks the scene from its top, so pieces are no
+// smaller than the load needs.
+int bandRows(int rows, int column_pieces, int threads) {
+  const int unit = OcclusionTiles::kCoarseRings;
+  const int bands = std::max(1, kPiecesPerThread * threads / std::max(1, column_pieces));
+  const int height = (rows + bands - 1) / bands;
+  return std::max(unit, (height + unit - 1) / unit * unit);
+}
+
+// The pieces of a scan (rows x columns beams) for `threads` threads, in the order the threads take
+// them: columns first, then bands of rings (chunkColumns, bandRows); the last piece per thread is
+// cut into single coarse tiles, so that the threads run out of work at about the same time.
+std::vector<BeamRect> cutPieces(int rows, int columns, int threads) {
+  const int width = chunkColumns(columns, threads);
+  const int column_pieces = (columns + width - 1) / width;
+  const int height = bandRows(rows, column_pieces, threads);
+  const int bands = (rows + height - 1) / height;
+  const int whole = column_pieces * bands;
+  std::vector<BeamRect> pieces;
+  for (int i = 0; i < whole; ++i) {
+    const int col_lo = (i / bands) * width, row_lo = (i % bands) * height;
+    const BeamRect piece{row_lo, std::min(rows - 1, row_lo + height - 1), col_lo,
+                         std::min(columns - 1, col_lo + width - 1)};
+    const bool cut = i >= whole - threads;
+    const int tile_cols = cut ? OcclusionTiles::kCoarseWidth : width;
+    const int tile_rows = cut ? OcclusionTiles::kCoarseRings : height;
+    for (int c = piece.col_lo; c <= piece.col_hi; c += tile_cols) {
+      for (int r = piece.row_lo; r <= piece.row_hi; r += tile_rows) {
+        pieces.push_back(BeamRect{r, std::min(piece.row_hi, r + tile_rows - 1), c,
+                                  std::min(piece.col_hi, c + tile_cols - 1)});
+      }
+    }
+  }
+  return pieces;
+}
+
+
+// What a result was computed from: if all of it is equal, the result is too.
+struct ReuseKey {
+  std::uint64_t scene_version = 0;
+  CastConfig config;
+  double angle_min = 0, angle_increment = 0;
+  int azimuths = 0;
+  std::vector<double> elevations;
+  std::vector<Eigen::Isometry3d> sensor_from_frame;  // meaningful where valid
+  std::vector<char> valid;
+
+  bool operator==(const ReuseKey& o) const {
+    if (scene_version != o.scene_version || !(config == o.config) || angle_min != o.angle_min ||
+        angle_increment != o.angle_increment || azimuths != o.azimuths ||
+        elevations != o.elevations || valid != o.valid) {
+      return false;
+    }
+    for (std::size_t f = 0; f < sensor_from_frame.size(); ++f) {
+      if (valid[f] && sensor_from_frame[f].matrix() != o.sensor_from_frame[f].matrix()) {
+        return false;
+      }
+    }
+    return true;
+  }
+};
+
+// A scene frame with bodies this scan, with its pose in the sensor frame.
+struct PlacedGroup {
+  const SceneIndex::Group* group;
+  const Eigen::Isometry3d* sensor_from_frame;
+  double near;
+};
+
+// Every frame relative to the sensor, in double, once per scan (so that a scene far from the origin
+// loses nothing), together with everything else the result depends on.
+ReuseKey relativeInputs(const Scene& scene, const FramePoses& poses,
+                        const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
+                        const CastConfig& config) {
+  const bool sensor_ok = isValidPose(world_from_sensor);
+  const std::size_t frame_count = scene.frames().size();
+  ReuseKey key;
+  key.scene_version = scene.version();
+  key.config = config;
+  key.angle_min = pattern.angleMin();
+  key.angle_increment = pattern.angleIncrement();
+  key.azimuths = pattern.azimuthCount();
+  key.elevations = pattern.elevations();
+  key.sensor_from_frame.assign(frame_count, Eigen::Isometry3d::Identity());
+  key.valid.assign(frame_count, 0);
+  for (std::size_t f = 0; f < frame_count; ++f) {
+    // A pose marked valid but not a finite rigid transform (FramePoses filled by hand rather than
+    // by resolveFramePoses) would be inverted by transposing its rotation: treat it as unknown.
+    key.valid[f] = sensor_ok && poses.valid[f] && isValidPose(poses.pose[f]);
+    if (key.valid[f]) key.sensor_from_frame[f] = relativePose(world_from_sensor, poses.pose[f]);
+  }
+  return key;
+}
+
+void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanResult* result) {
+  result->range.assign(beams, sensor_ok ? kInf : std::numeric_limits<double>::quiet_NaN());
+  result->body.assign(beams, -1);
+  result->triangle.assign(beams, -1);
+  if (with_normals) {
+    result->normal.assign(beams, Eigen::Vector3d::Zero());
+  } else {
+    result->normal.clear();
+  }
+  result->cos_incidence.clear();
+  result->stats = CastStats{};
+  result->stats.bodies = bodies;
+}
+
+void computeIncidence(const ScanPattern& pattern, ScanResult* result) {
+  const auto& dirs = pattern.directions();
+  result->cos_incidence.assign(dirs.size(), 0.0);
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    if (result->body[i] < 0) continue;
+    result->cos_incidence[i] = std::min(1.0, std::abs(dirs[i].dot(result->normal[i])));
+  }
+}
+
+}  // namespace
+
+// What a caster keeps between casts: the scene's body trees (rebuilt when the scene changes), the
+// walk's per-scan state (kept to reuse its memory), the threads, the kept slices and the inputs of
+// the last result.
+struct Caster::State {
+  std::unique_ptr<SceneIndex> index;
+  std::vector<PlacedGroup> placed;
+  std::vector<std::atomic<char>> cast;  // per body: cast against this scan (for the stats)
+  BeamSet beams;
+  std::unique_ptr<ThreadPool> pool;           // for CastConfig::threads > 1
+  std::unique_ptr<PlaneSliceCache> planes;    // CastConfig::plane_cache
+  std::optional<ReuseKey> previous;           // the inputs of the result, if it is complete
+
+  void placeGroups(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,
+                   ScanResult* result);
+  void castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,
+                  ScanResult* result);
+};
+
+Caster::Caster() : state_(std::make_unique<State>()) {}
+Caster::~Caster() = default;
+Caster::Caster(Caster&&) noexcept = default;
+Caster& Caster::operator=(Caster&&) noexcept = default;
+
+void Caster::forget() { state_->previous.reset(); }
+
+const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
+                               const Eigen::Isometry3d& world_from_sensor,
+                               const ScanPattern& pattern, const CastConfig& config) {
+  config.validate();
+  const std::size_t frame_count = scene.frames().size();
+  if (poses.pose.size() != frame_count || poses.valid.size() != frame_count) {
+    std::ostringstream msg;
+    msg << "FramePoses has " << poses.pose.size() << " poses for a scene of " << frame_count
+        << " frames";
+    throw std::invalid_argument(msg.str());
+  }
+  const bool sensor_ok = isValidPose(world_from_sensor);
+  ReuseKey key = relativeInputs(scene, poses, world_from_sensor, pattern, config);
+  if (sensor_ok && state_->previous && *state_->previous == key) {
+    result_.stats.reused = true;
+    return result_;
+  }
+  state_->previous.reset();
+  resetResult(pattern.size(), static_cast<int>(scene.bodies().size()), sensor_ok,
+              config.compute_incidence, &result_);
+  if (!sensor_ok) return result_;
+
+  state_->placeGroups(scene, key, pattern, &result_);
+  state_->castBodies(scene, pattern, config, &result_);
+  if (config.compute_incidence) computeIncidence(pattern, &result_);
+  state_->previous = std::move(key);
+  return result_;
+}
+
+// Where each frame's body tree is this scan, nearest first; the bodies of frames without a pose
+// are skipped.
+void Caster::State::placeGroups(const Scene& scene, const ReuseKey& key,
+                                const ScanPattern& pattern, ScanResult* result) {
+  if (!index || index->sceneVersion() != scene.version()) {
+    index = std::make_unique<SceneIndex>(scene);
+  }
+  placed.clear();
+  for (const auto& group : index->groups()) {
+    if (!key.valid[group->frame]) {
+      result->stats.bodies_skipped += static_cast<int>(group->bodies.size());
+      continue;
+    }
+    const Eigen::Isometry3d& pose = key.sensor_from_frame[group->frame];
+    const Aabb& bounds = group->tree.bounds();
+    const View view =
+        boxView(bounds.center(), bounds.extent() * 0.5, pose.linear(), pose.linear().cwiseAbs(),
+                pose.translation(), pattern.angleMin(), !pattern.planar());
+    placed.push_back(PlacedGroup{group.get(), &pose, view.near});
+  }
+  std::stable_sort(placed.begin(), placed.end(),
+                   [](const PlacedGroup& a, const PlacedGroup& b) { return a.near < b.near; });
+}
+
+// Every frame's bodies, nearest frame first, against the open beams of the pattern; with threads,
+// each thread takes pieces of the pattern's columns (all rows) in turn.
+void Caster::State::castBodies(const Scene& scene, const ScanPattern& pattern,
+                               const CastConfig& config, ScanResult* result) {
+  beams.reset(pattern, config, result);
+  const std::size_t bodies = scene.bodies().size();
+  if (cast.size() != bodies) cast = std::vector<std::atomic<char>>(bodies);
+  for (auto& mark : cast) mark.store(0, std::memory_order_relaxed);
+  PlaneSliceCache* kept = nullptr;
+  if (pattern.planar() && config.planar_fast_path && config.plane_cache) {
+    if (!planes) planes = std::make_unique<PlaneSliceCache>();
+    planes->newScan();
+    kept = planes.get();
+  }
+  // Planar fans: each frame's kept slice by this plane, where there is one.
+  std::vector<std::pair<PlaneFrame, const PlaneSlice*>> slices;
+  if (pattern.planar() && config.planar_fast_path) {
+    for (const PlacedGroup& p : placed) {
+      slices.emplace_back(PlaneFrame(*p.sensor_from_frame), nullptr);
+      if (kept) slices.back().second = kept->find(scene, *p.group, slices.back().first);
+      result->stats.kept_slices += slices.back().second != nullptr;
+    }
+  }
+  auto castWithin = [&](const BeamRect& within) {
+    for (std::size_t g = 0; g < placed.size(); ++g) {
+      const PlacedGroup& p = placed[g];
+      if (g < slices.size() && slices[g].second) {
+        castSlice(beams, scene, *slices[g].second, slices[g].first, *p.sensor_from_frame, config,
+                  within, &cast);
+      } else {
+        castGroup(beams, scene, *p.group, *p.sensor_from_frame, config, within, &cast);
+      }
+    }
+  };
+  int threads = config.threads;
+  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // Waking threads costs more than a small scan does: each gets at least kMinBeamsPerThread.
+  threads = std::max(1, std::min(threads, pattern.size() / kMinBeamsPerThread));
+  if (threads == 1) {
+    castWithin(beams.all());
+  } else {
+    if (!pool || pool->threads() != threads) pool = std::make_unique<ThreadPool>(threads);
+    const std::vector<BeamRect> pieces =
+        cutPieces(beams.all().row_hi + 1, pattern.azimuthCount(), threads);
+    pool->run(static_cast<int>(pieces.size()), [&](int i) { castWithin(pieces[i]); });
+  }
+  int cast_count = 0;
+  for (const auto& mark : cast) cast_count += mark.load(std::memory_order_relaxed);
+  result->stats.bodies_culled = static_cast<int>(bodies) - result->stats.bodies_skipped - cast_count;
+}
+
+}  // namespace core
+}  // namespace laser_raycast

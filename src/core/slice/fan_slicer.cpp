@@ -1,0 +1,149 @@
+#include "slice/fan_slicer.h"
+
+#include <cmath>
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+bool lexicographicLess(const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+  if (p.x() != q.x()) return p.x() < q.x();
+  if (p.y() != q.y()) return p.y() < q.y();
+  return p.z() < q.z();
+}
+
+// Where edge (p, q) crosses the plane, given the vertices' signed distances, sp <= 0 < sq or the
+// other way round. A vertex on the plane (distance 0) is its own crossing, bit for bit. Otherwise
+// the vertices are put in lexicographic order first, so both triangles sharing the edge get the
+// same bits.
+Eigen::Vector3d edgeCrossing(Eigen::Vector3d p, double sp, Eigen::Vector3d q, double sq) {
+  if (sp == 0) return p;
+  if (sq == 0) return q;
+  if (lexicographicLess(q, p)) {
+    std::swap(p, q);
+    std::swap(sp, sq);
+  }
+  return p + (q - p) * (sp / (sp - sq));  // sp and sq differ in sign: no cancellation
+}
+
+// A unit vector perpendicular to n, from n alone: n crossed with the axis it is least aligned with
+// (the first of them on a tie).
+Eigen::Vector3d perpendicular(const Eigen::Vector3d& n) {
+  const Eigen::Vector3d m = n.cwiseAbs();
+  const int axis = m.x() <= m.y() && m.x() <= m.z() ? 0 : (m.y() <= m.z() ? 1 : 2);
+  return n.cross(Eigen::Vector3d::Unit(axis)).normalized();
+}
+
+}  // namespace
+
+PlaneFrame::PlaneFrame(const Eigen::Isometry3d& sensor_from_frame) {
+  const Eigen::Matrix3d& rot = sensor_from_frame.linear();
+  const Eigen::Vector3d& trans = sensor_from_frame.translation();
+  n = rot.row(2).transpose();
+  offset = trans.z();
+  u = perpendicular(n);
+  v = n.cross(u);
+  a = rot.row(0).dot(u);
+  b = rot.row(0).dot(v);
+  c = rot.row(1).dot(u);
+  d = rot.row(1).dot(v);
+  tx = trans.x();
+  ty = trans.y();
+}
+
+bool PlaneFrame::crossing(const Eigen::Vector3d (&v)[3], Eigen::Vector2d* p,
+                          Eigen::Vector2d* q) const {
+  const double s[3] = {side(v[0]), side(v[1]), side(v[2])};
+  // A vertex exactly on the plane counts as just below it (the plane nudged up by an
+  // infinitesimal): an edge lying in the plane is then cut once, by the triangle above it, not
+  // twice; a triangle touching the plane from below, or lying in it, is not cut (as a ray in a
+  // triangle's plane misses it); one touching it from above gives a zero-length segment, which no
+  // beam crosses. Every crossing triangle has exactly two edges with one end below and one above.
+  const bool above[3] = {s[0] > 0, s[1] > 0, s[2] > 0};
+  if (above[0] == above[1] && above[1] == above[2]) return false;  // also NaN: never above
+  Eigen::Vector3d points[2];
+  int count = 0;
+  for (int k = 0; k < 3; ++k) {
+    const int j = k == 2 ? 0 : k + 1;
+    if (above[k] != above[j]) points[count++] = edgeCrossing(v[k], s[k], v[j], s[j]);
+  }
+  *p = planeCoords(points[0]);
+  *q = planeCoords(points[1]);
+  return true;
+}
+
+bool PlaneFrame::mayMeet(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box) const {
+  Eigen::Vector3d c, e;
+  boxInFrame(frame_from_mesh, box, &c, &e);
+  const Eigen::Vector3d abs_n = n.cwiseAbs();
+  // side() rounds a few times at magnitudes up to |n| (|c| + e) + |offset|.
+  const double slack =
+      2 * roundingGamma<double>(6) * (abs_n.dot(c.cwiseAbs() + e) + std::abs(offset));
+  return std::abs(side(c)) <= abs_n.dot(e) + slack;
+}
+
+void boxInFrame(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box, Eigen::Vector3d* center,
+                Eigen::Vector3d* half) {
+  const Eigen::Matrix3d abs_r = frame_from_mesh.linear().cwiseAbs();
+  const Eigen::Vector3d c = box.center(), e = box.extent() * 0.5;
+  *center = frame_from_mesh * c;
+  // The product's rounding: a few ulps of the terms, for the centre and any point of the box.
+  *half = abs_r * e;
+  *half += 8 * std::numeric_limits<double>::epsilon() *
+           (abs_r * (c.cwiseAbs() + e) + frame_from_mesh.translation().cwiseAbs() + *half);
+}
+
+PlaneSlicer::PlaneSlicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh,
+                         const ScanPattern& fan, double tmin, double tmax, bool cull_backfaces)
+    : PlaneSlicer(mesh, PlaneFrame(sensor_from_mesh), Eigen::Isometry3d::Identity(),
+                  sensor_from_mesh, fan, tmin, tmax, cull_backfaces) {}
+
+PlaneSlicer::PlaneSlicer(const Mesh& mesh, const PlaneFrame& plane,
+                         const Eigen::Isometry3d& frame_from_mesh,
+                         const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
+                         double tmin, double tmax, bool cull_backfaces)
+    : mesh_(mesh),
+      fan_(fan),
+      rot_(sensor_from_mesh.linear()),
+      trans_(sensor_from_mesh.translation()),
+      frame_(plane),
+      frame_from_mesh_(frame_from_mesh),
+      sensor_in_mesh_(-(rot_.transpose() * trans_)),
+      tmin_(tmin),
+      tmax_(tmax),
+      // Bound on the rounding of side() at a box centre and at a vertex, relative to the
+      // magnitudes involved (not an absolute epsilon): a box is pruned only if it is off the plane
+      // by more than that.
+      gamma_(2 * roundingGamma<double>(6)),
+      cull_backfaces_(cull_backfaces) {
+  tmax2_ = tmax * tmax * (1 + gamma_);
+}
+
+bool PlaneSlicer::mayCross(const Aabb& box) const {
+  if (!frame_.mayMeet(frame_from_mesh_, box)) return false;
+  // Nearest point of the box to the sensor, against range_max.
+  const Eigen::Vector3d nearest = sensor_in_mesh_.cwiseMax(box.lo).cwiseMin(box.hi);
+  return (nearest - sensor_in_mesh_).squaredNorm() <= tmax2_;
+}
+
+void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
+               double tmin, double tmax, bool cull_backfaces, int body_index, DepthBuffer buffer) {
+  const PlaneSlicer slicer(mesh, sensor_from_mesh, fan, tmin, tmax, cull_backfaces);
+  const auto& ids = mesh.bvh().triangleIds();
+  std::vector<double>& range = *buffer.range;
+  const int last = fan.azimuthCount() - 1;
+  mesh.bvh().visit([&](const Aabb& box) { return slicer.mayCross(box); },
+                   [&](std::uint32_t slot) {
+                     slicer.sliceSlot(slot, 0, last, [&](int i, double t) {
+                       if (buffer.crossings) ++(*buffer.crossings)[i];
+                       if (!(t < range[i])) return;
+                       range[i] = t;
+                       (*buffer.body)[i] = body_index;
+                       (*buffer.triangle)[i] = static_cast<int>(ids[slot]);
+                       if (buffer.normal) (*buffer.normal)[i] = slicer.sensorNormal(slot);
+                     });
+                   });
+}
+
+}  // namespace core
+}  // namespace laser_raycast

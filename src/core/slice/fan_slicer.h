@@ -1,0 +1,233 @@
+// The planar fast path: a 2D fan needs only the triangles that cross its plane. Each crossing
+// triangle is cut into a segment in the scan plane and tested against the beams of its angular
+// window, so the cost grows with the number of crossing triangles and beams, not with rays times
+// tree depth.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "beams/beam_window.h"
+#include "laser_raycast/core/mesh.h"
+#include "laser_raycast/core/scan_pattern.h"
+
+namespace laser_raycast {
+namespace core {
+
+// The per-beam nearest hit so far: distance, body and triangle.
+struct DepthBuffer {
+  std::vector<double>* range;
+  std::vector<int>* body;
+  std::vector<int>* triangle;
+  // If set, every segment a beam crosses within [tmin, tmax] is counted, nearest or not: a closed
+  // mesh's outline is crossed exactly once per beam from inside (the watertightness tests use it).
+  std::vector<int>* crossings = nullptr;
+  // If set, the hit triangle's front normal (sensor frame) is written with every nearer hit.
+  std::vector<Eigen::Vector3d>* normal = nullptr;
+};
+
+// The scan plane (the sensor's z = 0) in the frame that moves a group of bodies (scene_index.h):
+// side(p) = n . p + offset is the sensor z of p (frame coordinates). Points of the plane are
+// written in a basis (u, v) of it that depends on n alone, so that the same plane, met again from
+// another sensor pose in it (a robot driving on a floor), gives the same plane coordinates bit for
+// bit (plane_slice.h keeps them); toSensor() maps them to the sensor's x, y. Every planar test goes
+// through these steps, from vertices moved into the frame.
+struct PlaneFrame {
+  explicit PlaneFrame(const Eigen::Isometry3d& sensor_from_frame);
+
+  double side(const Eigen::Vector3d& p) const { return n.dot(p) + offset; }
+  Eigen::Vector2d planeCoords(const Eigen::Vector3d& p) const { return {u.dot(p), v.dot(p)}; }
+  Eigen::Vector2d toSensor(const Eigen::Vector2d& w) const {
+    return {a * w.x() + b * w.y() + tx, c * w.x() + d * w.y() + ty};
+  }
+  // Where a triangle (frame coordinates) crosses the plane, in plane coordinates: false if it does
+  // not (a vertex exactly on the plane counts as just below it, see PlaneSlicer).
+  bool crossing(const Eigen::Vector3d (&v)[3], Eigen::Vector2d* p, Eigen::Vector2d* q) const;
+  // False if no point of box (a mesh's frame, placed in this frame by frame_from_mesh) can be cut:
+  // the box moved into the frame, against side() with a slack for the rounding of moving a
+  // vertex there and of side() (relative to the magnitudes involved).
+  bool mayMeet(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box) const;
+
+  Eigen::Vector3d n;  // the sensor's z axis in the frame
+  double offset;      // the frame origin's sensor z
+  Eigen::Vector3d u, v;
+  double a, b, c, d, tx, ty;  // sensor x = a pu + b pv + tx, y = c pu + d pv + ty
+};
+
+// A box given in a mesh's frame as a box in the frame that places the mesh (frame_from_mesh):
+// centre and half extents, widened for the rounding of moving a point there.
+void boxInFrame(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box, Eigen::Vector3d* center,
+                Eigen::Vector3d* half);
+
+// Slices a mesh by the fan's plane: each triangle that crosses it becomes a segment in the plane,
+// tested against the beams. Watertight: each crossing point is computed from its edge's two
+// vertices in a fixed (lexicographic) order, so neighbouring triangles share bitwise-identical
+// segment endpoints, and a beam is tested against a segment by the signs of two cross products with
+// those endpoints. A beam exactly through a shared endpoint counts for one of the two segments
+// (half-open segments), and a vertex exactly on the plane counts as just below it, so that an edge
+// lying in the plane is cut once: a beam crosses a closed outline exactly once. A surface that only
+// touches the plane from below (the top of a box at exactly the sensor's height) is therefore not
+// seen; triangles lying in the plane are skipped, as the 3D tests skip a ray in a triangle's plane.
+class PlaneSlicer {
+ public:
+  // A mesh placed in a frame (frame_from_mesh) cut by that frame's plane (plane): how the walk
+  // slices a body, so that it gets the bits a kept slice of the frame holds.
+  PlaneSlicer(const Mesh& mesh, const PlaneFrame& plane, const Eigen::Isometry3d& frame_from_mesh,
+              const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan, double tmin,
+              double tmax, bool cull_backfaces);
+  // A mesh in its own frame.
+  PlaneSlicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
+              double tmin, double tmax, bool cull_backfaces);
+
+  const PlaneFrame& frame() const { return frame_; }
+  // The triangle in slot moved into the frame.
+  void frameTriangle(std::uint32_t slot, Eigen::Vector3d (&out)[3]) const {
+    const auto& v = mesh_.bvh().triangleVertices()[slot];
+    for (int k = 0; k < 3; ++k) out[k] = frame_from_mesh_ * v[k];
+  }
+
+  // False if the box (mesh frame) certainly neither crosses the plane nor comes within tmax.
+  bool mayCross(const Aabb& box) const;
+
+  // Slices the triangle in BVH slot `slot` and calls hit(beam, t) for every beam with index in
+  // [first, last] that crosses its segment with t in [tmin, tmax]. open(beam, near) may say that a
+  // beam needs no test: it has hit something nearer than `near`, the segment's nearest distance.
+  template <class Hit>
+  void sliceSlot(std::uint32_t slot, int first, int last, Hit&& hit) const {
+    sliceSlot(slot, first, last, std::forward<Hit>(hit), [](int, double) { return true; });
+  }
+  template <class Hit, class Open>
+  void sliceSlot(std::uint32_t slot, int first, int last, Hit&& hit, Open&& open) const {
+    Eigen::Vector3d v[3];
+    frameTriangle(slot, v);
+    Eigen::Vector2d p, q;
+    if (!frame_.crossing(v, &p, &q)) return;
+    testSegment(p, q, slot, first, last, std::forward<Hit>(hit), std::forward<Open>(open));
+  }
+  // The same for a segment given in plane coordinates (a cached slice's): the triangle in `slot`
+  // crosses the plane there.
+  template <class Hit, class Open>
+  void testSegment(const Eigen::Vector2d& plane_p, const Eigen::Vector2d& plane_q,
+                   std::uint32_t slot, int first, int last, Hit&& hit, Open&& open) const;
+
+  // The triangle in a slot (its index in the mesh).
+  std::uint32_t triangleOf(std::uint32_t slot) const { return mesh_.bvh().triangleIds()[slot]; }
+  // The hit triangle's front normal in the sensor frame.
+  Eigen::Vector3d sensorNormal(std::uint32_t slot) const {
+    return rot_ * mesh_.normal(mesh_.bvh().triangleIds()[slot]);
+  }
+
+ private:
+  const Mesh& mesh_;
+  const ScanPattern& fan_;
+  Eigen::Matrix3d rot_;
+  Eigen::Vector3d trans_;
+  PlaneFrame frame_;
+  Eigen::Isometry3d frame_from_mesh_;
+  Eigen::Vector3d sensor_in_mesh_;
+  double tmin_, tmax_, tmax2_, gamma_;
+  bool cull_backfaces_;
+};
+
+// Slices one mesh body and keeps, per beam, the nearest hit with t in [tmin, tmax] in buffer.
+void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
+               double tmin, double tmax, bool cull_backfaces, int body_index, DepthBuffer buffer);
+
+// Whether the beam with direction (dx, dy) (sensor frame) crosses the segment with ends p != q
+// (sensor x, y) with t in [tmin, tmax], and where. With front (the triangle's front normal's
+// sensor x, y), a beam meeting its back does not.
+inline bool beamCrossesSegment(double dx, double dy, const Eigen::Vector2d& p,
+                               const Eigen::Vector2d& q, double tmin, double tmax,
+                               const Eigen::Vector2d* front, double* t) {
+  // Which side of the beam's line each endpoint is on; a shared endpoint gives the same value to
+  // both of its segments.
+  const double side_p = dx * p.y() - dy * p.x();
+  const double side_q = dx * q.y() - dy * q.x();
+  if (!((side_p <= 0 && side_q >= 0) || (side_p >= 0 && side_q <= 0))) return false;
+  // Both on the line: the beam runs along the triangle's plane.
+  if (side_p == side_q) return false;
+  // Exactly through an endpoint: the beam counts for the segment whose other end lies on its left
+  // (as if nudged to the right), so for exactly one of the two segments sharing a point where the
+  // outline crosses the beam.
+  if (side_p == 0 ? !(side_q > 0) : (side_q == 0 && !(side_p > 0))) return false;
+  const double along_p = dx * p.x() + dy * p.y();
+  const double along_q = dx * q.x() + dy * q.y();
+  *t = along_p + (side_p / (side_p - side_q)) * (along_q - along_p);
+  if (!(*t >= tmin && *t <= tmax)) return false;
+  return !(front && dx * front->x() + dy * front->y() > 0);
+}
+
+// Tests the beams [first, last] of fan against a segment with ends p, q (sensor x, y): hit(beam, t)
+// for every beam that crosses it with t in [tmin, tmax]; open(beam, near) may say that a beam needs
+// no test (it has hit something nearer than `near`, the segment's nearest distance). With front
+// (the triangle's front normal's sensor x, y), a beam meeting its back is not hit.
+template <class Hit, class Open>
+void testSegmentInFan(const ScanPattern& fan, const Eigen::Vector2d& p, const Eigen::Vector2d& q,
+                      double tmin, double tmax, const Eigen::Vector2d* front, int first, int last,
+                      Hit&& hit, Open&& open) {
+  // Below this many beams in the window, every one is tested without computing bearings.
+  constexpr int kDirectBeams = 8;
+  if (p == q) return;  // touches the plane at a vertex: no beam crosses it
+  // No point of the segment is nearer to the sensor than this (the distance to its line where the
+  // foot of the perpendicular falls inside it, else to the nearer end), lowered for rounding: a
+  // beam that has already hit something nearer needs no test.
+  const Eigen::Vector2d pq = q - p;
+  const double along = -p.dot(pq), length2 = pq.squaredNorm();
+  const double near =
+      (along > 0 && along < length2 ? std::abs(p.x() * pq.y() - p.y() * pq.x()) / std::sqrt(length2)
+                                    : std::sqrt(std::min(p.squaredNorm(), q.squaredNorm()))) *
+          (1 - 16 * std::numeric_limits<double>::epsilon()) -
+      16 * std::numeric_limits<double>::epsilon() * (p.norm() + q.norm());
+  const auto& dirs = fan.directions();
+  auto test = [&](int lo, int hi) {
+    for (int i = std::max(lo, first); i <= std::min(hi, last); ++i) {
+      if (!open(i, near)) continue;
+      double t;
+      if (beamCrossesSegment(dirs[i].x(), dirs[i].y(), p, q, tmin, tmax, front, &t)) hit(i, t);
+    }
+  };
+  // A few beams are tested directly; for more, only those the segment's bearings can reach.
+  if (last - first < kDirectBeams) {
+    test(first, last);
+    return;
+  }
+  // The shorter arc between the endpoints' bearings, widened by one bearing error each side. Each
+  // true bearing lies within kBearingError of its approximation, so the arc from the lower
+  // approximation minus the error to the higher plus the error holds the true arc, also when the
+  // approximation flipped the sign of a tiny sweep (the window spans both approximations either
+  // way). The shorter arc is the true one unless the sweep is within two errors of half a turn (a
+  // segment passing beside the sensor): then every beam is tried.
+  const double bearing_p = approxAtan2(p.y(), p.x());
+  const double bearing_q = approxAtan2(q.y(), q.x());
+  double sweep = bearing_q - bearing_p;
+  if (sweep > M_PI) sweep -= 2 * M_PI;
+  if (sweep < -M_PI) sweep += 2 * M_PI;
+  const double pad = kBearingError;
+  if (std::abs(sweep) > M_PI - 2 * pad) {
+    test(first, last);
+    return;
+  }
+  const double start = wrapToTurn((sweep >= 0 ? bearing_p : bearing_q) - pad - fan.angleMin());
+  forEachBeamRange(fan, start, std::abs(sweep) + 2 * pad, test);
+}
+
+template <class Hit, class Open>
+void PlaneSlicer::testSegment(const Eigen::Vector2d& plane_p, const Eigen::Vector2d& plane_q,
+                              std::uint32_t slot, int first, int last, Hit&& hit,
+                              Open&& open) const {
+  Eigen::Vector2d front;
+  if (cull_backfaces_) {
+    const auto& v = mesh_.bvh().triangleVertices()[slot];
+    front = (rot_ * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
+  }
+  testSegmentInFan(fan_, frame_.toSensor(plane_p), frame_.toSensor(plane_q), tmin_, tmax_,
+                   cull_backfaces_ ? &front : nullptr, first, last, std::forward<Hit>(hit),
+                   std::forward<Open>(open));
+}
+
+}  // namespace core
+}  // namespace laser_raycast

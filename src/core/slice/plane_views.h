@@ -1,0 +1,63 @@
+// How the four children of a node of a kept slice's tree (plane_slice.h) look from the sensor under
+// a planar fan, computed together in float with SSE2: each child's nearest distance and the fan's
+// columns its box can be seen in. The boxes are 2D, in the plane's coordinates; the map to the
+// sensor's x, y is PlaneFrame's. Everything is conservative, as NodeViews is: every rounding widens
+// a window and lowers a distance, so a beam whose exact ray enters a child's box is always among
+// the child's columns. Only the amount of work depends on them.
+#pragma once
+
+#include <emmintrin.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "slice/fan_slicer.h"
+#include "laser_raycast/core/scan_pattern.h"
+#include "accel/wide_bvh.h"
+
+namespace laser_raycast {
+namespace core {
+
+// The plane's map and the fan's columns, prepared for PlaneViews.
+class PlaneViewFrame {
+ public:
+  PlaneViewFrame(const PlaneFrame& plane, double tmax, const ScanPattern& fan);
+
+ private:
+  friend struct PlaneViews;
+  __m128 a_, b_, c_, d_, abs_a_, abs_b_, abs_c_, abs_d_, tx_, ty_, abs_tx_, abs_ty_, tmax_;
+  // Columns: index = (angle - start) * inv_increment, a turn is `turn` columns; pad covers the
+  // float rounding of that arithmetic. fast_: the fan spans at most a turn.
+  __m128 start_, inv_increment_, turn_, inv_turn_, pad_;
+  int columns_;
+  bool fast_;
+};
+
+struct PlaneViews {
+  int mask;                   // bit k: child k exists and may be nearer than tmax
+  int columns_known;          // bit k: col_lo/col_hi hold child k's columns
+  alignas(16) float near[4];  // no point of the child's box is nearer to the sensor
+  alignas(16) int col_lo[4];  // the child's columns, where known (may be empty: lo > hi)
+  alignas(16) int col_hi[4];
+  // Otherwise (a window that wraps around the fan's ends): its bearing window (rad), for
+  // BeamSet::forEachColumnRange; az_half < 0: every column.
+  alignas(16) float az_center[4];
+  alignas(16) float az_half[4];
+
+  void compute(const WideBvh::Node& node, const PlaneViewFrame& frame);
+};
+
+// A beam in plane coordinates, prepared for conservative box tests against a slice tree's nodes,
+// four children at a time, in x and y only (the boxes' heights are not the walk's), with the origin
+// rounded once each way and shared by every beam of a walk.
+class PlaneRay : public WideSlabRay<2> {
+ public:
+  // Origin: plane coordinates, moved by frameSlack() each way, since the segments are tested
+  // mapped to the sensor's x, y.
+  using WideSlabRay<2>::WideSlabRay;
+};
+
+}  // namespace core
+}  // namespace laser_raycast

@@ -1,0 +1,401 @@
+#include "walk/body_traversal.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "beams/column_raster.h"
+#include "beams/edge_filter.h"
+#include "slice/fan_slicer.h"
+#include "walk/primitive_cast.h"
+#include "accel/wide_bvh.h"
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+// The walk's choices below change only how beams and triangles are paired, never a triangle's test,
+// so they change only the speed. Their values come from the benchmark's scenes.
+
+// An inner node whose window holds at most kTraceBeams beams has them traced through its subtree
+// one ray at a time instead of its children's windows being computed; so does one with at most
+// kTraceBeamsDense beams of a 3D pattern and at least one triangle below it for every
+// kBeamsPerTriangle of them (a detailed part: its triangles would each be rasterised for a few
+// beams, a beam traced meets only the few on its way). Thin geometry seen across many beams (a wall
+// of two triangles) keeps being rasterised, and a planar fan's nodes keep being sliced.
+constexpr long long kTraceBeams = 12;
+constexpr long long kTraceBeamsDense = 96;
+constexpr long long kBeamsPerTriangle = 2;
+// A leaf whose window holds at most this many beams has them tested against each of its triangles;
+// more are rasterised (3D) against each triangle's edge planes first.
+constexpr long long kLeafDirectBeams = 8;
+// A subtree with at most this many triangles and at least this many beams per triangle in its
+// window is sliced whole (planar fans), without windows or occlusion tests on the way.
+constexpr std::uint32_t kPlainSliceTriangles = 64;
+constexpr double kPlainSliceBeamsPerTriangle = 0.5;
+
+// The last values computed for triangle slots, by slot (a direct-mapped cache of N entries), for
+// a walk whose beams ask about the same slots again and again.
+template <class T, std::uint32_t N>
+class SlotCache {
+ public:
+  template <class Make>
+  const T& get(std::uint32_t slot, Make&& make) {
+    Entry& e = entries_[slot % N];
+    if (e.slot != slot) {
+      e.slot = slot;
+      e.value = make();
+    }
+    return e.value;
+  }
+
+ private:
+  struct Entry {
+    std::uint32_t slot = std::numeric_limits<std::uint32_t>::max();
+    T value{};
+  };
+  std::array<Entry, N> entries_;
+};
+
+template <TriangleMethod M>
+class MeshWalk {
+ public:
+  MeshWalk(BeamSet& beams, const Mesh& mesh, const PlacedBody& active,
+           const CastConfig& config)
+      : beams_(beams),
+        mesh_(mesh),
+        wide_(mesh.wideBvh()),
+        slots_(mesh.bvh().triangleVertices()),
+        ids_(mesh.bvh().triangleIds()),
+        active_(active),
+        config_(config),
+        rot_(active.sensor_from_body.linear()),
+        abs_rot_(rot_.cwiseAbs()),
+        trans_(active.sensor_from_body.translation()),
+        planar_(beams.pattern().planar()),
+        slicing_(planar_ && config.planar_fast_path),
+        // Without the fast paths every beam is traced from the root, as the reference.
+        tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
+        frame_(active.sensor_from_body, planar_, config.tmax),
+        origin_(active.sensor_in_body, mesh.bvh().bounds(), config.tmin) {
+    closed_ = !slicing_ && mesh.hasClosedComponents();
+    if (slicing_) {
+      // Cut in the frame's plane coordinates when the walk gives them (as a kept slice is).
+      if (active.plane) {
+        slicer_.emplace(mesh, *active.plane, active.frame_from_body, active.sensor_from_body,
+                        beams.pattern(), config.tmin, config.tmax, config.cull_backfaces);
+      } else {
+        slicer_.emplace(mesh, active.sensor_from_body, beams.pattern(), config.tmin, config.tmax,
+                        config.cull_backfaces);
+      }
+    }
+  }
+
+  void run(const BeamRect& within) {
+    if (wide_.empty()) return;
+    const Aabb& bounds = wide_.binary().bounds();
+    const View view = boxView(bounds.center(), bounds.extent() * 0.5, rot_, abs_rot_, trans_,
+                              beams_.pattern().angleMin(), !planar_);
+    if (!(view.near <= config_.tmax)) return;
+    top_ = 0;
+    const Entry root{wide_.root(), BeamRect{}, floatBelow(view.near), wide_.rootTriangles()};
+    beams_.forEachRect(view, within, [&](const BeamRect& rect) {
+      Entry e = root;
+      e.rect = rect;
+      push(e);
+    });
+    while (top_ > 0) {
+      const Entry e = stack_[--top_];
+      if (!beams_.anyOpen(e.rect, e.near)) continue;  // hidden behind nearer hits
+      if (tracing_only_) {
+        traceRect(e);
+      } else {
+        visit(e);
+      }
+    }
+  }
+
+ private:
+  struct Entry {
+    WideBvh::Ref ref;
+    BeamRect rect;
+    float near;               // no point of ref's box is nearer to the sensor
+    std::uint32_t triangles;  // below ref
+  };
+
+  void push(const Entry& e) {
+    if (top_ == static_cast<int>(stack_.size())) stack_.resize(stack_.size() * 2);
+    stack_[top_++] = e;
+  }
+
+  void visit(const Entry& e) {
+    const long long beams = e.rect.beams();
+    if (e.ref.isLeaf()) {
+      if (slicing_) {
+        sliceLeaf(e.ref, e.rect, e.near);
+      } else if (beams <= kLeafDirectBeams) {
+        testLeaf(e);
+      } else {
+        rasterLeaf(e);
+      }
+    } else if (slicing_ && e.triangles <= kPlainSliceTriangles &&
+               beams >= kPlainSliceBeamsPerTriangle * e.triangles) {
+      sliceSubtree(e);
+    } else if (beams <= kTraceBeams || (!planar_ && beams <= kTraceBeamsDense &&
+                                        e.triangles * kBeamsPerTriangle >= beams)) {
+      traceRect(e);
+    } else {
+      expand(e);
+    }
+  }
+
+  void expand(const Entry& e) {
+    const WideBvh::Node& node = wide_.nodes()[e.ref.index];
+    NodeViews views;
+    views.compute(node, frame_);
+    if (!views.mask) return;
+    Entry children[4 * 3];  // a child's view may wrap into several rects
+    int n = 0;
+    for (int k = 0; k < WideBvh::kWidth; ++k) {
+      if (!(views.mask & (1 << k))) continue;
+      beams_.forEachChildRect(views, k, e.rect, [&](const BeamRect& rect) {
+        if (n < 12) {
+          children[n++] =
+              Entry{node.child(k), rect, views.near[k], wide_.childTriangles(e.ref.index, k)};
+        }
+      });
+    }
+    sortFarthestFirst(children, n);
+    for (int j = 0; j < n; ++j) push(children[j]);
+  }
+
+  // The beam as a ray in the body's frame, for box tests: the same one for every box test of this
+  // walk.
+  WideBoxRay boxRay(int row, int col) const {
+    return WideBoxRay(origin_, active_.body_from_sensor_rot * beams_.rebuiltDirection(row, col));
+  }
+
+  // A triangle slot moved into the sensor frame. Every 3D test of this body's triangles is the
+  // beam's sensor-frame ray against these vertices, however the pair was found (traced,
+  // rasterised or tested directly), so shared edges are decided the same way everywhere.
+  struct SensorTriangle {
+    Eigen::Vector3d a, b, c;
+  };
+  SensorTriangle sensorTriangle(std::uint32_t slot) const {
+    const auto& v = slots_[slot];
+    return SensorTriangle{rot_ * v[0] + trans_, rot_ * v[1] + trans_, rot_ * v[2] + trans_};
+  }
+
+  // The same through a small cache: the beams traced through one node meet the same leaves.
+  const SensorTriangle& cachedTriangle(std::uint32_t slot) {
+    return triangles_.get(slot, [&] { return sensorTriangle(slot); });
+  }
+
+  Eigen::Vector3d sensorNormal(std::uint32_t triangle) const {
+    return rot_ * mesh_.normal(triangle);
+  }
+
+  // The nearest hit of one beam so far in this walk: a hit improves it if nearer, or as near on a
+  // lower triangle index, so the result does not depend on the order triangles are met in.
+  struct Best {
+    double t = std::numeric_limits<double>::infinity();
+    std::uint32_t triangle = std::numeric_limits<std::uint32_t>::max();
+    std::uint32_t slot = 0;
+    bool found() const { return triangle != std::numeric_limits<std::uint32_t>::max(); }
+    bool improves(double t2, std::uint32_t triangle2) const {
+      return t2 < t || (t2 == t && triangle2 < triangle);
+    }
+  };
+
+  void offer(int row, int col, const Best& best) {
+    beams_.offer(row, col, best.t, active_.index, static_cast<int>(best.triangle), [&] {
+      return slicing_ ? slicer_->sensorNormal(best.slot) : sensorNormal(best.triangle);
+    });
+  }
+
+  // Each open beam of the rect through the node's subtree, one ray at a time.
+  void traceRect(const Entry& e) {
+    for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
+      for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
+        const double range = beams_.range(row, col);
+        if (!(range >= e.near)) continue;  // a hit nearer than this node can be
+        double tmax = std::min(config_.tmax, range);
+        Best best;
+        if (slicing_) {
+          traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
+            if (!hidden(slot)) sliceOne(slot, col, &tmax, &best);
+          });
+        } else {
+          const auto ray = beams_.template sensorRay<M>(row, col);
+          traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
+            if (hidden(slot)) return;
+            const SensorTriangle& s = cachedTriangle(slot);
+            const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
+            if (hit && best.improves(hit->t, ids_[slot])) {
+              best = Best{hit->t, ids_[slot], slot};
+              tmax = hit->t;
+            }
+          });
+        }
+        if (best.found()) offer(row, col, best);
+      }
+    }
+  }
+
+  // A back face of a closed component that the sensor sees from outside: never the nearest hit of a
+  // beam (hiddenBackFace), so never tested. Only for the 3D tests: a planar fan's segments are
+  // cheap, and kept slices (which must skip what the walk skips) would pay more to decide.
+  // The answer depends on the slot alone for the whole walk, and neighbouring beams ask about the
+  // same slots: the last answers are kept by slot.
+  bool hidden(std::uint32_t slot) { return closed_ && hiddenClosed(slot); }
+  // Out of line: the tests that ask stay small inline.
+  __attribute__((noinline)) bool hiddenClosed(std::uint32_t slot) {
+    return hidden_.get(
+        slot, [&] { return hiddenBackFace(mesh_, slot, active_.sensor_in_body, config_.tmin); });
+  }
+
+  // The slot's segment in the scan plane against one beam, as slicing tests it.
+  void sliceOne(std::uint32_t slot, int col, double* tmax, Best* best) const {
+    slicer_->sliceSlot(
+        slot, col, col,
+        [&](int, double t) {
+          if (t <= *tmax && best->improves(t, ids_[slot])) {
+            *best = Best{t, ids_[slot], slot};
+            *tmax = t;
+          }
+        },
+        [&](int, double segment_near) { return segment_near <= *tmax; });
+  }
+
+  // A few beams against each triangle of a leaf, directly.
+  void testLeaf(const Entry& e) {
+    SensorTriangle tris[16];  // the leaf's first triangles, moved once
+    const std::uint32_t count = std::min<std::uint32_t>(e.ref.count, 16);
+    for (std::uint32_t i = 0; i < count; ++i) tris[i] = sensorTriangle(e.ref.index + i);
+    for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
+      for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
+        const double range = beams_.range(row, col);
+        if (!(range >= e.near)) continue;
+        const auto ray = beams_.template sensorRay<M>(row, col);
+        double tmax = std::min(config_.tmax, range);
+        Best best;
+        for (std::uint32_t i = 0; i < e.ref.count; ++i) {
+          const std::uint32_t slot = e.ref.index + i;
+          if (hidden(slot)) continue;
+          const SensorTriangle s = i < count ? tris[i] : sensorTriangle(slot);
+          const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
+          if (hit && best.improves(hit->t, ids_[slot])) {
+            best = Best{hit->t, ids_[slot], slot};
+            tmax = hit->t;
+          }
+        }
+        if (best.found()) offer(row, col, best);
+      }
+    }
+  }
+
+  // Each triangle of the leaf against the open beams of the leaf's window: column by column
+  // through a conservative float test of its edge planes and its plane (ColumnRaster), or for
+  // patterns too steep for it row by row (EdgeFilter), then the exact test for the beams let
+  // through.
+  void rasterLeaf(const Entry& e) {
+    for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
+      if (hidden(slot)) continue;
+      const SensorTriangle s = sensorTriangle(slot);
+      const std::uint32_t triangle = ids_[slot];
+      auto test = [&](int row, int col) {
+        // The range rounded up to float (compact, so cheaper to read here than the result's): a
+        // hit it lets through beyond the exact range is turned down by offer().
+        const double range = beams_.rangeAbove(row)[col];
+        if (!(range >= e.near)) return;
+        const auto hit = beams_.template sensorRay<M>(row, col).intersect(
+            s.a, s.b, s.c, std::min(config_.tmax, range));
+        if (!hit) return;
+        beams_.offer(row, col, hit->t, active_.index, static_cast<int>(triangle),
+                     [&] { return sensorNormal(triangle); });
+      };
+      if (beams_.columnRaster()) {
+        ColumnRaster(beams_, s.a, s.b, s.c).forEachCandidate(beams_, e.rect, test);
+        continue;
+      }
+      const EdgeFilter filter(s.a, s.b, s.c);
+      for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
+        filter.forEachCandidate(beams_, row, e.rect.col_lo, e.rect.col_hi,
+                                [&](int col) { test(row, col); });
+      }
+    }
+  }
+
+  // Every leaf below the entry that meets the scan plane, sliced into the entry's beams, with no
+  // windows or occlusion tests on the way: for a small subtree they cost more than they save.
+  void sliceSubtree(const Entry& e) {
+    WideBvh::Ref stack[64 * (WideBvh::kWidth - 1) + 1];
+    int top = 0;
+    stack[top++] = e.ref;
+    while (top > 0) {
+      const WideBvh::Ref ref = stack[--top];
+      if (ref.isLeaf()) {
+        sliceLeaf(ref, e.rect, e.near);
+        continue;
+      }
+      const WideBvh::Node& node = wide_.nodes()[ref.index];
+      const int mask = planeMask(node, frame_);
+      for (int k = 0; k < WideBvh::kWidth; ++k) {
+        if (mask & (1 << k)) stack[top++] = node.child(k);
+      }
+    }
+  }
+
+  void sliceLeaf(WideBvh::Ref leaf, const BeamRect& rect, double near) {
+    for (std::uint32_t slot = leaf.index; slot < leaf.index + leaf.count; ++slot) {
+      if (hidden(slot)) continue;
+      slicer_->sliceSlot(
+          slot, rect.col_lo, rect.col_hi,
+          [&](int col, double t) {
+            beams_.offer(0, col, t, active_.index, static_cast<int>(ids_[slot]),
+                         [&] { return slicer_->sensorNormal(slot); });
+          },
+          [&](int col, double segment_near) {
+            return beams_.range(0, col) >= std::max(near, segment_near);
+          });
+    }
+  }
+
+  BeamSet& beams_;
+  const Mesh& mesh_;
+  const WideBvh& wide_;
+  const std::vector<std::array<Eigen::Vector3d, 3>>& slots_;
+  const std::vector<std::uint32_t>& ids_;
+  const PlacedBody& active_;
+  const CastConfig& config_;
+  const Eigen::Matrix3d rot_, abs_rot_;
+  const Eigen::Vector3d trans_;
+  const bool planar_, slicing_, tracing_only_;
+  SlotCache<SensorTriangle, 64> triangles_;
+  SlotCache<bool, 256> hidden_;
+  bool closed_;  // the mesh has closed components
+  const ViewFrame frame_;
+  const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame
+  std::optional<PlaneSlicer> slicer_;
+  std::vector<Entry> stack_ = std::vector<Entry>(256);
+  int top_ = 0;
+};
+
+}  // namespace
+
+void castBody(BeamSet& beams, const Scene& scene, const PlacedBody& active,
+              const CastConfig& config, const BeamRect& within) {
+  const Body& body = scene.bodies()[active.index];
+  const auto* mesh = std::get_if<std::shared_ptr<const Mesh>>(&body.shape);
+  if (!mesh) {
+    castPrimitive(beams, scene, active, config, within);
+    return;
+  }
+  dispatchTriangleMethod(config.method, [&](auto method) {
+    MeshWalk<decltype(method)::value> walk(beams, **mesh, active, config);
+    walk.run(within);
+  });
+}
+
+}  // namespace core
+}  // namespace laser_raycast

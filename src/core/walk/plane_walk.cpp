@@ -1,0 +1,304 @@
+#include "walk/plane_walk.h"
+#include "beams/placed_body.h"
+
+#include <algorithm>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "slice/plane_views.h"
+#include "walk/primitive_cast.h"
+#include "walk/scene_walk.h"
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+// A node whose window holds at most this many beams has them traced through its subtree one ray at
+// a time instead of its children's windows being computed. Only speed depends on it.
+constexpr long long kTraceBeams = 16;
+
+// The map from plane coordinates (z = 0) to the sensor frame, for the node views.
+Eigen::Isometry3d sensorFromPlane(const PlaneFrame& f) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() << f.a, f.b, 0, f.c, f.d, 0, 0, 0, 1;
+  pose.translation() << f.tx, f.ty, 0;
+  return pose;
+}
+
+class SliceWalk {
+ public:
+  SliceWalk(BeamSet& beams, const Scene& scene, const PlaneSlice& slice, const PlaneFrame& plane,
+            const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
+            std::vector<std::atomic<char>>* cast)
+      : beams_(beams),
+        scene_(scene),
+        slice_(slice),
+        plane_(plane),
+        sensor_from_frame_(sensor_from_frame),
+        config_(config),
+        cast_(cast),
+        sensor_from_plane_(sensorFromPlane(plane)),
+        views_(plane, config.tmax, beams.pattern()) {
+    // The sensor and the beams in plane coordinates, for the traced rays' box tests: the inverse
+    // of the map to the sensor frame.
+    const double det = plane.a * plane.d - plane.b * plane.c;
+    inverse_ << plane.d / det, -plane.b / det, -plane.c / det, plane.a / det;
+    origin_.emplace(-(inverse_ * Eigen::Vector2d(plane.tx, plane.ty)), slice.tree.bounds(),
+                    config.tmin);
+    stack_.reserve(256);  // room for most walks: it would grow four or five times a scan
+  }
+
+  void run(const BeamRect& within) {
+    if (slice_.wide.empty()) return;
+    const Aabb& bounds = slice_.tree.bounds();
+    const Eigen::Matrix3d& rot = sensor_from_plane_.linear();
+    const View view = boxView(bounds.center(), bounds.extent() * 0.5, rot, rot.cwiseAbs(),
+                              sensor_from_plane_.translation(), beams_.pattern().angleMin(), false);
+    if (!(view.near <= config_.tmax)) return;
+    beams_.forEachRect(view, within, [&](const BeamRect& rect) {
+      stack_.push_back(Entry{slice_.wide.root(), rect, floatBelow(view.near)});
+    });
+    walk();
+    deferred_.cast(beams_, scene_, config_);
+  }
+
+ private:
+  struct Entry {
+    WideBvh::Ref ref;
+    BeamRect rect;
+    float near;
+  };
+
+  void walk() {
+    while (!stack_.empty()) {
+      Entry e = stack_.back();
+      stack_.pop_back();
+      // The nearest child of an expanded node goes on at once, without a round trip through the
+      // stack.
+      while (beams_.anyOpen(e.rect, e.near)) {  // else hidden behind nearer hits
+        if (e.ref.isLeaf()) {
+          for (std::uint32_t i = e.ref.index; i < e.ref.index + e.ref.count; ++i) {
+            testItem(slice_.items[i], e.rect, e.near);
+          }
+          break;
+        }
+        if (e.rect.beams() <= kTraceBeams) {
+          traceRect(e);
+          break;
+        }
+        if (!expand(&e)) break;
+      }
+    }
+  }
+
+ private:
+  // Replaces *entry by the nearest of its node's children that may be seen in its window, after
+  // pushing the others, farthest first; false if there is none.
+  bool expand(Entry* entry) {
+    // Only the fields needed, not the whole entry: it was just written field by field.
+    const WideBvh::Node& node = slice_.wide.nodes()[entry->ref.index];
+    const int col_lo = entry->rect.col_lo, col_hi = entry->rect.col_hi;
+    PlaneViews views;
+    views.compute(node, views_);
+    // The children's windows, field by field (a child's view may wrap into several windows).
+    constexpr int kMax = 4 * 3;
+    int child[kMax], lo[kMax], hi[kMax];
+    float near[kMax];
+    int n = 0;
+    for (int k = 0; k < WideBvh::kWidth; ++k) {
+      if (!(views.mask & (1 << k))) continue;
+      auto add = [&](int first, int last) {
+        const int l = std::max(first, col_lo), h = std::min(last, col_hi);
+        if (l <= h && n < kMax) {
+          child[n] = k;
+          lo[n] = l;
+          hi[n] = h;
+          near[n] = views.near[k];
+          ++n;
+        }
+      };
+      if (views.columns_known & (1 << k)) {
+        add(views.col_lo[k], views.col_hi[k]);
+      } else if (!(views.az_half[k] >= 0)) {
+        add(col_lo, col_hi);
+      } else {
+        beams_.forEachColumnRange(views.az_center[k], views.az_half[k], add);
+      }
+    }
+    if (n == 0) return false;
+    int order[kMax];
+    sortFarthestFirst(near, order, n);
+    auto childEntry = [&](int j) {
+      return Entry{node.child(child[j]), BeamRect{0, 0, lo[j], hi[j]}, near[j]};
+    };
+    for (int i = 0; i + 1 < n; ++i) stack_.push_back(childEntry(order[i]));
+    *entry = childEntry(order[n - 1]);
+    return true;
+  }
+
+  // The body's pose relative to the sensor.
+  Eigen::Isometry3d sensorFromBody(int body) const {
+    return sensor_from_frame_ * scene_.bodies()[body].frame_from_body;
+  }
+  const Mesh& meshOf(int body) const {
+    return *std::get<std::shared_ptr<const Mesh>>(scene_.bodies()[body].shape);
+  }
+
+  // A segment against the beams [first, last] as PlaneSlicer tests it; a hit improving *best (if
+  // given) or offered to the beam.
+  template <class Hit, class Open>
+  void testSegment(const PlaneSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
+    Eigen::Vector2d front;
+    if (config_.cull_backfaces) front = frontOf(s);
+    testSegmentInFan(beams_.pattern(), plane_.toSensor(s.p), plane_.toSensor(s.q), config_.tmin,
+                     config_.tmax, config_.cull_backfaces ? &front : nullptr, first, last, hit,
+                     open);
+  }
+
+  void offerSegmentHit(int col, double t, const PlaneSlice::Item& s) {
+    const Mesh& mesh = meshOf(s.body);
+    const std::uint32_t triangle = mesh.bvh().triangleIds()[s.slot];
+    beams_.offer(0, col, t, s.body, static_cast<int>(triangle), [&] {
+      return Eigen::Vector3d(sensorFromBody(s.body).linear() * mesh.normal(triangle));
+    });
+  }
+
+  void testItem(const PlaneSlice::Item& item, const BeamRect& rect, float near) {
+    (*cast_)[item.body].store(1, std::memory_order_relaxed);
+    if (item.slot == PlaneSlice::kPrimitive) {
+      castPrimitiveItem(item.body, rect);
+      return;
+    }
+    testSegment(
+        item, rect.col_lo, rect.col_hi, [&](int col, double t) { offerSegmentHit(col, t, item); },
+        [&](int col, double segment_near) {
+          return beams_.range(0, col) >= std::max(double(near), segment_near);
+        });
+  }
+
+  // A primitive: its pose, culled by its box's view as the scene walk culls it, then cast over the
+  // rect, or after the walk if it is large for its distance (a wall the sensor stands beside:
+  // nearest first would test it with every beam before the nearer things in front of it).
+  void castPrimitiveItem(int index, const BeamRect& rect) {
+    PlacedBody a = placeBody(scene_, index, sensor_from_frame_);
+    viewPlacedBody(scene_, beams_.pattern().angleMin(), false, &a);
+    if (!(a.view.near <= config_.tmax) || !a.view.crosses) return;
+    beams_.forEachRect(a.view, rect, [&](const BeamRect& r) {
+      if (deferLargePrimitive(a)) {
+        deferred_.add(a, r);
+      } else if (beams_.anyOpen(r, a.view.near)) {
+        castPrimitive(beams_, scene_, a, config_, r);
+      }
+    });
+  }
+
+  // A beam traced through a subtree: its ray in plane coordinates and its nearest item so far.
+  struct Traced {
+    int col;
+    double dx, dy, tmax;
+    const PlaneSlice::Item* best;
+    double best_t;
+    PlaneRay ray;
+  };
+
+  // The test of a traced beam against a leaf's item.
+  auto leafTest(Traced* b) {
+    return [this, b](std::uint32_t i) {
+      const PlaneSlice::Item& item = slice_.items[i];
+      (*cast_)[item.body].store(1, std::memory_order_relaxed);
+      if (item.slot == PlaneSlice::kPrimitive) {
+        PlacedBody a = placeBody(scene_, item.body, sensor_from_frame_);
+        placeSensorInBody(&a);
+        castPrimitiveBeam(beams_, scene_, a, config_, 0, b->col);
+        b->tmax = std::min(b->tmax, beams_.range(0, b->col));
+        return;
+      }
+      Eigen::Vector2d front;
+      if (config_.cull_backfaces) front = frontOf(item);
+      double t;
+      if (!beamCrossesSegment(b->dx, b->dy, plane_.toSensor(item.p), plane_.toSensor(item.q),
+                              config_.tmin, b->tmax, config_.cull_backfaces ? &front : nullptr,
+                              &t)) {
+        return;
+      }
+      if (t < b->best_t || (t == b->best_t && before(item, *b->best))) {
+        b->best = &item;
+        b->best_t = t;
+        b->tmax = t;
+      }
+    };
+  }
+
+  // Each open beam of the rect through the node's subtree, two at a time (their walks side by
+  // side): box tests in plane coordinates, each item tested as testItem tests it.
+  void traceRect(const Entry& e) {
+    const auto& dirs = beams_.pattern().directions();
+    Traced pair[2];
+    int n = 0;
+    for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
+      const double range = beams_.range(0, col);
+      if (!(range >= e.near)) continue;
+      Traced& b = pair[n++];
+      b.col = col;
+      b.dx = dirs[col].x();
+      b.dy = dirs[col].y();
+      b.tmax = std::min(config_.tmax, range);
+      b.best = nullptr;
+      b.best_t = std::numeric_limits<double>::infinity();
+      b.ray = PlaneRay(*origin_, inverse_ * Eigen::Vector2d(b.dx, b.dy));
+      if (n == 2) {
+        traceWidePair(slice_.wide, e.ref, pair[0].ray, &pair[0].tmax, leafTest(&pair[0]),
+                      pair[1].ray, &pair[1].tmax, leafTest(&pair[1]));
+        finish(pair[0]);
+        finish(pair[1]);
+        n = 0;
+      }
+    }
+    if (n == 1) {
+      traceWide(slice_.wide, e.ref, pair[0].ray, &pair[0].tmax, leafTest(&pair[0]));
+      finish(pair[0]);
+    }
+  }
+
+  void finish(const Traced& b) {
+    if (b.best) offerSegmentHit(b.col, b.best_t, *b.best);
+  }
+
+  // The tie rule of BeamSet::offer: the lower body, then the lower triangle.
+  bool before(const PlaneSlice::Item& a, const PlaneSlice::Item& b) const {
+    if (a.body != b.body) return a.body < b.body;
+    const auto& ids = meshOf(a.body).bvh().triangleIds();
+    return ids[a.slot] < ids[b.slot];
+  }
+
+  Eigen::Vector2d frontOf(const PlaneSlice::Item& s) const {
+    const auto& v = meshOf(s.body).bvh().triangleVertices()[s.slot];
+    return (sensorFromBody(s.body).linear() * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
+  }
+
+  BeamSet& beams_;
+  const Scene& scene_;
+  const PlaneSlice& slice_;
+  const PlaneFrame& plane_;
+  const Eigen::Isometry3d sensor_from_frame_;
+  const CastConfig& config_;
+  std::vector<std::atomic<char>>* cast_;
+  const Eigen::Isometry3d sensor_from_plane_;
+  const PlaneViewFrame views_;
+  Eigen::Matrix2d inverse_;
+  std::optional<PlaneRay::Origin> origin_;
+  std::vector<Entry> stack_;
+  DeferredPrimitives deferred_;  // cast after the walk
+};
+
+}  // namespace
+
+void castSlice(BeamSet& beams, const Scene& scene, const PlaneSlice& slice, const PlaneFrame& plane,
+               const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
+               const BeamRect& within, std::vector<std::atomic<char>>* cast) {
+  SliceWalk(beams, scene, slice, plane, sensor_from_frame, config, cast).run(within);
+}
+
+}  // namespace core
+}  // namespace laser_raycast
