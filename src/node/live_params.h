@@ -5,13 +5,13 @@
 
 #include <string>
 
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/node/node_params.h"
 
 namespace laser_raycast {
 
 struct LiveParams {
-  core::EncoderConfig output;  // range limits, min-range policy, noise, intensity, realism
+  core::MeasurementConfig output;  // range limits, min-range policy, noise, intensity, realism
   double rate = 10.0;          // Hz
 };
 
@@ -21,7 +21,7 @@ LiveParams liveParams(const SensorParams& params);
 // Applies `live` to *params and returns "", or returns the problem (naming the parameter and the
 // value) and leaves *params as it was: a rate outside (0, kMaxRate], a rate too fast for a
 // rotating sensor's scan_time (one turn per scan; scan_time itself needs a restart), or output
-// settings core::EncoderConfig::validate refuses (e.g. range_min >= range_max).
+// settings core::MeasurementConfig::validate refuses (e.g. range_min >= range_max).
 std::string applyLiveParams(const LiveParams& live, SensorParams* params);
 
 }  // namespace laser_raycast

@@ -46,7 +46,7 @@ void writePoint(const Point& p, std::uint8_t* out) {
   std::memcpy(out + Layout::kTime, &p.time, 4);
 }
 
-void checkSizes(const core::ScanPattern& pattern, const core::EncodedScan& scan,
+void checkSizes(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
                 const std::vector<double>& column_times) {
   const std::size_t beams = pattern.size();
   std::string problem;
@@ -69,7 +69,7 @@ void checkSizes(const core::ScanPattern& pattern, const core::EncodedScan& scan,
 
 }  // namespace
 
-void buildPointCloud(const core::ScanPattern& pattern, const core::EncodedScan& scan,
+void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
                      const std::vector<double>& column_times, const std_msgs::Header& header,
                      const CloudOptions& options, sensor_msgs::PointCloud2* cloud) {
   checkSizes(pattern, scan, column_times);

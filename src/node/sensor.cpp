@@ -23,7 +23,7 @@ Sensor::Sensor(ros::NodeHandle& nh, const SensorParams& params, const std::strin
       pattern_(params.scan.pattern()),
       cast_config_(params.scan.castConfig()),
       threads_(threads),
-      encoder_(params.scan.output),
+      measurement_model_(params.scan.output),
       monitor_(params.name, nh.resolveName(params.topic), grace_period) {
   cast_config_.threads = threads_;
   if (params.planar()) {
@@ -80,7 +80,7 @@ void Sensor::applyLive() {
   cast_params_ = params_;
   cast_config_ = cast_params_.scan.castConfig();
   cast_config_.threads = threads_;
-  encoder_.setConfig(cast_params_.scan.output);
+  measurement_model_.setConfig(cast_params_.scan.output);
   if (cast_params_.sweep == Sweep::kRotating) {
     column_times_ = rotatingColumnTimes(pattern_.azimuthCount(), cast_params_.timeIncrement());
   }
@@ -133,7 +133,7 @@ void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>&
   }
   const double cast_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  encoder_.encode(scene, *result, reflectivity, &encoded_);
+  measurement_model_.measure(scene, *result, reflectivity, &measured_);
   if (cast_params_.planar()) {
     publishScan(times.front());
   } else {
@@ -144,11 +144,11 @@ void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>&
   header.frame_id = cast_params_.frame_id;
   publishLabels(scene, header);
 
-  const core::EncoderConfig& out = cast_params_.scan.output;
+  const core::MeasurementConfig& out = cast_params_.scan.output;
   std::size_t hits = 0;
-  for (const float r : encoded_.ranges) hits += r >= out.range_min && r <= out.range_max;
+  for (const float r : measured_.ranges) hits += r >= out.range_min && r <= out.range_max;
   monitor_.published(times.front(), missing_links, cast_seconds,
-                     encoded_.ranges.empty() ? 0.0 : double(hits) / encoded_.ranges.size());
+                     measured_.ranges.empty() ? 0.0 : double(hits) / measured_.ranges.size());
 }
 
 void Sensor::publishScan(const ros::Time& stamp) {
@@ -162,8 +162,8 @@ void Sensor::publishScan(const ros::Time& stamp) {
   scan.scan_time = static_cast<float>(cast_params_.scanTime());
   scan.range_min = static_cast<float>(cast_params_.scan.output.range_min);
   scan.range_max = static_cast<float>(cast_params_.scan.output.range_max);
-  scan.ranges = encoded_.ranges;
-  scan.intensities = encoded_.intensities;
+  scan.ranges = measured_.ranges;
+  scan.intensities = measured_.intensities;
   scan_pub_.publish(scan);
 }
 
@@ -174,7 +174,7 @@ void Sensor::publishCloud(const ros::Time& stamp) {
   CloudOptions options;
   options.organized = cast_params_.organized;
   sensor_msgs::PointCloud2 cloud;
-  buildPointCloud(pattern_, encoded_, column_times_, header, options, &cloud);
+  buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud);
   cloud_pub_.publish(cloud);
 }
 
@@ -184,7 +184,7 @@ void Sensor::publishLabels(const core::Scene& scene, const std_msgs::Header& hea
   laser_raycast::ScanLabels labels;
   labels.header = header;
   labels.link_names = scene.labels();
-  labels.labels.assign(encoded_.labels.begin(), encoded_.labels.end());
+  labels.labels.assign(measured_.labels.begin(), measured_.labels.end());
   labels_pub_.publish(labels);
 }
 

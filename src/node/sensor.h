@@ -1,4 +1,4 @@
-// One simulated sensor of the node: its beams, caster and encoder, where its pose comes from (TF or
+// One simulated sensor of the node: its beams, caster and model, where its pose comes from (TF or
 // a pose topic), its publishers (LaserScan for a planar pattern, PointCloud2 otherwise, and the
 // per-beam labels), its live parameters, and its monitor. The cast thread casts it; its timer, the
 // subscriber check and live reconfiguration run on the node's callback thread.
@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scene.h"
 #include "laser_raycast/node/node_params.h"
@@ -93,8 +93,8 @@ class Sensor {
   core::CastConfig cast_config_;
   const int threads_;  // ~threads (node-wide), for every cast
   core::Caster caster_;
-  core::ScanEncoder encoder_;
-  core::EncodedScan encoded_;
+  core::MeasurementModel measurement_model_;
+  core::MeasuredScan measured_;
   std::vector<double> column_times_;  // s after the stamp, per azimuth column (rotating)
 
   std::unique_ptr<PoseTopic> pose_topic_;

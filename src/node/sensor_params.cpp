@@ -78,7 +78,7 @@ void readSensorModel(ParamReader* r, SensorParams* s) {
 
 // What the sensor reports: range limits, min-range policy, noise, intensity; and how it casts.
 void readOutput(ParamReader* r, core::ScanSpec* scan) {
-  core::EncoderConfig& out = scan->output;
+  core::MeasurementConfig& out = scan->output;
   out.range_min = r->number("range_min", out.range_min, "m");
   out.range_max = r->number("range_max", out.range_max, "m");
   out.min_range_policy =

@@ -32,7 +32,7 @@ void SensorReconfigure::onConfig(RaycastConfig& config, std::uint32_t) {
   const Sensor::Live before = sensor_->live();
   Sensor::Live next = before;
   next.rate = config.rate;
-  core::EncoderConfig& out = next.output;
+  core::MeasurementConfig& out = next.output;
   out.range_min = config.range_min;
   out.range_max = config.range_max;
   out.noise_stddev = config.noise_stddev;

@@ -69,18 +69,18 @@ Pass brutePass(const core::BvhT<T>& bvh) {
 
 // The pipeline as the node runs it: one Caster::cast per sensor pose over the whole pattern.
 // forget() first, so that an unchanged pose does not return the previous result. The caster keeps
-// its thread pool between casts, as the node's does, and its kept slices (plane_slice.h) unless
-// plane_cache is false: then every planar fan is cast as one in a plane never met before (a tilting
+// its thread pool between casts, as the node's does, and its kept slices (kept_slice.h) unless
+// keep_slices is false: then every planar fan is cast as one in a plane never met before (a tilting
 // sensor's, or a robot's first scans).
-Pass pipelinePass(const BenchScene& scene, int threads, bool plane_cache) {
+Pass pipelinePass(const BenchScene& scene, int threads, bool keep_slices) {
   auto caster = std::make_shared<core::Caster>();
-  return [caster, &scene, threads, plane_cache](const WorkloadRays& w, const std::vector<int>&,
+  return [caster, &scene, threads, keep_slices](const WorkloadRays& w, const std::vector<int>&,
                                                 std::vector<double>* out) {
     core::CastConfig config;
     config.tmin = 0;
     config.tmax = w.tmax;
     config.threads = threads;
-    config.plane_cache = plane_cache;
+    config.keep_slices = keep_slices;
     const std::size_t beams = static_cast<std::size_t>(w.pattern->size());
     for (std::size_t p = 0; p < w.sensors.size(); ++p) {
       caster->forget();

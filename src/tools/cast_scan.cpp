@@ -16,7 +16,7 @@
 
 #include "command_line.h"
 #include "laser_raycast/core/caster.h"
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/kinematics.h"
 #include "laser_raycast/loader/package_resolver.h"
@@ -359,7 +359,7 @@ LoadedScene loadScene(const Args& args) {
 
 // Casts the scan `repeat` more times and prints the median time to stderr. Each cast is computed
 // anew (forget(): not the previous scan's result), as the node casts scan after scan: a planar
-// fan's kept slices of its plane (plane_slice.h) serve the casts after the first two.
+// fan's kept slices of its plane (kept_slice.h) serve the casts after the first two.
 void reportMedianCastTime(const Args& args, const LoadedScene& loaded,
                           const core::ScanPattern& pattern, const core::CastConfig& config,
                           core::Caster& caster) {

@@ -1,6 +1,6 @@
 // Stress case 6: non-finite input. NaN, +Inf or -Inf in a vertex, the ray origin or the direction,
 // a zero direction, and a NaN interval: no hit and no crash at the triangle and through the BVH;
-// Mesh rejects non-finite vertices; through the Caster and the ScanEncoder a non-finite sensor pose
+// Mesh rejects non-finite vertices; through the Caster and the MeasurementModel a non-finite sensor pose
 // makes every beam NaN (REP 117: erroneous), and a non-finite frame pose drops only that frame.
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/mesh.h"
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 #include "random.h"
 #include "stress_report.h"
 
@@ -145,7 +145,7 @@ TEST(StressNonFinite, TriangleAndBvhNeverHit) {
   EXPECT_EQ(any[0].hits, 0);
 }
 
-// The production pipeline: Mesh, ScanPattern, Caster and ScanEncoder.
+// The production pipeline: Mesh, ScanPattern, Caster and MeasurementModel.
 TEST(StressNonFinite, PipelineReportsNanOrRejects) {
   // Mesh rejects a non-finite vertex (in the vertex list, used or not).
   const TriMesh cube = makeBoxRoom(Vector3d(1, 1, 1), 1);
@@ -197,10 +197,10 @@ TEST(StressNonFinite, PipelineReportsNanOrRejects) {
   const core::FramePoses good = core::FramePoses::identity(scene);
   const core::ScanPattern planar(core::FanSpec{-M_PI, M_PI, 0, 720});
   const core::ScanPattern rings(core::FanSpec{-M_PI, M_PI, 0, 360}, {-0.2, 0.2});
-  core::EncoderConfig encoder_config;
-  encoder_config.range_min = 0.1;
-  encoder_config.range_max = 20;
-  core::ScanEncoder encoder(encoder_config);
+  core::MeasurementConfig measurement_config;
+  measurement_config.range_min = 0.1;
+  measurement_config.range_max = 20;
+  core::MeasurementModel model(measurement_config);
 
   // Non-finite sensor poses: a translation component or a rotation entry.
   std::vector<Eigen::Isometry3d> bad_sensors;
@@ -224,8 +224,8 @@ TEST(StressNonFinite, PipelineReportsNanOrRejects) {
         // A good cast first, so that a stale result cannot pass for the NaN one.
         caster.cast(scene, good, Eigen::Isometry3d::Identity(), *pattern, config);
         const core::ScanResult& r = caster.cast(scene, good, sensor, *pattern, config);
-        core::EncodedScan out;
-        encoder.encode(scene, r, {}, &out);
+        core::MeasuredScan out;
+        model.measure(scene, r, {}, &out);
         for (int i = 0; i < pattern->size(); ++i) {
           ++sensor_beams;
           sensor_not_nan += !std::isnan(r.range[i]);
@@ -246,8 +246,8 @@ TEST(StressNonFinite, PipelineReportsNanOrRejects) {
       core::Caster caster;
       const core::ScanResult& r =
           caster.cast(scene, poses, Eigen::Isometry3d::Identity(), planar, config);
-      core::EncodedScan out;
-      encoder.encode(scene, r, {}, &out);
+      core::MeasuredScan out;
+      model.measure(scene, r, {}, &out);
       ++frame_casts;
       frames_skipped += r.stats.bodies_skipped == 1;
       for (int i = 0; i < planar.size(); ++i) {
@@ -269,7 +269,7 @@ TEST(StressNonFinite, PipelineReportsNanOrRejects) {
             count(pattern_rejected) + " / " + count(pattern_cases)});
   t.addRow({"Caster: beams NaN under a non-finite sensor pose",
             count(sensor_beams - sensor_not_nan) + " / " + count(sensor_beams)});
-  t.addRow({"ScanEncoder: ranges NaN, labels -1",
+  t.addRow({"MeasurementModel: ranges NaN, labels -1",
             count(sensor_beams - encoded_not_nan) + " / " + count(sensor_beams) + ", " +
                 count(sensor_beams - labelled) + " / " + count(sensor_beams)});
   t.addRow({"Non-finite frame pose: frame skipped, no NaN beam",

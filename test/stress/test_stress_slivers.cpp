@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
-#include "slice/fan_slicer.h"
+#include "slice/slicer.h"
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/core/pose.h"
 #include "random.h"

@@ -201,7 +201,7 @@ inline std::string reportIntro() {
          "Every case measures one figure for each triangle method in double and in float, and "
          "asserts a bound only on the production path: `watertight` in double, through the BVH "
          "(`Mesh`, `Bvh::closestHit`) and the `Caster` (planar fast path and per-beam path) with "
-         "the `ScanEncoder` for REP 117 output. The other rows are recorded, not asserted. "
+         "the `MeasurementModel` for REP 117 output. The other rows are recorded, not asserted. "
          "Expected values never come from the code under test: analytic values, long double "
          "arithmetic, brute force, or topology (a ray from inside a convex closed mesh crosses it "
          "exactly once). Randomness is seeded, so a run repeats these figures exactly on the "

@@ -101,7 +101,7 @@ TEST(NodeViews, EveryBeamThatEntersAChildBoxIsInItsWindow) {
       const core::Mesh mesh(s.vertices, s.triangles);
       const core::WideBvh& w = mesh.wideBvh();
       const Eigen::Isometry3d pose = randomPose(rng, 6);
-      const core::ViewFrame frame(pose, pattern.planar(), 30.0);
+      const core::ViewBasis frame(pose, pattern.planar(), 30.0);
       for (const core::WideBvh::Node& node : w.nodes()) {
         core::NodeViews views;
         views.compute(node, frame);

@@ -123,14 +123,14 @@ TEST(CasterWalk, TiltedRoomWithAVertexRowAtTheSensorHeightLeaksNowhere) {
           }
           break;
         case 1:
-          c.plane_cache = false;
+          c.keep_slices = false;
           break;
         case 2:
           c.planar_fast_path = false;  // every beam traced
           break;
         case 3:
           c.occlusion_culling = false;
-          c.plane_cache = false;
+          c.keep_slices = false;
           break;
         case 4:
           pattern = &rings;

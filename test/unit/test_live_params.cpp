@@ -85,7 +85,7 @@ TEST(LiveParams, RatesOutsideTheRangeAreRefused) {
   }
 }
 
-// The encoder's own validation, naming the field.
+// The measurement model's own validation, naming the field.
 TEST(LiveParams, InconsistentOutputSettingsAreRefused) {
   LiveParams live = liveParams(SensorParams());
   live.output.range_min = 6.0;

@@ -37,8 +37,8 @@ ScanPattern twoRings() {
 }
 
 // Ring-major: ring 0 = {2, no return, 1.5}, ring 1 = {too close, 3, NaN}.
-EncodedScan sixBeams() {
-  EncodedScan scan;
+MeasuredScan sixBeams() {
+  MeasuredScan scan;
   scan.ranges = {2.0f, kInf, 1.5f, -kInf, 3.0f, kNan};
   scan.intensities = {0.5f, 0.0f, 0.25f, 0.0f, 0.75f, 0.0f};
   scan.labels = {0, -1, 0, 0, 0, -1};
@@ -157,7 +157,7 @@ TEST(PointCloud, OrganizedHoldsEveryBeam) {
     }
   }
   // With a return on every beam, an organized cloud is dense.
-  EncodedScan all = sixBeams();
+  MeasuredScan all = sixBeams();
   all.ranges = {1, 2, 3, 4, 5, 6};
   buildPointCloud(twoRings(), all, {}, header(), organized, &cloud);
   EXPECT_TRUE(cloud.is_dense);
@@ -165,7 +165,7 @@ TEST(PointCloud, OrganizedHoldsEveryBeam) {
 }
 
 TEST(PointCloud, NoIntensitiesGiveZero) {
-  EncodedScan scan = sixBeams();
+  MeasuredScan scan = sixBeams();
   scan.intensities.clear();
   sensor_msgs::PointCloud2 cloud;
   buildPointCloud(twoRings(), scan, {}, header(), CloudOptions{}, &cloud);
@@ -174,7 +174,7 @@ TEST(PointCloud, NoIntensitiesGiveZero) {
 
 TEST(PointCloud, MismatchedSizesThrow) {
   sensor_msgs::PointCloud2 cloud;
-  EncodedScan scan = sixBeams();
+  MeasuredScan scan = sixBeams();
   scan.ranges.pop_back();
   EXPECT_THROW(buildPointCloud(twoRings(), scan, {}, header(), CloudOptions{}, &cloud),
                std::invalid_argument);
@@ -210,9 +210,9 @@ TEST(PointCloud, PointsOfACastLieOnTheWall) {
   Caster caster;
   const ScanResult& result = caster.cast(scene, FramePoses::identity(scene),
                                          Eigen::Isometry3d::Identity(), pattern, spec.castConfig());
-  ScanEncoder encoder(spec.output);
-  EncodedScan scan;
-  encoder.encode(scene, result, {}, &scan);
+  MeasurementModel model(spec.output);
+  MeasuredScan scan;
+  model.measure(scene, result, {}, &scan);
   sensor_msgs::PointCloud2 cloud;
   buildPointCloud(pattern, scan, {}, header(), CloudOptions{}, &cloud);
   const auto points = readAll(cloud);

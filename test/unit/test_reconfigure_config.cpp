@@ -1,5 +1,5 @@
 // cfg/Raycast.cfg against the code it configures: each live parameter's default is the node's and
-// the encoder's default, its limits are the ones they validate, the string choices are exactly the
+// the measurement model's default, its limits are the ones they validate, the string choices are exactly the
 // names they parse, and the levels say what a change touches. The generated header is compiled
 // here, so a .cfg that does not generate or build fails this test.
 #include <gtest/gtest.h>
@@ -11,14 +11,14 @@
 #include <string>
 #include <vector>
 
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/node/node_params.h"
 
 namespace laser_raycast_test {
 namespace {
 
 using laser_raycast::RaycastConfig;
-using laser_raycast::core::EncoderConfig;
+using laser_raycast::core::MeasurementConfig;
 
 std::map<std::string, RaycastConfig::AbstractParamDescriptionConstPtr> descriptions() {
   std::map<std::string, RaycastConfig::AbstractParamDescriptionConstPtr> out;
@@ -37,18 +37,18 @@ TEST(ReconfigureConfig, TheLiveParameters) {
 
 TEST(ReconfigureConfig, DefaultsAreTheNodes) {
   const RaycastConfig& def = RaycastConfig::__getDefault__();
-  const EncoderConfig encoder;
+  const MeasurementConfig model;
   const laser_raycast::SensorParams sensor;
   EXPECT_EQ(def.rate, sensor.rate);
-  EXPECT_EQ(def.range_min, encoder.range_min);
-  EXPECT_EQ(def.range_max, encoder.range_max);
-  EXPECT_EQ(def.min_range_policy, toString(encoder.min_range_policy));
-  EXPECT_EQ(def.intensity, laser_raycast::kIntensityNames.name(encoder.intensity));
-  EXPECT_EQ(def.noise_stddev, encoder.noise_stddev);
-  EXPECT_EQ(static_cast<std::uint64_t>(def.noise_seed), encoder.noise_seed);
-  EXPECT_EQ(def.range_bias, encoder.range_bias);
-  EXPECT_EQ(def.range_resolution, encoder.range_resolution);
-  EXPECT_EQ(def.dropout_probability, encoder.dropout_probability);
+  EXPECT_EQ(def.range_min, model.range_min);
+  EXPECT_EQ(def.range_max, model.range_max);
+  EXPECT_EQ(def.min_range_policy, toString(model.min_range_policy));
+  EXPECT_EQ(def.intensity, laser_raycast::kIntensityNames.name(model.intensity));
+  EXPECT_EQ(def.noise_stddev, model.noise_stddev);
+  EXPECT_EQ(static_cast<std::uint64_t>(def.noise_seed), model.noise_seed);
+  EXPECT_EQ(def.range_bias, model.range_bias);
+  EXPECT_EQ(def.range_resolution, model.range_resolution);
+  EXPECT_EQ(def.dropout_probability, model.dropout_probability);
 }
 
 TEST(ReconfigureConfig, LimitsAreTheValidatedOnes) {
@@ -98,7 +98,7 @@ TEST(ReconfigureConfig, ChoicesAreTheParsedNames) {
   EXPECT_STREQ(laser_raycast::Raycast_reflectivity, "reflectivity");
 }
 
-// 1: the encoder only; 2: also the cast; 4: the timer.
+// 1: the measurement model only; 2: also the cast; 4: the timer.
 TEST(ReconfigureConfig, Levels) {
   auto d = descriptions();
   for (const char* name :

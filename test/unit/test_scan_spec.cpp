@@ -1,5 +1,5 @@
 // ScanSpec: one validated description of a scan, from which the pattern, the caster's configuration
-// and the encoder's are made.
+// and the measurement model's are made.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -24,9 +24,9 @@ struct CastConfig {
   // hit). Never changes the result; off only to test that.
   bool occlusion_culling = true;
   // Planar fans: keep each mesh's slice by a scan plane met again (a sensor moving in its own
-  // plane, as on a floor) and cast later scans through it (plane_slice.h). Never changes the
+  // plane, as on a floor) and cast later scans through it (kept_slice.h). Never changes the
   // result; off to measure a cast whose plane is new every scan, or to test that.
-  bool plane_cache = true;
+  bool keep_slices = true;
 
   // Throws std::invalid_argument naming the field and its value.
   void validate() const;

@@ -41,7 +41,7 @@ class Caster {
                               double time_increment);
 
   // Drops the remembered inputs, so that the next cast() computes even if nothing moved (timing).
-  // Kept slices of meshes by scan planes (CastConfig::plane_cache) stay: like the meshes' BVHs,
+  // Kept slices of meshes by scan planes (CastConfig::keep_slices) stay: like the meshes' BVHs,
   // they hold geometry, not results.
   void forget();
 

@@ -16,7 +16,7 @@ struct CastStats {
   int bodies_culled = 0;
   bool reused = false;  // nothing moved relative to the sensor: the previous geometry was returned
   // Planar fans: frames cast through a kept slice of their bodies by the scan plane
-  // (plane_slice.h).
+  // (kept_slice.h).
   int kept_slices = 0;
 };
 

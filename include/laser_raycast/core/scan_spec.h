@@ -1,13 +1,13 @@
 // What a scan is, in one place: the beams (a fan of azimuths at one or more elevations), the
 // triangle test, and what the sensor reports (range limits, min-range policy, noise, intensity).
-// Validated once; the ScanPattern, the Caster's configuration and the ScanEncoder's are all made
-// from it, so the interval the caster searches always matches the one the encoder reports.
+// Validated once; the ScanPattern, the Caster's configuration and the MeasurementModel's are all made
+// from it, so the interval the caster searches always matches the one the measurement model reports.
 #pragma once
 
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/triangle.h"
 
@@ -19,7 +19,7 @@ struct ScanSpec {
   // Elevations (rad, in [-pi/2, pi/2], distinct, any order). Ring r is the r-th lowest, as lidar
   // drivers number rings. {0}: a planar fan (a LaserScan).
   std::vector<double> elevations = {0.0};
-  EncoderConfig output;  // range_min, range_max, min_range_policy, noise, intensity
+  MeasurementConfig output;  // range_min, range_max, min_range_policy, noise, intensity
   TriangleMethod method = TriangleMethod::kWatertight;  // triangle test for meshes
   bool cull_backfaces = false;  // one-sided triangles: a beam reaching a back face passes through
 

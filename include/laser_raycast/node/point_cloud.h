@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/scan_pattern.h"
 
 namespace laser_raycast {
@@ -36,7 +36,7 @@ struct CloudOptions {
 // and time column_times[column] (s after header.stamp; empty: every column at the stamp, an
 // instantaneous scan; see rotatingColumnTimes). Throws std::invalid_argument if scan.ranges,
 // scan.intensities or column_times do not match the pattern's size, or it has over 65536 rings.
-void buildPointCloud(const core::ScanPattern& pattern, const core::EncodedScan& scan,
+void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
                      const std::vector<double>& column_times, const std_msgs::Header& header,
                      const CloudOptions& options, sensor_msgs::PointCloud2* cloud);
 

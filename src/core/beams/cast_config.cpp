@@ -26,7 +26,7 @@ bool CastConfig::operator==(const CastConfig& o) const {
   return method == o.method && cull_backfaces == o.cull_backfaces && tmin == o.tmin &&
          tmax == o.tmax && planar_fast_path == o.planar_fast_path &&
          raster_fast_path == o.raster_fast_path && occlusion_culling == o.occlusion_culling &&
-         plane_cache == o.plane_cache && compute_incidence == o.compute_incidence;
+         keep_slices == o.keep_slices && compute_incidence == o.compute_incidence;
 }
 
 }  // namespace core

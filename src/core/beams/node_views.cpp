@@ -41,7 +41,7 @@ void storeElevations(const __m128 c[3], const __m128 e[3], __m128 rho2, __m128 r
 
 }  // namespace
 
-ViewFrame::ViewFrame(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax)
+ViewBasis::ViewBasis(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax)
     : planar_(planar) {
   const Eigen::Matrix3d& r = sensor_from_body.linear();
   const Eigen::Vector3d& t = sensor_from_body.translation();
@@ -56,7 +56,7 @@ ViewFrame::ViewFrame(const Eigen::Isometry3d& sensor_from_body, bool planar, dou
   tmax_ = _mm_set1_ps(floatAbove(tmax));
 }
 
-void NodeViews::compute(const WideBvh::Node& node, const ViewFrame& f) {
+void NodeViews::compute(const WideBvh::Node& node, const ViewBasis& f) {
   const __m128 half_ps = _mm_set1_ps(0.5f);
   const __m128 slack = _mm_set1_ps(kViewSlack);
   __m128 cb[3], eb[3];
@@ -135,7 +135,7 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewFrame& f) {
   storeElevations(c, e, rho2, r2, el_lo, el_hi);
 }
 
-int planeMask(const WideBvh::Node& node, const ViewFrame& f) {
+int planeMask(const WideBvh::Node& node, const ViewBasis& f) {
   const __m128 half_ps = _mm_set1_ps(0.5f);
   const __m128 slack = _mm_set1_ps(kViewSlack);
   __m128 cz = f.trans_[2], ez = _mm_setzero_ps(), mag = f.abs_trans_[2];

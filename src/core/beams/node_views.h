@@ -16,14 +16,14 @@ namespace laser_raycast {
 namespace core {
 
 // A body's pose relative to the sensor, prepared for node views.
-class ViewFrame {
+class ViewBasis {
  public:
   // planar: only whether a box meets the sensor's xy plane matters, not its elevations.
-  ViewFrame(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax);
+  ViewBasis(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax);
 
  private:
   friend struct NodeViews;
-  friend int planeMask(const WideBvh::Node& node, const ViewFrame& frame);
+  friend int planeMask(const WideBvh::Node& node, const ViewBasis& basis);
   __m128 rot_[3][3], abs_rot_[3][3], trans_[3], abs_trans_[3];
   __m128 tmax_;
   bool planar_;
@@ -38,12 +38,12 @@ struct NodeViews {
   alignas(16) float el_hi[4];
 
   // Fills the views of node's children.
-  void compute(const WideBvh::Node& node, const ViewFrame& frame);
+  void compute(const WideBvh::Node& node, const ViewBasis& basis);
 };
 
 // Which of node's children may meet the sensor's xy plane (bit k for child k): the cheap part of
 // NodeViews, for walks that need nothing else.
-int planeMask(const WideBvh::Node& node, const ViewFrame& frame);
+int planeMask(const WideBvh::Node& node, const ViewBasis& basis);
 
 }  // namespace core
 }  // namespace laser_raycast

@@ -10,7 +10,7 @@
 namespace laser_raycast {
 namespace core {
 
-struct PlaneFrame;
+struct ScanPlane;
 
 struct PlacedBody {
   int index;
@@ -20,9 +20,9 @@ struct PlacedBody {
   Eigen::Vector3d center;                // bounding sphere centre, sensor frame
   double radius;
   View view;  // how the body's box looks from the sensor: nearest distance, windows
-  // Planar fans: the scan plane in the body's frame's coordinates (fan_slicer.h), and where the
+  // Planar fans: the scan plane in the body's frame's coordinates (slicer.h), and where the
   // body is in that frame: a mesh is cut there, as a kept slice of the frame is.
-  const PlaneFrame* plane = nullptr;
+  const ScanPlane* plane = nullptr;
   Eigen::Isometry3d frame_from_body = Eigen::Isometry3d::Identity();
 };
 

@@ -13,12 +13,12 @@
 
 #include "beams/beam_set.h"
 #include "beams/beam_window.h"
-#include "walk/body_traversal.h"
-#include "slice/plane_slice.h"
-#include "walk/plane_walk.h"
+#include "walk/mesh_walk.h"
+#include "slice/kept_slice.h"
+#include "walk/slice_walk.h"
 #include "laser_raycast/core/pose.h"
 #include "scene/scene_index.h"
-#include "walk/scene_walk.h"
+#include "walk/frame_walk.h"
 #include "util/thread_pool.h"
 
 namespace laser_raycast {
@@ -170,7 +170,7 @@ struct Caster::State {
   std::vector<std::atomic<char>> cast;  // per body: cast against this scan (for the stats)
   BeamSet beams;
   std::unique_ptr<ThreadPool> pool;           // for CastConfig::threads > 1
-  std::unique_ptr<PlaneSliceCache> planes;    // CastConfig::plane_cache
+  std::unique_ptr<KeptSlices> planes;    // CastConfig::keep_slices
   std::optional<ReuseKey> previous;           // the inputs of the result, if it is complete
 
   void placeGroups(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,
@@ -247,17 +247,17 @@ void Caster::State::castBodies(const Scene& scene, const ScanPattern& pattern,
   const std::size_t bodies = scene.bodies().size();
   if (cast.size() != bodies) cast = std::vector<std::atomic<char>>(bodies);
   for (auto& mark : cast) mark.store(0, std::memory_order_relaxed);
-  PlaneSliceCache* kept = nullptr;
-  if (pattern.planar() && config.planar_fast_path && config.plane_cache) {
-    if (!planes) planes = std::make_unique<PlaneSliceCache>();
+  KeptSlices* kept = nullptr;
+  if (pattern.planar() && config.planar_fast_path && config.keep_slices) {
+    if (!planes) planes = std::make_unique<KeptSlices>();
     planes->newScan();
     kept = planes.get();
   }
   // Planar fans: each frame's kept slice by this plane, where there is one.
-  std::vector<std::pair<PlaneFrame, const PlaneSlice*>> slices;
+  std::vector<std::pair<ScanPlane, const KeptSlice*>> slices;
   if (pattern.planar() && config.planar_fast_path) {
     for (const PlacedGroup& p : placed) {
-      slices.emplace_back(PlaneFrame(*p.sensor_from_frame), nullptr);
+      slices.emplace_back(ScanPlane(*p.sensor_from_frame), nullptr);
       if (kept) slices.back().second = kept->find(scene, *p.group, slices.back().first);
       result->stats.kept_slices += slices.back().second != nullptr;
     }
@@ -266,10 +266,10 @@ void Caster::State::castBodies(const Scene& scene, const ScanPattern& pattern,
     for (std::size_t g = 0; g < placed.size(); ++g) {
       const PlacedGroup& p = placed[g];
       if (g < slices.size() && slices[g].second) {
-        castSlice(beams, scene, *slices[g].second, slices[g].first, *p.sensor_from_frame, config,
+        walkSlice(beams, scene, *slices[g].second, slices[g].first, *p.sensor_from_frame, config,
                   within, &cast);
       } else {
-        castGroup(beams, scene, *p.group, *p.sensor_from_frame, config, within, &cast);
+        walkFrame(beams, scene, *p.group, *p.sensor_from_frame, config, within, &cast);
       }
     }
   };

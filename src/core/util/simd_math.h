@@ -1,5 +1,5 @@
 // Small SSE2 helpers shared by the float computations in front of the exact tests (node_views.cpp,
-// plane_views.cpp, column_raster.h, primitive_cast.cpp).
+// slice_views.cpp, column_raster.h, primitive_cast.cpp).
 #pragma once
 
 #include <emmintrin.h>
@@ -43,7 +43,7 @@ inline __m128 atan2Ps(__m128 y, __m128 x) {
 }
 
 // The bearings of a box's corners off a reference direction u = (ux, uy) pointing into the box,
-// four boxes at a time, for the narrow windows of node_views.cpp and plane_views.cpp. A corner's
+// four boxes at a time, for the narrow windows of node_views.cpp and slice_views.cpp. A corner's
 // bearing off u, delta, is bounded by tan delta = (u x c) / (u . c), which is farther from 0 than
 // delta on either side; seen from the sensor, a convex box that does not hold it spans the bearings
 // of its corners, on both sides of u (but for u's rounding: where tan delta and delta agree far

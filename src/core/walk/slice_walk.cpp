@@ -1,4 +1,4 @@
-#include "walk/plane_walk.h"
+#include "walk/slice_walk.h"
 #include "beams/placed_body.h"
 
 #include <algorithm>
@@ -6,9 +6,9 @@
 #include <optional>
 #include <vector>
 
-#include "slice/plane_views.h"
+#include "slice/slice_views.h"
 #include "walk/primitive_cast.h"
-#include "walk/scene_walk.h"
+#include "walk/frame_walk.h"
 
 namespace laser_raycast {
 namespace core {
@@ -19,7 +19,7 @@ namespace {
 constexpr long long kTraceBeams = 16;
 
 // The map from plane coordinates (z = 0) to the sensor frame, for the node views.
-Eigen::Isometry3d sensorFromPlane(const PlaneFrame& f) {
+Eigen::Isometry3d sensorFromPlane(const ScanPlane& f) {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() << f.a, f.b, 0, f.c, f.d, 0, 0, 0, 1;
   pose.translation() << f.tx, f.ty, 0;
@@ -28,7 +28,7 @@ Eigen::Isometry3d sensorFromPlane(const PlaneFrame& f) {
 
 class SliceWalk {
  public:
-  SliceWalk(BeamSet& beams, const Scene& scene, const PlaneSlice& slice, const PlaneFrame& plane,
+  SliceWalk(BeamSet& beams, const Scene& scene, const KeptSlice& slice, const ScanPlane& plane,
             const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
             std::vector<std::atomic<char>>* cast)
       : beams_(beams),
@@ -99,7 +99,7 @@ class SliceWalk {
     // Only the fields needed, not the whole entry: it was just written field by field.
     const WideBvh::Node& node = slice_.wide.nodes()[entry->ref.index];
     const int col_lo = entry->rect.col_lo, col_hi = entry->rect.col_hi;
-    PlaneViews views;
+    SliceViews views;
     views.compute(node, views_);
     // The children's windows, field by field (a child's view may wrap into several windows).
     constexpr int kMax = 4 * 3;
@@ -145,10 +145,10 @@ class SliceWalk {
     return *std::get<std::shared_ptr<const Mesh>>(scene_.bodies()[body].shape);
   }
 
-  // A segment against the beams [first, last] as PlaneSlicer tests it; a hit improving *best (if
+  // A segment against the beams [first, last] as Slicer tests it; a hit improving *best (if
   // given) or offered to the beam.
   template <class Hit, class Open>
-  void testSegment(const PlaneSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
+  void testSegment(const KeptSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
     Eigen::Vector2d front;
     if (config_.cull_backfaces) front = frontOf(s);
     testSegmentInFan(beams_.pattern(), plane_.toSensor(s.p), plane_.toSensor(s.q), config_.tmin,
@@ -156,7 +156,7 @@ class SliceWalk {
                      open);
   }
 
-  void offerSegmentHit(int col, double t, const PlaneSlice::Item& s) {
+  void offerSegmentHit(int col, double t, const KeptSlice::Item& s) {
     const Mesh& mesh = meshOf(s.body);
     const std::uint32_t triangle = mesh.bvh().triangleIds()[s.slot];
     beams_.offer(0, col, t, s.body, static_cast<int>(triangle), [&] {
@@ -164,9 +164,9 @@ class SliceWalk {
     });
   }
 
-  void testItem(const PlaneSlice::Item& item, const BeamRect& rect, float near) {
+  void testItem(const KeptSlice::Item& item, const BeamRect& rect, float near) {
     (*cast_)[item.body].store(1, std::memory_order_relaxed);
-    if (item.slot == PlaneSlice::kPrimitive) {
+    if (item.slot == KeptSlice::kPrimitive) {
       castPrimitiveItem(item.body, rect);
       return;
     }
@@ -197,7 +197,7 @@ class SliceWalk {
   struct Traced {
     int col;
     double dx, dy, tmax;
-    const PlaneSlice::Item* best;
+    const KeptSlice::Item* best;
     double best_t;
     PlaneRay ray;
   };
@@ -205,9 +205,9 @@ class SliceWalk {
   // The test of a traced beam against a leaf's item.
   auto leafTest(Traced* b) {
     return [this, b](std::uint32_t i) {
-      const PlaneSlice::Item& item = slice_.items[i];
+      const KeptSlice::Item& item = slice_.items[i];
       (*cast_)[item.body].store(1, std::memory_order_relaxed);
-      if (item.slot == PlaneSlice::kPrimitive) {
+      if (item.slot == KeptSlice::kPrimitive) {
         PlacedBody a = placeBody(scene_, item.body, sensor_from_frame_);
         placeSensorInBody(&a);
         castPrimitiveBeam(beams_, scene_, a, config_, 0, b->col);
@@ -266,26 +266,26 @@ class SliceWalk {
   }
 
   // The tie rule of BeamSet::offer: the lower body, then the lower triangle.
-  bool before(const PlaneSlice::Item& a, const PlaneSlice::Item& b) const {
+  bool before(const KeptSlice::Item& a, const KeptSlice::Item& b) const {
     if (a.body != b.body) return a.body < b.body;
     const auto& ids = meshOf(a.body).bvh().triangleIds();
     return ids[a.slot] < ids[b.slot];
   }
 
-  Eigen::Vector2d frontOf(const PlaneSlice::Item& s) const {
+  Eigen::Vector2d frontOf(const KeptSlice::Item& s) const {
     const auto& v = meshOf(s.body).bvh().triangleVertices()[s.slot];
     return (sensorFromBody(s.body).linear() * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
   }
 
   BeamSet& beams_;
   const Scene& scene_;
-  const PlaneSlice& slice_;
-  const PlaneFrame& plane_;
+  const KeptSlice& slice_;
+  const ScanPlane& plane_;
   const Eigen::Isometry3d sensor_from_frame_;
   const CastConfig& config_;
   std::vector<std::atomic<char>>* cast_;
   const Eigen::Isometry3d sensor_from_plane_;
-  const PlaneViewFrame views_;
+  const SliceViewBasis views_;
   Eigen::Matrix2d inverse_;
   std::optional<PlaneRay::Origin> origin_;
   std::vector<Entry> stack_;
@@ -294,7 +294,7 @@ class SliceWalk {
 
 }  // namespace
 
-void castSlice(BeamSet& beams, const Scene& scene, const PlaneSlice& slice, const PlaneFrame& plane,
+void walkSlice(BeamSet& beams, const Scene& scene, const KeptSlice& slice, const ScanPlane& plane,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
                const BeamRect& within, std::vector<std::atomic<char>>* cast) {
   SliceWalk(beams, scene, slice, plane, sensor_from_frame, config, cast).run(within);

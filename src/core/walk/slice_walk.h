@@ -1,4 +1,4 @@
-// A frame's bodies under a planar fan, through a kept slice of them (plane_slice.h): the slice's
+// A frame's bodies under a planar fan, through a kept slice of them (kept_slice.h): the slice's
 // tree walked front to back, each node with the beams its window holds, skipping nodes beyond the
 // range or hidden behind nearer hits, tracing the beams of small windows one at a time; each
 // segment tested as the fan slicer tests it, each primitive analytically.
@@ -9,15 +9,15 @@
 
 #include "beams/beam_set.h"
 #include "laser_raycast/core/cast_config.h"
-#include "slice/fan_slicer.h"
-#include "slice/plane_slice.h"
+#include "slice/slicer.h"
+#include "slice/kept_slice.h"
 
 namespace laser_raycast {
 namespace core {
 
 // Casts the open beams of `within` against the bodies of a frame through slice, their slice by
 // plane (the plane of sensor_from_frame). Sets cast[b] for each body b it casts against.
-void castSlice(BeamSet& beams, const Scene& scene, const PlaneSlice& slice, const PlaneFrame& plane,
+void walkSlice(BeamSet& beams, const Scene& scene, const KeptSlice& slice, const ScanPlane& plane,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
                const BeamRect& within, std::vector<std::atomic<char>>* cast);
 

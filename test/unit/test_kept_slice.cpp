@@ -1,4 +1,4 @@
-// Kept slices of a frame's bodies by the scan plane (plane_slice.h): a planar cast through them
+// Kept slices of a frame's bodies by the scan plane (kept_slice.h): a planar cast through them
 // gives the same result, bit for bit, as one that cuts the meshes again; they are built only for a
 // plane met again, never used for another plane, another scene or a changed one.
 #include <gtest/gtest.h>
@@ -39,12 +39,12 @@ Eigen::Isometry3d onTheFloor(Rng& rng, double height) {
 
 core::ScanResult castFresh(const RandomScene& rs, const Eigen::Isometry3d& sensor,
                            const core::ScanPattern& pattern, core::CastConfig config) {
-  config.plane_cache = false;
+  config.keep_slices = false;
   core::Caster caster;
   return caster.cast(rs.scene, rs.poses, sensor, pattern, config);
 }
 
-TEST(PlaneSlice, KeptSlicesNeverChangeAResult) {
+TEST(KeptSlice, KeptSlicesNeverChangeAResult) {
   Rng rng(53);
   int kept = 0, hits = 0;
   for (int s = 0; s < 4; ++s) {
@@ -78,7 +78,7 @@ TEST(PlaneSlice, KeptSlicesNeverChangeAResult) {
 // A field of small primitives as a warehouse's barrels and crates (upright and tilted cylinders,
 // boxes, spheres, near and far): a kept slice's walk meets many of them with one traced beam at a
 // time, and must find what a fresh cut finds, bit for bit, and what the brute force finds.
-TEST(PlaneSlice, SmallPrimitivesThroughKeptSlices) {
+TEST(KeptSlice, SmallPrimitivesThroughKeptSlices) {
   Rng rng(67);
   RandomScene rs;
   core::Scene& scene = rs.scene;
@@ -117,7 +117,7 @@ TEST(PlaneSlice, SmallPrimitivesThroughKeptSlices) {
 }
 
 // A tilting sensor meets a new plane every scan: nothing is kept, and nothing changes.
-TEST(PlaneSlice, ANewPlaneEveryScanKeepsNothing) {
+TEST(KeptSlice, ANewPlaneEveryScanKeepsNothing) {
   Rng rng(59);
   const RandomScene rs = randomScene(rng);
   const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 720));
@@ -134,7 +134,7 @@ TEST(PlaneSlice, ANewPlaneEveryScanKeepsNothing) {
 }
 
 // A scene changed after its slices were kept: the next cast sees the change.
-TEST(PlaneSlice, AChangedSceneIsNotCastThroughOldSlices) {
+TEST(KeptSlice, AChangedSceneIsNotCastThroughOldSlices) {
   Rng rng(61);
   RandomScene rs = randomScene(rng);
   const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 720));

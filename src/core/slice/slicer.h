@@ -34,10 +34,10 @@ struct DepthBuffer {
 // side(p) = n . p + offset is the sensor z of p (frame coordinates). Points of the plane are
 // written in a basis (u, v) of it that depends on n alone, so that the same plane, met again from
 // another sensor pose in it (a robot driving on a floor), gives the same plane coordinates bit for
-// bit (plane_slice.h keeps them); toSensor() maps them to the sensor's x, y. Every planar test goes
+// bit (kept_slice.h keeps them); toSensor() maps them to the sensor's x, y. Every planar test goes
 // through these steps, from vertices moved into the frame.
-struct PlaneFrame {
-  explicit PlaneFrame(const Eigen::Isometry3d& sensor_from_frame);
+struct ScanPlane {
+  explicit ScanPlane(const Eigen::Isometry3d& sensor_from_frame);
 
   double side(const Eigen::Vector3d& p) const { return n.dot(p) + offset; }
   Eigen::Vector2d planeCoords(const Eigen::Vector3d& p) const { return {u.dot(p), v.dot(p)}; }
@@ -45,7 +45,7 @@ struct PlaneFrame {
     return {a * w.x() + b * w.y() + tx, c * w.x() + d * w.y() + ty};
   }
   // Where a triangle (frame coordinates) crosses the plane, in plane coordinates: false if it does
-  // not (a vertex exactly on the plane counts as just below it, see PlaneSlicer).
+  // not (a vertex exactly on the plane counts as just below it, see Slicer).
   bool crossing(const Eigen::Vector3d (&v)[3], Eigen::Vector2d* p, Eigen::Vector2d* q) const;
   // False if no point of box (a mesh's frame, placed in this frame by frame_from_mesh) can be cut:
   // the box moved into the frame, against side() with a slack for the rounding of moving a
@@ -72,18 +72,18 @@ void boxInFrame(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box, Eigen
 // lying in the plane is cut once: a beam crosses a closed outline exactly once. A surface that only
 // touches the plane from below (the top of a box at exactly the sensor's height) is therefore not
 // seen; triangles lying in the plane are skipped, as the 3D tests skip a ray in a triangle's plane.
-class PlaneSlicer {
+class Slicer {
  public:
   // A mesh placed in a frame (frame_from_mesh) cut by that frame's plane (plane): how the walk
   // slices a body, so that it gets the bits a kept slice of the frame holds.
-  PlaneSlicer(const Mesh& mesh, const PlaneFrame& plane, const Eigen::Isometry3d& frame_from_mesh,
+  Slicer(const Mesh& mesh, const ScanPlane& plane, const Eigen::Isometry3d& frame_from_mesh,
               const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan, double tmin,
               double tmax, bool cull_backfaces);
   // A mesh in its own frame.
-  PlaneSlicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
+  Slicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
               double tmin, double tmax, bool cull_backfaces);
 
-  const PlaneFrame& frame() const { return frame_; }
+  const ScanPlane& plane() const { return plane_; }
   // The triangle in slot moved into the frame.
   void frameTriangle(std::uint32_t slot, Eigen::Vector3d (&out)[3]) const {
     const auto& v = mesh_.bvh().triangleVertices()[slot];
@@ -105,7 +105,7 @@ class PlaneSlicer {
     Eigen::Vector3d v[3];
     frameTriangle(slot, v);
     Eigen::Vector2d p, q;
-    if (!frame_.crossing(v, &p, &q)) return;
+    if (!plane_.crossing(v, &p, &q)) return;
     testSegment(p, q, slot, first, last, std::forward<Hit>(hit), std::forward<Open>(open));
   }
   // The same for a segment given in plane coordinates (a cached slice's): the triangle in `slot`
@@ -126,7 +126,7 @@ class PlaneSlicer {
   const ScanPattern& fan_;
   Eigen::Matrix3d rot_;
   Eigen::Vector3d trans_;
-  PlaneFrame frame_;
+  ScanPlane plane_;
   Eigen::Isometry3d frame_from_mesh_;
   Eigen::Vector3d sensor_in_mesh_;
   double tmin_, tmax_, tmax2_, gamma_;
@@ -216,7 +216,7 @@ void testSegmentInFan(const ScanPattern& fan, const Eigen::Vector2d& p, const Ei
 }
 
 template <class Hit, class Open>
-void PlaneSlicer::testSegment(const Eigen::Vector2d& plane_p, const Eigen::Vector2d& plane_q,
+void Slicer::testSegment(const Eigen::Vector2d& plane_p, const Eigen::Vector2d& plane_q,
                               std::uint32_t slot, int first, int last, Hit&& hit,
                               Open&& open) const {
   Eigen::Vector2d front;
@@ -224,7 +224,7 @@ void PlaneSlicer::testSegment(const Eigen::Vector2d& plane_p, const Eigen::Vecto
     const auto& v = mesh_.bvh().triangleVertices()[slot];
     front = (rot_ * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
   }
-  testSegmentInFan(fan_, frame_.toSensor(plane_p), frame_.toSensor(plane_q), tmin_, tmax_,
+  testSegmentInFan(fan_, plane_.toSensor(plane_p), plane_.toSensor(plane_q), tmin_, tmax_,
                    cull_backfaces_ ? &front : nullptr, first, last, std::forward<Hit>(hit),
                    std::forward<Open>(open));
 }

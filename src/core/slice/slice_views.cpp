@@ -1,4 +1,4 @@
-#include "slice/plane_views.h"
+#include "slice/slice_views.h"
 
 #include <cmath>
 #include <cstddef>
@@ -25,7 +25,7 @@ inline __m128 floorPs(__m128 x) {
 
 }  // namespace
 
-PlaneViewFrame::PlaneViewFrame(const PlaneFrame& p, double tmax, const ScanPattern& fan) {
+SliceViewBasis::SliceViewBasis(const ScanPlane& p, double tmax, const ScanPattern& fan) {
   auto set = [](double x) { return _mm_set1_ps(static_cast<float>(x)); };
   a_ = set(p.a);
   b_ = set(p.b);
@@ -54,7 +54,7 @@ PlaneViewFrame::PlaneViewFrame(const PlaneFrame& p, double tmax, const ScanPatte
   pad_ = set(64 * std::numeric_limits<float>::epsilon() * magnitude + 0.01);
 }
 
-void PlaneViews::compute(const WideBvh::Node& node, const PlaneViewFrame& f) {
+void SliceViews::compute(const WideBvh::Node& node, const SliceViewBasis& f) {
   const __m128 half_ps = _mm_set1_ps(0.5f), slack = _mm_set1_ps(kViewSlack);
   const __m128 lo_x = _mm_load_ps(node.lo[0]), lo_y = _mm_load_ps(node.lo[1]);
   const __m128 hi_x = _mm_load_ps(node.hi[0]), hi_y = _mm_load_ps(node.hi[1]);

@@ -27,7 +27,7 @@ inline const EnumNames<MinRangePolicy, 3> kMinRangePolicyNames{{{
 }}};
 inline const char* toString(MinRangePolicy policy) { return kMinRangePolicyNames.name(policy); }
 
-struct EncoderConfig {
+struct MeasurementConfig {
   double range_min = 0.0;   // m, >= 0
   double range_max = 30.0;  // m, > range_min
   MinRangePolicy min_range_policy = MinRangePolicy::kNegInf;
@@ -35,7 +35,7 @@ struct EncoderConfig {
   // Seed of the random draws (noise and dropout): equal seeds give equal sequences.
   std::uint64_t noise_seed = 0;
   bool intensity = false;  // fill intensities: reflectivity of the link hit x cos(incidence angle)
-  // Range realism, off by default; like the noise, only valid returns get it (see ScanEncoder).
+  // Range realism, off by default; like the noise, only valid returns get it (see MeasurementModel).
   double range_bias = 0.0;        // m, finite: added to every valid range (a calibration offset)
   double range_resolution = 0.0;  // m, >= 0: valid ranges are rounded to a multiple of it; 0: off
   double dropout_probability = 0.0;  // in [0, 1]: chance that a valid return is lost (+Inf)
@@ -48,17 +48,17 @@ struct EncoderConfig {
 // hit closer than range_min follows the policy, no hit is +Inf, NaN stays NaN. Under pass_through
 // the cast starts at range_min (ScanSpec::castConfig), so no closer range comes from it; one passed
 // anyway is +Inf.
-double classifyRange(double range, const EncoderConfig& config);
+double classifyRange(double range, const MeasurementConfig& config);
 
 // A valid range rounded to the nearest multiple of range_resolution (halves away from zero), as a
 // driver reporting in fixed units does, then clamped to [range_min, range_max] so that a valid
 // return stays valid (a multiple just outside a limit becomes the limit itself). Returns range
 // unchanged if range_resolution is 0.
-double quantizeRange(double range, const EncoderConfig& config);
+double quantizeRange(double range, const MeasurementConfig& config);
 
-struct EncodedScan {
+struct MeasuredScan {
   std::vector<float> ranges;       // REP 117
-  std::vector<float> intensities;  // one per beam when EncoderConfig::intensity, else empty
+  std::vector<float> intensities;  // one per beam when MeasurementConfig::intensity, else empty
   std::vector<int> labels;         // label index of the body hit (also when too close), -1 for none
 };
 
@@ -76,27 +76,27 @@ struct EncodedScan {
 // one uniform u in [0, 1) from the second if dropout_probability > 0, lost iff u <
 // dropout_probability. So a seed fixes both sequences, and changing the dropout probability does
 // not change the noise of the beams that remain. Both sequences continue across calls.
-class ScanEncoder {
+class MeasurementModel {
  public:
   static constexpr std::uint64_t kDropoutSeedMix = 0x9E3779B97F4A7C15ULL;
 
-  explicit ScanEncoder(const EncoderConfig& config);  // validates
+  explicit MeasurementModel(const MeasurementConfig& config);  // validates
 
   // A new configuration for the next encode() (e.g. from dynamic_reconfigure): validates it, and
   // restarts both random sequences if noise_seed changed; otherwise they continue.
-  void setConfig(const EncoderConfig& config);
+  void setConfig(const MeasurementConfig& config);
 
   // reflectivity is indexed by label (missing entries count as 1); intensity needs
   // result.cos_incidence.
-  void encode(const Scene& scene, const ScanResult& result, const std::vector<double>& reflectivity,
-              EncodedScan* out);
+  void measure(const Scene& scene, const ScanResult& result, const std::vector<double>& reflectivity,
+              MeasuredScan* out);
 
  private:
   void seed(std::uint64_t seed);
   // The realism steps for one valid range (the class comment's formula and draws); false if lost.
   bool degrade(double* range);
 
-  EncoderConfig config_;
+  MeasurementConfig config_;
   std::mt19937_64 rng_;          // noise
   std::mt19937_64 dropout_rng_;  // dropout
   std::normal_distribution<double> noise_;

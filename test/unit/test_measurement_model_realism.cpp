@@ -1,4 +1,4 @@
-// The encoder's range realism options: range_bias, range_resolution (quantizeRange) and
+// The measurement model's range realism options: range_bias, range_resolution (quantizeRange) and
 // dropout_probability. Exact values by hand, dropout statistics with fixed seeds, the documented
 // order (bias, noise, clamp, quantise, dropout), and that invalid readings get none of it.
 #include <gtest/gtest.h>
@@ -8,9 +8,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include "encoder_inputs.h"
+#include "measurement_inputs.h"
 #include "expect_invalid.h"
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -21,10 +21,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 constexpr float kInfF = std::numeric_limits<float>::infinity();
 
-EncodedScan encodeOnce(const EncoderConfig& config, const ScanResult& result) {
-  ScanEncoder encoder(config);
-  EncodedScan out;
-  encoder.encode(labelledScene(), result, {}, &out);
+MeasuredScan encodeOnce(const MeasurementConfig& config, const ScanResult& result) {
+  MeasurementModel model(config);
+  MeasuredScan out;
+  model.measure(labelledScene(), result, {}, &out);
   return out;
 }
 
@@ -35,9 +35,9 @@ ScanResult resultWithRanges(const std::vector<double>& ranges) {
   return r;
 }
 
-TEST(EncoderRealism, ValidateNamesFieldAndValue) {
-  auto message = [](const EncoderConfig& c) { return invalidMessage([&] { c.validate(); }); };
-  EncoderConfig c;
+TEST(MeasurementModelRealism, ValidateNamesFieldAndValue) {
+  auto message = [](const MeasurementConfig& c) { return invalidMessage([&] { c.validate(); }); };
+  MeasurementConfig c;
   c.range_bias = -0.05;
   c.range_resolution = 0.002;
   c.dropout_probability = 1.0;
@@ -45,30 +45,30 @@ TEST(EncoderRealism, ValidateNamesFieldAndValue) {
   c.dropout_probability = 0.0;
   EXPECT_NO_THROW(c.validate());
   for (const double bad : {kNan, kInf, -kInf}) {
-    c = EncoderConfig{};
+    c = MeasurementConfig{};
     c.range_bias = bad;
     expectMentions(message(c), {"range_bias", std::isnan(bad) ? "nan" : "inf"});
   }
   for (const double bad : {-0.001, kNan, kInf}) {
-    c = EncoderConfig{};
+    c = MeasurementConfig{};
     c.range_resolution = bad;
     expectMentions(message(c), {"range_resolution", std::isnan(bad) ? "nan"
                                                     : bad < 0       ? "-0.001"
                                                                     : "inf"});
   }
   for (const double bad : {-0.1, 1.5, kNan}) {
-    c = EncoderConfig{};
+    c = MeasurementConfig{};
     c.dropout_probability = bad;
     expectMentions(message(c), {"dropout_probability", std::isnan(bad) ? "nan"
                                                        : bad < 0       ? "-0.1"
                                                                        : "1.5"});
   }
-  EXPECT_THROW(ScanEncoder{c}, std::invalid_argument);
+  EXPECT_THROW(MeasurementModel{c}, std::invalid_argument);
 }
 
 // Hand-computed multiples, clamped to [range_min, range_max].
-TEST(EncoderRealism, QuantizeRangeByHand) {
-  EncoderConfig c = encoderConfig(0.5, 10.0);
+TEST(MeasurementModelRealism, QuantizeRangeByHand) {
+  MeasurementConfig c = measurementConfig(0.5, 10.0);
   EXPECT_EQ(quantizeRange(1.2345, c), 1.2345);  // resolution 0: off
   c.range_resolution = 0.002;
   EXPECT_EQ(quantizeRange(1.2345, c), 617 * 0.002);   // 617.25 steps
@@ -80,20 +80,20 @@ TEST(EncoderRealism, QuantizeRangeByHand) {
   EXPECT_EQ(quantizeRange(0.5, c), 2 * 0.3);    // 1.67 steps: 0.6, inside
   EXPECT_EQ(quantizeRange(10.0, c), 33 * 0.3);  // 33.33 steps: 9.9, inside
   // The nearest multiple lies outside: the limit.
-  c = encoderConfig(0.5, 9.9);
+  c = measurementConfig(0.5, 9.9);
   c.range_resolution = 0.4;
   EXPECT_EQ(quantizeRange(0.55, c), 0.5);  // 1.375 steps: 0.4 < range_min
   EXPECT_EQ(quantizeRange(9.85, c), 9.9);  // 24.6 steps: 10.0 > range_max
 }
 
-// Through the encoder: every valid output is a multiple of the resolution (to float), within half
+// Through the measurement model: every valid output is a multiple of the resolution (to float), within half
 // a step of the range, and inside the limits.
-TEST(EncoderRealism, QuantisationInTheEncoder) {
+TEST(MeasurementModelRealism, QuantisationInTheEncoder) {
   std::vector<double> ranges;
   for (int i = 0; i < 2000; ++i) ranges.push_back(0.5 + 0.004749 * i);  // 0.5 .. 9.99
-  EncoderConfig c = encoderConfig(0.5, 10.0);
+  MeasurementConfig c = measurementConfig(0.5, 10.0);
   c.range_resolution = 0.01;
-  const EncodedScan out = encodeOnce(c, resultWithRanges(ranges));
+  const MeasuredScan out = encodeOnce(c, resultWithRanges(ranges));
   for (std::size_t i = 0; i < ranges.size(); ++i) {
     const double steps = static_cast<double>(out.ranges[i]) / 0.01;
     ASSERT_NEAR(steps, std::round(steps), 1e-4) << i << " " << out.ranges[i];
@@ -108,10 +108,10 @@ TEST(EncoderRealism, QuantisationInTheEncoder) {
 }
 
 // The bias shifts valid ranges exactly, clamped to the limits; bias then quantisation.
-TEST(EncoderRealism, BiasThenQuantisation) {
-  EncoderConfig c = encoderConfig(0.5, 10.0);
+TEST(MeasurementModelRealism, BiasThenQuantisation) {
+  MeasurementConfig c = measurementConfig(0.5, 10.0);
   c.range_bias = 0.05;
-  EncodedScan out = encodeOnce(c, resultWithRanges({4.0, 9.99, 10.0, 0.5}));
+  MeasuredScan out = encodeOnce(c, resultWithRanges({4.0, 9.99, 10.0, 0.5}));
   EXPECT_EQ(out.ranges[0], static_cast<float>(4.0 + 0.05));
   EXPECT_EQ(out.ranges[1], 10.0f);  // 10.04 clamped: still valid
   EXPECT_EQ(out.ranges[2], 10.0f);
@@ -130,18 +130,18 @@ TEST(EncoderRealism, BiasThenQuantisation) {
 // p = 0.3 over 10^5 valid beams (seeded): 30% +- 1% lost (the binomial standard deviation is
 // 0.14%). Lost beams report +Inf, label -1 and intensity 0; the others are untouched. A quarter of
 // the beams are invalid and are never lost or changed.
-TEST(EncoderRealism, DropoutStatistics) {
+TEST(MeasurementModelRealism, DropoutStatistics) {
   const int n = 133336;
   ScanResult r = uniformResult(n, 4.0, true);
   for (int i = 3; i < n; i += 4) {
     r.range[i] = i % 8 == 3 ? kInf : 0.2;  // no return, or too close
     if (r.range[i] == kInf) r.body[i] = -1;
   }
-  EncoderConfig c = encoderConfig(0.5, 10.0);
+  MeasurementConfig c = measurementConfig(0.5, 10.0);
   c.intensity = true;
   c.dropout_probability = 0.3;
   c.noise_seed = 12345;
-  const EncodedScan out = encodeOnce(c, r);
+  const MeasuredScan out = encodeOnce(c, r);
   int valid = 0, lost = 0;
   for (int i = 0; i < n; ++i) {
     if (i % 4 == 3) {
@@ -164,9 +164,9 @@ TEST(EncoderRealism, DropoutStatistics) {
   EXPECT_NEAR(static_cast<double>(lost) / valid, 0.3, 0.01) << lost;
 }
 
-TEST(EncoderRealism, DropoutZeroAndOne) {
+TEST(MeasurementModelRealism, DropoutZeroAndOne) {
   const ScanResult r = uniformResult(1000, 4.0);
-  EncoderConfig c = encoderConfig(0.5, 10.0);
+  MeasurementConfig c = measurementConfig(0.5, 10.0);
   c.dropout_probability = 1.0;
   for (const float x : encodeOnce(c, r).ranges) ASSERT_EQ(x, kInfF);
   c.dropout_probability = 0.0;
@@ -174,14 +174,14 @@ TEST(EncoderRealism, DropoutZeroAndOne) {
 }
 
 // A seed fixes both sequences; the noise of the beams that remain does not depend on dropout.
-TEST(EncoderRealism, DeterministicAndDropoutKeepsTheNoise) {
+TEST(MeasurementModelRealism, DeterministicAndDropoutKeepsTheNoise) {
   const ScanResult r = uniformResult(5000, 4.0);
-  EncoderConfig c = encoderConfig(0.5, 10.0);
+  MeasurementConfig c = measurementConfig(0.5, 10.0);
   c.noise_stddev = 0.02;
   c.noise_seed = 99;
-  const EncodedScan noise_only = encodeOnce(c, r);
+  const MeasuredScan noise_only = encodeOnce(c, r);
   c.dropout_probability = 0.5;
-  const EncodedScan both = encodeOnce(c, r);
+  const MeasuredScan both = encodeOnce(c, r);
   EXPECT_EQ(both.ranges, encodeOnce(c, r).ranges);  // same seed, same scan
   int lost = 0;
   for (int i = 0; i < 5000; ++i) {
@@ -194,24 +194,24 @@ TEST(EncoderRealism, DeterministicAndDropoutKeepsTheNoise) {
   EXPECT_GT(lost, 2000);
   EXPECT_LT(lost, 3000);
   c.noise_seed = 100;
-  const EncodedScan other = encodeOnce(c, r);
+  const MeasuredScan other = encodeOnce(c, r);
   EXPECT_NE(other.ranges, both.ranges);
 }
 
 // +Inf, -Inf and NaN readings get no bias, noise, quantisation or dropout, under every option.
-TEST(EncoderRealism, InvalidReadingsGetNone) {
+TEST(MeasurementModelRealism, InvalidReadingsGetNone) {
   ScanResult r = uniformResult(3000, 0.0);
   for (int i = 0; i < 3000; ++i) {
     r.range[i] = i % 3 == 0 ? kInf : i % 3 == 1 ? 0.2 : kNan;
     if (i % 3 != 1) r.body[i] = -1;
   }
   for (const MinRangePolicy policy : {MinRangePolicy::kNegInf, MinRangePolicy::kNan}) {
-    EncoderConfig c = encoderConfig(0.5, 10.0, policy);
+    MeasurementConfig c = measurementConfig(0.5, 10.0, policy);
     c.range_bias = 0.7;  // would carry the too-close 0.2 m past range_min
     c.range_resolution = 0.25;
     c.noise_stddev = 0.5;
     c.dropout_probability = 0.5;
-    const EncodedScan out = encodeOnce(c, r);
+    const MeasuredScan out = encodeOnce(c, r);
     for (int i = 0; i < 3000; ++i) {
       if (i % 3 == 0) {
         ASSERT_EQ(out.ranges[i], kInfF) << i;
@@ -229,33 +229,33 @@ TEST(EncoderRealism, InvalidReadingsGetNone) {
 
 // setConfig: the same seed continues both sequences, a new seed restarts them, a bad config is
 // refused and the old one kept.
-TEST(EncoderRealism, SetConfig) {
+TEST(MeasurementModelRealism, SetConfig) {
   const laser_raycast::core::Scene scene = labelledScene();
   const ScanResult r = uniformResult(500, 4.0);
-  EncoderConfig c = encoderConfig(0.5, 10.0);
+  MeasurementConfig c = measurementConfig(0.5, 10.0);
   c.noise_stddev = 0.02;
   c.dropout_probability = 0.2;
   c.noise_seed = 5;
-  ScanEncoder reference(c), changed(c);
-  EncodedScan first, expected, out;
-  reference.encode(scene, r, {}, &first);
-  reference.encode(scene, r, {}, &expected);
-  changed.encode(scene, r, {}, &out);
+  MeasurementModel reference(c), changed(c);
+  MeasuredScan first, expected, out;
+  reference.measure(scene, r, {}, &first);
+  reference.measure(scene, r, {}, &expected);
+  changed.measure(scene, r, {}, &out);
   changed.setConfig(c);
-  changed.encode(scene, r, {}, &out);
+  changed.measure(scene, r, {}, &out);
   EXPECT_EQ(out.ranges, expected.ranges);  // continued
   c.noise_seed = 6;
   changed.setConfig(c);
-  changed.encode(scene, r, {}, &out);
+  changed.measure(scene, r, {}, &out);
   EXPECT_EQ(out.ranges, encodeOnce(c, r).ranges);  // restarted from seed 6
   c.noise_seed = 5;
   changed.setConfig(c);
-  changed.encode(scene, r, {}, &out);
+  changed.measure(scene, r, {}, &out);
   EXPECT_EQ(out.ranges, first.ranges);  // back to seed 5 from its start
-  EncoderConfig bad = c;
+  MeasurementConfig bad = c;
   bad.dropout_probability = 2;
   EXPECT_THROW(changed.setConfig(bad), std::invalid_argument);
-  changed.encode(scene, r, {}, &out);
+  changed.measure(scene, r, {}, &out);
   EXPECT_EQ(out.ranges, expected.ranges);  // seed 5's second scan: the old config, continued
 }
 

@@ -6,7 +6,7 @@
 // remain, or at a leaf, each open beam is traced through the node's subtree with the exact
 // triangle test.
 //
-// Under a planar fan a mesh's triangles can instead be sliced by the scan plane (fan_slicer.h). Per
+// Under a planar fan a mesh's triangles can instead be sliced by the scan plane (slicer.h). Per
 // connected component of the mesh, and the same for every beam and every thread, the cheaper of the
 // two is chosen: a component's triangles share edges only with each other, so one component never
 // mixes the two tests, and both are watertight on their own.
@@ -22,7 +22,7 @@ namespace core {
 
 // Casts the open beams of `within` (a rect of beams the body's bounding sphere can reach) against
 // the body active.index of scene.
-void castBody(BeamSet& beams, const Scene& scene, const PlacedBody& active,
+void walkMesh(BeamSet& beams, const Scene& scene, const PlacedBody& active,
               const CastConfig& config, const BeamRect& within);
 
 }  // namespace core

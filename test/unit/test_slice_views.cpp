@@ -1,4 +1,4 @@
-// The 2D views and box tests of a kept slice's tree (plane_views.h), each against its exact
+// The 2D views and box tests of a kept slice's tree (slice_views.h), each against its exact
 // counterpart: every beam whose exact ray enters a child's box lies among the child's columns, no
 // point of the box is nearer than its near distance, and PlaneRay enters every such child.
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 
 #include "fan_specs.h"
 #include "beams/beam_set.h"
-#include "slice/plane_slice.h"
-#include "slice/plane_views.h"
+#include "slice/kept_slice.h"
+#include "slice/slice_views.h"
 #include "random.h"
 
 namespace laser_raycast_test {
@@ -40,14 +40,14 @@ std::optional<L> entry(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
 }
 
 // A plane frame for a level sensor at (x, y), turned by yaw, over a frame at the identity.
-core::PlaneFrame planeAt(double x, double y, double yaw) {
+core::ScanPlane planeAt(double x, double y, double yaw) {
   Eigen::Isometry3d world_from_sensor = Eigen::Isometry3d::Identity();
   world_from_sensor.translation() << x, y, 0.2;
   world_from_sensor.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return core::PlaneFrame(world_from_sensor.inverse());
+  return core::ScanPlane(world_from_sensor.inverse());
 }
 
-TEST(PlaneViews, EveryBeamThatEntersAChildBoxIsAmongItsColumns) {
+TEST(SliceViews, EveryBeamThatEntersAChildBoxIsAmongItsColumns) {
   Rng rng(67);
   long long inside = 0, windows = 0, entered_columns = 0, boxes_seen = 0;
   const core::ScanPattern fans[] = {core::ScanPattern(fanBySamples(-M_PI, M_PI, 360)),
@@ -61,7 +61,7 @@ TEST(PlaneViews, EveryBeamThatEntersAChildBoxIsAmongItsColumns) {
     core::BeamSet beams;
     beams.reset(fan, core::CastConfig{}, &result);
     for (int scene = 0; scene < 6; ++scene) {
-      // A slice of random segments (plane coordinates), built as PlaneSlice builds its tree.
+      // A slice of random segments (plane coordinates), built as KeptSlice builds its tree.
       std::vector<core::Aabb> boxes;
       for (int i = 0; i < 300; ++i) {
         const Eigen::Vector2d p(uniform(rng, -12, 12), uniform(rng, -12, 12));
@@ -73,10 +73,10 @@ TEST(PlaneViews, EveryBeamThatEntersAChildBoxIsAmongItsColumns) {
       }
       const core::Bvh tree = core::Bvh::buildOverBoxes(boxes);
       const core::WideBvh wide(tree, {});
-      const core::PlaneFrame plane =
+      const core::ScanPlane plane =
           planeAt(uniform(rng, -6, 6), uniform(rng, -6, 6), uniform(rng, -M_PI, M_PI));
       const double tmax = 25;
-      const core::PlaneViewFrame frame(plane, tmax, fan);
+      const core::SliceViewBasis frame(plane, tmax, fan);
       // The map's exact inverse: the sensor and the beams in plane coordinates.
       Eigen::Matrix<L, 2, 2> m;
       m << plane.a, plane.b, plane.c, plane.d;
@@ -84,7 +84,7 @@ TEST(PlaneViews, EveryBeamThatEntersAChildBoxIsAmongItsColumns) {
       const Eigen::Matrix<L, 2, 1> origin = -(inv * Eigen::Matrix<L, 2, 1>(plane.tx, plane.ty));
       const core::PlaneRay::Origin ray_origin(origin.cast<double>(), tree.bounds(), 0.0);
       for (const core::WideBvh::Node& node : wide.nodes()) {
-        core::PlaneViews views;
+        core::SliceViews views;
         views.compute(node, frame);
         for (int k = 0; k < core::WideBvh::kWidth; ++k) {
           if (node.index[k] == core::WideBvh::kEmpty) continue;

@@ -1,4 +1,4 @@
-#include "slice/fan_slicer.h"
+#include "slice/slicer.h"
 
 #include <cmath>
 
@@ -36,7 +36,7 @@ Eigen::Vector3d perpendicular(const Eigen::Vector3d& n) {
 
 }  // namespace
 
-PlaneFrame::PlaneFrame(const Eigen::Isometry3d& sensor_from_frame) {
+ScanPlane::ScanPlane(const Eigen::Isometry3d& sensor_from_frame) {
   const Eigen::Matrix3d& rot = sensor_from_frame.linear();
   const Eigen::Vector3d& trans = sensor_from_frame.translation();
   n = rot.row(2).transpose();
@@ -51,7 +51,7 @@ PlaneFrame::PlaneFrame(const Eigen::Isometry3d& sensor_from_frame) {
   ty = trans.y();
 }
 
-bool PlaneFrame::crossing(const Eigen::Vector3d (&v)[3], Eigen::Vector2d* p,
+bool ScanPlane::crossing(const Eigen::Vector3d (&v)[3], Eigen::Vector2d* p,
                           Eigen::Vector2d* q) const {
   const double s[3] = {side(v[0]), side(v[1]), side(v[2])};
   // A vertex exactly on the plane counts as just below it (the plane nudged up by an
@@ -72,7 +72,7 @@ bool PlaneFrame::crossing(const Eigen::Vector3d (&v)[3], Eigen::Vector2d* p,
   return true;
 }
 
-bool PlaneFrame::mayMeet(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box) const {
+bool ScanPlane::mayMeet(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box) const {
   Eigen::Vector3d c, e;
   boxInFrame(frame_from_mesh, box, &c, &e);
   const Eigen::Vector3d abs_n = n.cwiseAbs();
@@ -93,12 +93,12 @@ void boxInFrame(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box, Eigen
            (abs_r * (c.cwiseAbs() + e) + frame_from_mesh.translation().cwiseAbs() + *half);
 }
 
-PlaneSlicer::PlaneSlicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh,
+Slicer::Slicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh,
                          const ScanPattern& fan, double tmin, double tmax, bool cull_backfaces)
-    : PlaneSlicer(mesh, PlaneFrame(sensor_from_mesh), Eigen::Isometry3d::Identity(),
+    : Slicer(mesh, ScanPlane(sensor_from_mesh), Eigen::Isometry3d::Identity(),
                   sensor_from_mesh, fan, tmin, tmax, cull_backfaces) {}
 
-PlaneSlicer::PlaneSlicer(const Mesh& mesh, const PlaneFrame& plane,
+Slicer::Slicer(const Mesh& mesh, const ScanPlane& plane,
                          const Eigen::Isometry3d& frame_from_mesh,
                          const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
                          double tmin, double tmax, bool cull_backfaces)
@@ -106,7 +106,7 @@ PlaneSlicer::PlaneSlicer(const Mesh& mesh, const PlaneFrame& plane,
       fan_(fan),
       rot_(sensor_from_mesh.linear()),
       trans_(sensor_from_mesh.translation()),
-      frame_(plane),
+      plane_(plane),
       frame_from_mesh_(frame_from_mesh),
       sensor_in_mesh_(-(rot_.transpose() * trans_)),
       tmin_(tmin),
@@ -119,8 +119,8 @@ PlaneSlicer::PlaneSlicer(const Mesh& mesh, const PlaneFrame& plane,
   tmax2_ = tmax * tmax * (1 + gamma_);
 }
 
-bool PlaneSlicer::mayCross(const Aabb& box) const {
-  if (!frame_.mayMeet(frame_from_mesh_, box)) return false;
+bool Slicer::mayCross(const Aabb& box) const {
+  if (!plane_.mayMeet(frame_from_mesh_, box)) return false;
   // Nearest point of the box to the sensor, against range_max.
   const Eigen::Vector3d nearest = sensor_in_mesh_.cwiseMax(box.lo).cwiseMin(box.hi);
   return (nearest - sensor_in_mesh_).squaredNorm() <= tmax2_;
@@ -128,7 +128,7 @@ bool PlaneSlicer::mayCross(const Aabb& box) const {
 
 void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
                double tmin, double tmax, bool cull_backfaces, int body_index, DepthBuffer buffer) {
-  const PlaneSlicer slicer(mesh, sensor_from_mesh, fan, tmin, tmax, cull_backfaces);
+  const Slicer slicer(mesh, sensor_from_mesh, fan, tmin, tmax, cull_backfaces);
   const auto& ids = mesh.bvh().triangleIds();
   std::vector<double>& range = *buffer.range;
   const int last = fan.azimuthCount() - 1;

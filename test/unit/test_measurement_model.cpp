@@ -1,4 +1,4 @@
-// REP 117 encoding: classifyRange and ScanEncoder. Out of range is +Inf, too close -Inf (or NaN by
+// REP 117 encoding: classifyRange and MeasurementModel. Out of range is +Inf, too close -Inf (or NaN by
 // policy), erroneous NaN, valid iff range_min <= r <= range_max; noise is seeded, clamped and only
 // on valid beams; intensity is reflectivity x cos(incidence); one rounding to float.
 #include <gtest/gtest.h>
@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "encoder_inputs.h"
+#include "measurement_inputs.h"
 #include "expect_invalid.h"
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/scan_spec.h"
 
 namespace laser_raycast_test {
@@ -33,7 +33,7 @@ bool sameFloat(float a, float b) { return a == b || (std::isnan(a) && std::isnan
 TEST(ClassifyRange, ValidOutOfRangeAndNan) {
   for (const MinRangePolicy policy :
        {MinRangePolicy::kNegInf, MinRangePolicy::kPassThrough, MinRangePolicy::kNan}) {
-    const EncoderConfig c = encoderConfig(0.5, 10.0, policy);
+    const MeasurementConfig c = measurementConfig(0.5, 10.0, policy);
     EXPECT_EQ(classifyRange(5.25, c), 5.25);
     EXPECT_EQ(classifyRange(0.5, c), 0.5);    // exactly range_min: valid
     EXPECT_EQ(classifyRange(10.0, c), 10.0);  // exactly range_max: valid
@@ -42,19 +42,19 @@ TEST(ClassifyRange, ValidOutOfRangeAndNan) {
     EXPECT_TRUE(std::isnan(classifyRange(kNan, c)));
   }
   // range_min 0: a zero range is valid.
-  EXPECT_EQ(classifyRange(0.0, encoderConfig(0.0, 1.0)), 0.0);
+  EXPECT_EQ(classifyRange(0.0, measurementConfig(0.0, 1.0)), 0.0);
 }
 
 // A hit closer than range_min: -Inf by default (REP 117: too close), NaN with "nan". With
 // "pass_through" the cast should have started at range_min (ScanSpec::castConfig), so such a hit
 // means the caller cast from 0; it is reported as +Inf, never as a valid range.
 TEST(ClassifyRange, TooClosePolicies) {
-  EXPECT_EQ(classifyRange(0.3, encoderConfig(0.5, 10.0)), -kInf);
-  EXPECT_EQ(classifyRange(std::nextafter(0.5, 0.0), encoderConfig(0.5, 10.0)), -kInf);
-  EXPECT_EQ(classifyRange(0.0, encoderConfig(0.5, 10.0)), -kInf);
-  EXPECT_TRUE(std::isnan(classifyRange(0.3, encoderConfig(0.5, 10.0, MinRangePolicy::kNan))));
-  EXPECT_EQ(classifyRange(0.3, encoderConfig(0.5, 10.0, MinRangePolicy::kPassThrough)), kInf);
-  EXPECT_EQ(EncoderConfig{}.min_range_policy, MinRangePolicy::kNegInf);  // the default
+  EXPECT_EQ(classifyRange(0.3, measurementConfig(0.5, 10.0)), -kInf);
+  EXPECT_EQ(classifyRange(std::nextafter(0.5, 0.0), measurementConfig(0.5, 10.0)), -kInf);
+  EXPECT_EQ(classifyRange(0.0, measurementConfig(0.5, 10.0)), -kInf);
+  EXPECT_TRUE(std::isnan(classifyRange(0.3, measurementConfig(0.5, 10.0, MinRangePolicy::kNan))));
+  EXPECT_EQ(classifyRange(0.3, measurementConfig(0.5, 10.0, MinRangePolicy::kPassThrough)), kInf);
+  EXPECT_EQ(MeasurementConfig{}.min_range_policy, MinRangePolicy::kNegInf);  // the default
 }
 
 TEST(MinRangePolicy, StringRoundTrip) {
@@ -75,46 +75,46 @@ TEST(MinRangePolicy, StringRoundTrip) {
   }
 }
 
-TEST(EncoderConfig, ValidateNamesFieldAndValue) {
-  auto message = [](const EncoderConfig& c) { return invalidMessage([&] { c.validate(); }); };
-  EXPECT_NO_THROW(EncoderConfig{}.validate());
-  EXPECT_NO_THROW(encoderConfig(0, 0.001).validate());
-  EncoderConfig c;
+TEST(MeasurementConfig, ValidateNamesFieldAndValue) {
+  auto message = [](const MeasurementConfig& c) { return invalidMessage([&] { c.validate(); }); };
+  EXPECT_NO_THROW(MeasurementConfig{}.validate());
+  EXPECT_NO_THROW(measurementConfig(0, 0.001).validate());
+  MeasurementConfig c;
   c.range_min = -0.25;
   expectMentions(message(c), {"range_min", "-0.25"});
   c.range_min = kNan;
   expectMentions(message(c), {"range_min", "nan"});
   c.range_min = kInf;
   expectMentions(message(c), {"range_min", "inf"});
-  c = encoderConfig(2.5, 2.5);
+  c = measurementConfig(2.5, 2.5);
   expectMentions(message(c), {"range_max", "2.5", "range_min"});
-  c = encoderConfig(2.5, 1.5);
+  c = measurementConfig(2.5, 1.5);
   expectMentions(message(c), {"range_max", "1.5", "range_min", "2.5"});
-  c = encoderConfig(0, kInf);  // REP 117 ranges need a finite maximum
+  c = measurementConfig(0, kInf);  // REP 117 ranges need a finite maximum
   expectMentions(message(c), {"range_max", "inf"});
-  c = encoderConfig(0, kNan);
+  c = measurementConfig(0, kNan);
   expectMentions(message(c), {"range_max", "nan"});
   // Finite in double but +Inf as a float: a valid reading would be published as "no return".
-  c = encoderConfig(0, 1e39);
+  c = measurementConfig(0, 1e39);
   expectMentions(message(c), {"range_max", "1e+39", "float"});
-  EXPECT_NO_THROW(encoderConfig(0, std::numeric_limits<float>::max()).validate());
-  c = EncoderConfig{};
+  EXPECT_NO_THROW(measurementConfig(0, std::numeric_limits<float>::max()).validate());
+  c = MeasurementConfig{};
   c.noise_stddev = -0.01;
   expectMentions(message(c), {"noise_stddev", "-0.01"});
   c.noise_stddev = kNan;
   expectMentions(message(c), {"noise_stddev", "nan"});
   c.noise_stddev = kInf;
   expectMentions(message(c), {"noise_stddev", "inf"});
-  // The encoder validates its config.
-  EXPECT_THROW(ScanEncoder{c}, std::invalid_argument);
+  // The measurement model validates its config.
+  EXPECT_THROW(MeasurementModel{c}, std::invalid_argument);
 }
 
 // -------------------------------------------------------------------------------------------------
-// ScanEncoder
+// MeasurementModel
 
 // Each beam kind by hand: valid ranges rounded once to float, +Inf, -Inf, NaN; labels from the
 // body's label (also for too-close hits), -1 where nothing was hit.
-TEST(ScanEncoder, Rep117AndLabels) {
+TEST(MeasurementModel, Rep117AndLabels) {
   const Scene scene = labelledScene();
   ScanResult r;
   r.range = {1.2345678901234567, 0.5, 10.0, kInf, 0.25, kNan, 3.0, 7.777777777777777};
@@ -122,9 +122,9 @@ TEST(ScanEncoder, Rep117AndLabels) {
   r.triangle.assign(r.range.size(), -1);
   for (const MinRangePolicy policy :
        {MinRangePolicy::kNegInf, MinRangePolicy::kNan, MinRangePolicy::kPassThrough}) {
-    ScanEncoder encoder(encoderConfig(0.5, 10.0, policy));
-    EncodedScan out;
-    encoder.encode(scene, r, {}, &out);
+    MeasurementModel model(measurementConfig(0.5, 10.0, policy));
+    MeasuredScan out;
+    model.measure(scene, r, {}, &out);
     ASSERT_EQ(out.ranges.size(), r.range.size());
     ASSERT_EQ(out.labels.size(), r.range.size());
     EXPECT_TRUE(out.intensities.empty());
@@ -148,7 +148,7 @@ TEST(ScanEncoder, Rep117AndLabels) {
 // The policy end to end with the caster: a panel at 0.3 m in front of a wall at 3 m, range_min 0.5.
 // -inf and nan cast from 0 and report the panel as too close; pass_through casts from range_min
 // (ScanSpec::castConfig) and reports the wall behind it.
-TEST(ScanEncoder, PassThroughShowsTheSurfaceBeyond) {
+TEST(MeasurementModel, PassThroughShowsTheSurfaceBeyond) {
   Scene scene;
   scene.addFrame("world");
   scene.addLabel("wall");
@@ -177,16 +177,16 @@ TEST(ScanEncoder, PassThroughShowsTheSurfaceBeyond) {
     for (const MinRangePolicy policy :
          {MinRangePolicy::kNegInf, MinRangePolicy::kNan, MinRangePolicy::kPassThrough}) {
       ScanSpec spec;
-      spec.output = encoderConfig(0.5, 10.0, policy);
-      const EncoderConfig& ec = spec.output;
+      spec.output = measurementConfig(0.5, 10.0, policy);
+      const MeasurementConfig& ec = spec.output;
       CastConfig cc = spec.castConfig();
       cc.planar_fast_path = fast;
       Caster caster;
       const ScanResult& r = caster.cast(scene, FramePoses::identity(scene),
                                         Eigen::Isometry3d::Identity(), pattern, cc);
-      ScanEncoder encoder(ec);
-      EncodedScan out;
-      encoder.encode(scene, r, {}, &out);
+      MeasurementModel model(ec);
+      MeasuredScan out;
+      model.measure(scene, r, {}, &out);
       if (policy == MinRangePolicy::kPassThrough) {
         EXPECT_EQ(out.ranges[mid], 3.0f);
         EXPECT_EQ(out.labels[mid], 0);
@@ -206,20 +206,20 @@ TEST(ScanEncoder, PassThroughShowsTheSurfaceBeyond) {
 
 // Noise is seeded: equal seeds give equal scans, different seeds different ones, and every call
 // draws afresh (a second encode of the same result differs).
-TEST(ScanEncoder, NoiseIsSeededAndFresh) {
+TEST(MeasurementModel, NoiseIsSeededAndFresh) {
   const Scene scene = labelledScene();
   const ScanResult r = uniformResult(200, 4.0);
-  EncoderConfig c = encoderConfig(0.1, 20.0);
+  MeasurementConfig c = measurementConfig(0.1, 20.0);
   c.noise_stddev = 0.02;
   c.noise_seed = 42;
-  ScanEncoder a(c), b(c);
+  MeasurementModel a(c), b(c);
   c.noise_seed = 43;
-  ScanEncoder other(c);
-  EncodedScan ea, eb, eo, ea2;
-  a.encode(scene, r, {}, &ea);
-  b.encode(scene, r, {}, &eb);
-  other.encode(scene, r, {}, &eo);
-  a.encode(scene, r, {}, &ea2);
+  MeasurementModel other(c);
+  MeasuredScan ea, eb, eo, ea2;
+  a.measure(scene, r, {}, &ea);
+  b.measure(scene, r, {}, &eb);
+  other.measure(scene, r, {}, &eo);
+  a.measure(scene, r, {}, &ea2);
   EXPECT_EQ(ea.ranges, eb.ranges);
   EXPECT_NE(ea.ranges, eo.ranges);
   EXPECT_NE(ea.ranges, ea2.ranges);
@@ -227,24 +227,24 @@ TEST(ScanEncoder, NoiseIsSeededAndFresh) {
   for (const float x : ea.ranges) changed += x != 4.0f;
   EXPECT_GT(changed, 190);
   // The second call of a continues the same sequence as b's second call.
-  EncodedScan eb2;
-  b.encode(scene, r, {}, &eb2);
+  MeasuredScan eb2;
+  b.measure(scene, r, {}, &eb2);
   EXPECT_EQ(ea2.ranges, eb2.ranges);
 }
 
 // Zero-mean Gaussian with the configured standard deviation: 10^4 samples, mean within 4 standard
 // errors, sample standard deviation within 5% (its own standard error is about 0.7%).
-TEST(ScanEncoder, NoiseStatistics) {
+TEST(MeasurementModel, NoiseStatistics) {
   const Scene scene = labelledScene();
   const int n = 10000;
   const double range = 5.0, sigma = 0.01;
   const ScanResult r = uniformResult(n, range);
-  EncoderConfig c = encoderConfig(0.0, 10.0);
+  MeasurementConfig c = measurementConfig(0.0, 10.0);
   c.noise_stddev = sigma;
   c.noise_seed = 2024;
-  ScanEncoder encoder(c);
-  EncodedScan out;
-  encoder.encode(scene, r, {}, &out);
+  MeasurementModel model(c);
+  MeasuredScan out;
+  model.measure(scene, r, {}, &out);
   double sum = 0, sum2 = 0;
   for (const float x : out.ranges) {
     const double e = static_cast<double>(x) - range;
@@ -259,7 +259,7 @@ TEST(ScanEncoder, NoiseStatistics) {
 
 // Noise keeps a valid return valid: results are clamped to [range_min, range_max] (hits right at
 // the bounds with large noise pile up exactly there); invalid beams (+Inf, -Inf, NaN) get none.
-TEST(ScanEncoder, NoiseIsClampedAndOnlyOnValidBeams) {
+TEST(MeasurementModel, NoiseIsClampedAndOnlyOnValidBeams) {
   const Scene scene = labelledScene();
   ScanResult r = uniformResult(4000, 0.0);
   for (int i = 0; i < 4000; ++i) {
@@ -282,11 +282,11 @@ TEST(ScanEncoder, NoiseIsClampedAndOnlyOnValidBeams) {
         r.body[i] = -1;
     }
   }
-  EncoderConfig c = encoderConfig(0.5, 10.0);
+  MeasurementConfig c = measurementConfig(0.5, 10.0);
   c.noise_stddev = 1.0;
-  ScanEncoder encoder(c);
-  EncodedScan out;
-  encoder.encode(scene, r, {}, &out);
+  MeasurementModel model(c);
+  MeasuredScan out;
+  model.measure(scene, r, {}, &out);
   int at_min = 0, at_max = 0, moved_min = 0, moved_max = 0;
   for (int i = 0; i < 4000; ++i) {
     const float x = out.ranges[i];
@@ -316,21 +316,21 @@ TEST(ScanEncoder, NoiseIsClampedAndOnlyOnValidBeams) {
 }
 
 // Without noise the output is the range itself (to float), every call.
-TEST(ScanEncoder, NoNoiseIsExact) {
+TEST(MeasurementModel, NoNoiseIsExact) {
   const Scene scene = labelledScene();
   ScanResult r = uniformResult(50, 0.0);
   for (int i = 0; i < 50; ++i) r.range[i] = 0.5 + 0.1234567891234 * i;
-  ScanEncoder encoder(encoderConfig(0.5, 10.0));
+  MeasurementModel model(measurementConfig(0.5, 10.0));
   for (int call = 0; call < 2; ++call) {
-    EncodedScan out;
-    encoder.encode(scene, r, {}, &out);
+    MeasuredScan out;
+    model.measure(scene, r, {}, &out);
     for (int i = 0; i < 50; ++i) EXPECT_EQ(out.ranges[i], static_cast<float>(r.range[i])) << i;
   }
 }
 
 // Intensity = reflectivity[label] * cos_incidence for valid hits, 0 for anything else; labels
 // beyond the reflectivity table count as 1; asking for intensity without incidence throws.
-TEST(ScanEncoder, Intensity) {
+TEST(MeasurementModel, Intensity) {
   const Scene scene = labelledScene();
   ScanResult r;
   r.range = {2.0, 3.0, 4.0, 5.0, kInf, 0.2, kNan, 6.0};
@@ -338,11 +338,11 @@ TEST(ScanEncoder, Intensity) {
   r.triangle.assign(r.range.size(), -1);
   r.cos_incidence = {1.0, 0.5, 0.25, 0.8, 0.0, 0.9, 0.0, 0.3};
   const std::vector<double> reflectivity = {0.9, 0.4};  // wall, table; robot missing -> 1
-  EncoderConfig c = encoderConfig(0.5, 10.0);
+  MeasurementConfig c = measurementConfig(0.5, 10.0);
   c.intensity = true;
-  ScanEncoder encoder(c);
-  EncodedScan out;
-  encoder.encode(scene, r, reflectivity, &out);
+  MeasurementModel model(c);
+  MeasuredScan out;
+  model.measure(scene, r, reflectivity, &out);
   ASSERT_EQ(out.intensities.size(), r.range.size());
   EXPECT_EQ(out.intensities[0], static_cast<float>(0.9 * 1.0));
   EXPECT_EQ(out.intensities[1], static_cast<float>(0.4 * 0.5));
@@ -353,22 +353,22 @@ TEST(ScanEncoder, Intensity) {
   EXPECT_EQ(out.intensities[6], 0.0f);                            // NaN
   EXPECT_EQ(out.intensities[7], static_cast<float>(1.0 * 0.3));
   // An empty table: every label counts as 1.
-  encoder.encode(scene, r, {}, &out);
+  model.measure(scene, r, {}, &out);
   EXPECT_EQ(out.intensities[1], 0.5f);
   // Intensity off: no intensities, even with incidence available.
-  ScanEncoder plain(encoderConfig(0.5, 10.0));
-  plain.encode(scene, r, reflectivity, &out);
+  MeasurementModel plain(measurementConfig(0.5, 10.0));
+  plain.measure(scene, r, reflectivity, &out);
   EXPECT_TRUE(out.intensities.empty());
   // Intensity on without incidence (or with the wrong count): an error, not garbage.
   ScanResult no_incidence = r;
   no_incidence.cos_incidence.clear();
-  EXPECT_THROW(encoder.encode(scene, no_incidence, reflectivity, &out), std::invalid_argument);
+  EXPECT_THROW(model.measure(scene, no_incidence, reflectivity, &out), std::invalid_argument);
   no_incidence.cos_incidence.assign(3, 1.0);
-  EXPECT_THROW(encoder.encode(scene, no_incidence, reflectivity, &out), std::invalid_argument);
+  EXPECT_THROW(model.measure(scene, no_incidence, reflectivity, &out), std::invalid_argument);
 }
 
 // Intensity end to end: a wall mesh hit head-on and at 60 degrees, reflectivity 0.8.
-TEST(ScanEncoder, IntensityFromCaster) {
+TEST(MeasurementModel, IntensityFromCaster) {
   Scene scene;
   scene.addFrame("world");
   scene.addLabel("wall");
@@ -386,11 +386,11 @@ TEST(ScanEncoder, IntensityFromCaster) {
   Caster caster;
   const ScanResult& r = caster.cast(scene, FramePoses::identity(scene),
                                     Eigen::Isometry3d::Identity(), ScanPattern(fan), cc);
-  EncoderConfig ec = encoderConfig(0.1, 30.0);
+  MeasurementConfig ec = measurementConfig(0.1, 30.0);
   ec.intensity = true;
-  ScanEncoder encoder(ec);
-  EncodedScan out;
-  encoder.encode(scene, r, {0.8}, &out);
+  MeasurementModel model(ec);
+  MeasuredScan out;
+  model.measure(scene, r, {0.8}, &out);
   EXPECT_NEAR(out.intensities[1], 0.8, 1e-7);
   EXPECT_NEAR(out.intensities[0], 0.4, 1e-7);
   EXPECT_NEAR(out.intensities[2], 0.4, 1e-7);

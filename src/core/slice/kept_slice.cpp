@@ -1,4 +1,4 @@
-#include "slice/plane_slice.h"
+#include "slice/kept_slice.h"
 
 #include <algorithm>
 #include <cstring>
@@ -9,56 +9,56 @@ namespace core {
 namespace {
 
 // A mesh body's segments: the triangles of its BVH whose boxes may meet the plane, each cut as
-// PlaneSlicer cuts it.
+// Slicer cuts it.
 void addMeshSegments(const Mesh& mesh, int body, const Eigen::Isometry3d& frame_from_mesh,
-                     const PlaneFrame& frame, std::vector<PlaneSlice::Item>* items) {
+                     const ScanPlane& plane, std::vector<KeptSlice::Item>* items) {
   const auto& slots = mesh.bvh().triangleVertices();
-  mesh.bvh().visit([&](const Aabb& box) { return frame.mayMeet(frame_from_mesh, box); },
+  mesh.bvh().visit([&](const Aabb& box) { return plane.mayMeet(frame_from_mesh, box); },
                    [&](std::uint32_t slot) {
                      Eigen::Vector3d v[3];
                      for (int k = 0; k < 3; ++k) v[k] = frame_from_mesh * slots[slot][k];
                      Eigen::Vector2d p, q;
-                     if (!frame.crossing(v, &p, &q) || p == q) return;
-                     items->push_back(PlaneSlice::Item{p, q, body, slot});
+                     if (!plane.crossing(v, &p, &q) || p == q) return;
+                     items->push_back(KeptSlice::Item{p, q, body, slot});
                    });
 }
 
 // A primitive body whose box may meet the plane, with the bounds of its box's corners in plane
 // coordinates.
-void addPrimitive(const Scene& scene, int body, const PlaneFrame& frame,
-                  std::vector<PlaneSlice::Item>* items) {
+void addPrimitive(const Scene& scene, int body, const ScanPlane& plane,
+                  std::vector<KeptSlice::Item>* items) {
   const Eigen::Isometry3d& pose = scene.bodies()[body].frame_from_body;
   Aabb own;
   own.lo = scene.boxCenter(body) - scene.boxHalf(body);
   own.hi = scene.boxCenter(body) + scene.boxHalf(body);
-  if (!frame.mayMeet(pose, own)) return;
+  if (!plane.mayMeet(pose, own)) return;
   Eigen::Vector3d c, e;
   boxInFrame(pose, own, &c, &e);
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector2d hi = -lo;
   for (int corner = 0; corner < 8; ++corner) {
     const Eigen::Vector3d sign(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1, corner & 4 ? 1 : -1);
-    const Eigen::Vector2d w = frame.planeCoords(c + sign.cwiseProduct(e));
+    const Eigen::Vector2d w = plane.planeCoords(c + sign.cwiseProduct(e));
     lo = lo.cwiseMin(w);
     hi = hi.cwiseMax(w);
   }
   // Widened for the rounding of the plane coordinates: the walk only culls by these bounds.
   const Eigen::Vector2d pad = 8 * std::numeric_limits<double>::epsilon() *
                               (lo.cwiseAbs() + hi.cwiseAbs() + Eigen::Vector2d::Ones());
-  items->push_back(PlaneSlice::Item{lo - pad, hi + pad, body, PlaneSlice::kPrimitive});
+  items->push_back(KeptSlice::Item{lo - pad, hi + pad, body, KeptSlice::kPrimitive});
 }
 
 }  // namespace
 
-std::unique_ptr<PlaneSlice> PlaneSlice::build(const Scene& scene, const SceneIndex::Group& group,
-                                              const PlaneFrame& frame) {
-  auto slice = std::make_unique<PlaneSlice>();
+std::unique_ptr<KeptSlice> KeptSlice::build(const Scene& scene, const SceneIndex::Group& group,
+                                              const ScanPlane& plane) {
+  auto slice = std::make_unique<KeptSlice>();
   for (const int body : group.bodies) {
     const Body& b = scene.bodies()[body];
     if (const auto* mesh = std::get_if<std::shared_ptr<const Mesh>>(&b.shape)) {
-      addMeshSegments(**mesh, body, b.frame_from_body, frame, &slice->items);
+      addMeshSegments(**mesh, body, b.frame_from_body, plane, &slice->items);
     } else {
-      addPrimitive(scene, body, frame, &slice->items);
+      addPrimitive(scene, body, plane, &slice->items);
     }
   }
   // The tree is built over 2D boxes, but the SAH weighs a box by its area, and a flat box (an
@@ -88,13 +88,13 @@ std::unique_ptr<PlaneSlice> PlaneSlice::build(const Scene& scene, const SceneInd
   return slice;
 }
 
-bool PlaneSliceCache::Key::operator==(const Key& o) const {
+bool KeptSlices::Key::operator==(const Key& o) const {
   // Bitwise: the same plane, not a nearby one.
   return scene_version == o.scene_version && group == o.group &&
          std::memcmp(n, o.n, sizeof n) == 0 && std::memcmp(&offset, &o.offset, sizeof offset) == 0;
 }
 
-std::size_t PlaneSliceCache::KeyHash::operator()(const Key& k) const {
+std::size_t KeptSlices::KeyHash::operator()(const Key& k) const {
   std::size_t h = std::hash<const void*>()(k.group) ^ std::hash<std::uint64_t>()(k.scene_version);
   for (const double x : {k.n[0], k.n[1], k.n[2], k.offset}) {
     std::uint64_t bits;
@@ -104,22 +104,22 @@ std::size_t PlaneSliceCache::KeyHash::operator()(const Key& k) const {
   return h;
 }
 
-const PlaneSlice* PlaneSliceCache::find(const Scene& scene, const SceneIndex::Group& group,
-                                        const PlaneFrame& frame) {
-  const Key key{scene.version(), &group, {frame.n.x(), frame.n.y(), frame.n.z()}, frame.offset};
+const KeptSlice* KeptSlices::find(const Scene& scene, const SceneIndex::Group& group,
+                                        const ScanPlane& plane) {
+  const Key key{scene.version(), &group, {plane.n.x(), plane.n.y(), plane.n.z()}, plane.offset};
   std::lock_guard<std::mutex> lock(mutex_);
   Entry& entry = entries_[key];
   entry.last_scan = scan_;
   if (entry.slice) return entry.slice.get();
   if (++entry.sightings != 2) return nullptr;  // once: not yet; beyond 2: too large to keep
-  std::unique_ptr<PlaneSlice> slice = PlaneSlice::build(scene, group, frame);
+  std::unique_ptr<KeptSlice> slice = KeptSlice::build(scene, group, plane);
   if (slice->items.size() > kMaxItems / 4) return nullptr;  // and never built again
   items_ += slice->items.size();
   entry.slice = std::move(slice);
   return entry.slice.get();
 }
 
-void PlaneSliceCache::newScan() {
+void KeptSlices::newScan() {
   std::lock_guard<std::mutex> lock(mutex_);
   ++scan_;
   for (auto it = entries_.begin(); it != entries_.end();) {
@@ -143,7 +143,7 @@ void PlaneSliceCache::newScan() {
   }
 }
 
-std::size_t PlaneSliceCache::slices() const {
+std::size_t KeptSlices::slices() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::size_t n = 0;
   for (const auto& entry : entries_) n += entry.second.slice != nullptr;

@@ -1,7 +1,7 @@
 // The caster's top level: the bodies of one frame, front to back through their tree
 // (scene_index.h), each node with the beams its window holds, skipping nodes off the scan plane,
 // beyond the range or hidden behind nearer hits; each body reached is cast with the beams of its
-// own window (body_traversal.h).
+// own window (mesh_walk.h).
 #pragma once
 
 #include <atomic>
@@ -16,7 +16,7 @@ namespace core {
 
 // Casts the open beams of `within` against the bodies of group, placed by sensor_from_frame. Sets
 // cast[b] for each body b it casts against (several walks may set them at once).
-void castGroup(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
+void walkFrame(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
                const BeamRect& within, std::vector<std::atomic<char>>* cast);
 

@@ -1,4 +1,4 @@
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 namespace laser_raycast {
 namespace core {
 
-void EncoderConfig::validate() const {
+void MeasurementConfig::validate() const {
   std::ostringstream msg;
   if (!(std::isfinite(range_min) && range_min >= 0)) {
     msg << "range_min must be finite and >= 0, got " << range_min;
@@ -34,7 +34,7 @@ void EncoderConfig::validate() const {
   throw std::invalid_argument(msg.str());
 }
 
-double classifyRange(double range, const EncoderConfig& config) {
+double classifyRange(double range, const MeasurementConfig& config) {
   if (std::isnan(range)) return range;
   if (!(range <= config.range_max)) return std::numeric_limits<double>::infinity();
   if (range < config.range_min) {
@@ -51,31 +51,31 @@ double classifyRange(double range, const EncoderConfig& config) {
   return range;
 }
 
-double quantizeRange(double range, const EncoderConfig& config) {
+double quantizeRange(double range, const MeasurementConfig& config) {
   const double step = config.range_resolution;
   if (!(step > 0)) return range;
   return std::clamp(std::round(range / step) * step, config.range_min, config.range_max);
 }
 
-ScanEncoder::ScanEncoder(const EncoderConfig& config) : config_(config), noise_(0.0, 1.0) {
+MeasurementModel::MeasurementModel(const MeasurementConfig& config) : config_(config), noise_(0.0, 1.0) {
   config_.validate();
   seed(config_.noise_seed);
 }
 
-void ScanEncoder::setConfig(const EncoderConfig& config) {
+void MeasurementModel::setConfig(const MeasurementConfig& config) {
   config.validate();
   const bool reseed = config.noise_seed != config_.noise_seed;
   config_ = config;
   if (reseed) seed(config_.noise_seed);
 }
 
-void ScanEncoder::seed(std::uint64_t seed) {
+void MeasurementModel::seed(std::uint64_t seed) {
   rng_.seed(seed);
   dropout_rng_.seed(seed ^ kDropoutSeedMix);
   noise_.reset();  // drop a normal value cached from the old sequence
 }
 
-bool ScanEncoder::degrade(double* range) {
+bool MeasurementModel::degrade(double* range) {
   double r = *range + config_.range_bias;
   if (config_.noise_stddev > 0) r += config_.noise_stddev * noise_(rng_);
   r = std::clamp(r, config_.range_min, config_.range_max);
@@ -88,8 +88,8 @@ bool ScanEncoder::degrade(double* range) {
   return true;
 }
 
-void ScanEncoder::encode(const Scene& scene, const ScanResult& result,
-                         const std::vector<double>& reflectivity, EncodedScan* out) {
+void MeasurementModel::measure(const Scene& scene, const ScanResult& result,
+                         const std::vector<double>& reflectivity, MeasuredScan* out) {
   const std::size_t n = result.range.size();
   out->ranges.resize(n);
   out->labels.resize(n);

@@ -1,7 +1,7 @@
-// How the four children of a node of a kept slice's tree (plane_slice.h) look from the sensor under
+// How the four children of a node of a kept slice's tree (kept_slice.h) look from the sensor under
 // a planar fan, computed together in float with SSE2: each child's nearest distance and the fan's
 // columns its box can be seen in. The boxes are 2D, in the plane's coordinates; the map to the
-// sensor's x, y is PlaneFrame's. Everything is conservative, as NodeViews is: every rounding widens
+// sensor's x, y is ScanPlane's. Everything is conservative, as NodeViews is: every rounding widens
 // a window and lowers a distance, so a beam whose exact ray enters a child's box is always among
 // the child's columns. Only the amount of work depends on them.
 #pragma once
@@ -13,20 +13,20 @@
 #include <cstdint>
 #include <limits>
 
-#include "slice/fan_slicer.h"
+#include "slice/slicer.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "accel/wide_bvh.h"
 
 namespace laser_raycast {
 namespace core {
 
-// The plane's map and the fan's columns, prepared for PlaneViews.
-class PlaneViewFrame {
+// The plane's map and the fan's columns, prepared for SliceViews.
+class SliceViewBasis {
  public:
-  PlaneViewFrame(const PlaneFrame& plane, double tmax, const ScanPattern& fan);
+  SliceViewBasis(const ScanPlane& plane, double tmax, const ScanPattern& fan);
 
  private:
-  friend struct PlaneViews;
+  friend struct SliceViews;
   __m128 a_, b_, c_, d_, abs_a_, abs_b_, abs_c_, abs_d_, tx_, ty_, abs_tx_, abs_ty_, tmax_;
   // Columns: index = (angle - start) * inv_increment, a turn is `turn` columns; pad covers the
   // float rounding of that arithmetic. fast_: the fan spans at most a turn.
@@ -35,7 +35,7 @@ class PlaneViewFrame {
   bool fast_;
 };
 
-struct PlaneViews {
+struct SliceViews {
   int mask;                   // bit k: child k exists and may be nearer than tmax
   int columns_known;          // bit k: col_lo/col_hi hold child k's columns
   alignas(16) float near[4];  // no point of the child's box is nearer to the sensor
@@ -46,7 +46,7 @@ struct PlaneViews {
   alignas(16) float az_center[4];
   alignas(16) float az_half[4];
 
-  void compute(const WideBvh::Node& node, const PlaneViewFrame& frame);
+  void compute(const WideBvh::Node& node, const SliceViewBasis& basis);
 };
 
 // A beam in plane coordinates, prepared for conservative box tests against a slice tree's nodes,

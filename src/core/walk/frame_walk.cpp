@@ -1,11 +1,11 @@
-#include "walk/scene_walk.h"
+#include "walk/frame_walk.h"
 #include "beams/placed_body.h"
 
 #include <algorithm>
 #include <optional>
 
-#include "walk/body_traversal.h"
-#include "slice/fan_slicer.h"
+#include "walk/mesh_walk.h"
+#include "slice/slicer.h"
 #include "beams/node_views.h"
 #include "walk/primitive_cast.h"
 
@@ -13,9 +13,9 @@ namespace laser_raycast {
 namespace core {
 namespace {
 
-class GroupWalk {
+class FrameWalk {
  public:
-  GroupWalk(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
+  FrameWalk(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
             const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
             std::vector<std::atomic<char>>* cast)
       : beams_(beams),
@@ -25,7 +25,7 @@ class GroupWalk {
         config_(config),
         cast_(cast),
         planar_(beams.pattern().planar()),
-        frame_(sensor_from_frame, planar_, config.tmax) {
+        basis_(sensor_from_frame, planar_, config.tmax) {
     if (planar_) plane_.emplace(sensor_from_frame);
   }
 
@@ -51,7 +51,7 @@ class GroupWalk {
         if (isPrimitive(a.index) && deferLargePrimitive(a)) {
           deferred_.add(a, e.rect);
         } else {
-          castBody(beams_, scene_, a, config_, e.rect);
+          walkMesh(beams_, scene_, a, config_, e.rect);
         }
       } else if (e.ref.isLeaf()) {
         for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
@@ -81,7 +81,7 @@ class GroupWalk {
   void expand(const Entry& e) {
     const WideBvh::Node& node = group_.wide.nodes()[e.ref.index];
     NodeViews views;
-    views.compute(node, frame_);
+    views.compute(node, basis_);
     Entry children[4 * 3];  // a child's view may wrap into several rects
     int n = 0;
     for (int k = 0; k < WideBvh::kWidth; ++k) {
@@ -122,8 +122,8 @@ class GroupWalk {
   const CastConfig& config_;
   std::vector<std::atomic<char>>* cast_;
   const bool planar_;
-  const ViewFrame frame_;
-  std::optional<PlaneFrame> plane_;  // planar fans: the scan plane in the frame
+  const ViewBasis basis_;
+  std::optional<ScanPlane> plane_;  // planar fans: the scan plane in the frame
   // Nearest first over the whole tree (a heap rather than a stack: a depth-first walk would finish
   // a near node's far bodies before the next near node), so that near hits hide far bodies.
   static bool farther(const Entry& a, const Entry& b) { return a.near > b.near; }
@@ -138,10 +138,10 @@ class GroupWalk {
 
 }  // namespace
 
-void castGroup(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
+void walkFrame(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
                const BeamRect& within, std::vector<std::atomic<char>>* cast) {
-  GroupWalk(beams, scene, group, sensor_from_frame, config, cast).run(within);
+  FrameWalk(beams, scene, group, sensor_from_frame, config, cast).run(within);
 }
 
 }  // namespace core

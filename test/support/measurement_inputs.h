@@ -1,19 +1,19 @@
-// Hand-made inputs for the encoder tests: range limits, a scene of labelled bodies, and uniform
+// Hand-made inputs for the measurement model tests: range limits, a scene of labelled bodies, and uniform
 // cast results.
 #pragma once
 
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
-#include "laser_raycast/core/scan_encoder.h"
+#include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/scene.h"
 
 namespace laser_raycast_test {
 
-inline laser_raycast::core::EncoderConfig encoderConfig(
+inline laser_raycast::core::MeasurementConfig measurementConfig(
     double range_min, double range_max,
     laser_raycast::core::MinRangePolicy policy = laser_raycast::core::MinRangePolicy::kNegInf) {
-  laser_raycast::core::EncoderConfig c;
+  laser_raycast::core::MeasurementConfig c;
   c.range_min = range_min;
   c.range_max = range_max;
   c.min_range_policy = policy;

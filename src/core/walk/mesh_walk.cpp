@@ -1,4 +1,4 @@
-#include "walk/body_traversal.h"
+#include "walk/mesh_walk.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "beams/column_raster.h"
 #include "beams/edge_filter.h"
-#include "slice/fan_slicer.h"
+#include "slice/slicer.h"
 #include "walk/primitive_cast.h"
 #include "accel/wide_bvh.h"
 
@@ -76,7 +76,7 @@ class MeshWalk {
         slicing_(planar_ && config.planar_fast_path),
         // Without the fast paths every beam is traced from the root, as the reference.
         tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
-        frame_(active.sensor_from_body, planar_, config.tmax),
+        basis_(active.sensor_from_body, planar_, config.tmax),
         origin_(active.sensor_in_body, mesh.bvh().bounds(), config.tmin) {
     closed_ = !slicing_ && mesh.hasClosedComponents();
     if (slicing_) {
@@ -152,7 +152,7 @@ class MeshWalk {
   void expand(const Entry& e) {
     const WideBvh::Node& node = wide_.nodes()[e.ref.index];
     NodeViews views;
-    views.compute(node, frame_);
+    views.compute(node, basis_);
     if (!views.mask) return;
     Entry children[4 * 3];  // a child's view may wrap into several rects
     int n = 0;
@@ -339,7 +339,7 @@ class MeshWalk {
         continue;
       }
       const WideBvh::Node& node = wide_.nodes()[ref.index];
-      const int mask = planeMask(node, frame_);
+      const int mask = planeMask(node, basis_);
       for (int k = 0; k < WideBvh::kWidth; ++k) {
         if (mask & (1 << k)) stack[top++] = node.child(k);
       }
@@ -374,16 +374,16 @@ class MeshWalk {
   SlotCache<SensorTriangle, 64> triangles_;
   SlotCache<bool, 256> hidden_;
   bool closed_;  // the mesh has closed components
-  const ViewFrame frame_;
+  const ViewBasis basis_;
   const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame
-  std::optional<PlaneSlicer> slicer_;
+  std::optional<Slicer> slicer_;
   std::vector<Entry> stack_ = std::vector<Entry>(256);
   int top_ = 0;
 };
 
 }  // namespace
 
-void castBody(BeamSet& beams, const Scene& scene, const PlacedBody& active,
+void walkMesh(BeamSet& beams, const Scene& scene, const PlacedBody& active,
               const CastConfig& config, const BeamRect& within) {
   const Body& body = scene.bodies()[active.index];
   const auto* mesh = std::get_if<std::shared_ptr<const Mesh>>(&body.shape);
