@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
-#include "slice/slicer.h"
+#include "slice_mesh.h"
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/core/pose.h"
 #include "random.h"

@@ -205,12 +205,12 @@ FilterCase randomTriangle(Rng& rng) {
                     c + size * randomUnitVector(rng)};
 }
 
-// Casts nothing: sets the beams' ranges through offer(), as the walk does.
+// Casts nothing: sets the beams' ranges through keepNearestHit(), as the walks do.
 void setRandomRanges(Rng& rng, core::BeamSet* beams) {
   for (int row = 0; row < beams->rows(); ++row) {
     for (int col = 0; col < beams->cols(); ++col) {
       if (rng() % 3 == 0) continue;
-      beams->offer(row, col, uniform(rng, 0.05, 40), 0, 0, [] { return Eigen::Vector3d(); });
+      beams->keepNearestHit(row, col, uniform(rng, 0.05, 40), 0, 0, [] { return Eigen::Vector3d(); });
     }
   }
 }
@@ -383,7 +383,7 @@ TEST(BeamSet, AWindowWithAnOpenBeamIsNeverClosed) {
   for (int step = 0; step < 20000; ++step) {
     const int row = static_cast<int>(uniform(rng, 0, beams.rows())),
               col = static_cast<int>(uniform(rng, 0, beams.cols()));
-    beams.offer(row, col, std::min(beams.range(row, col), uniform(rng, 0, 10)), 0, 0,
+    beams.keepNearestHit(row, col, std::min(beams.range(row, col), uniform(rng, 0, 10)), 0, 0,
                 [] { return Eigen::Vector3d(); });
     core::BeamRect rect;
     rect.row_lo = static_cast<int>(uniform(rng, 0, beams.rows()));

@@ -12,7 +12,7 @@
 #include "cast_reference.h"
 #include "fan_specs.h"
 #include "laser_raycast/core/caster.h"
-#include "slice/slicer.h"
+#include "slice_mesh.h"
 #include "laser_raycast/core/pose.h"
 #include "mesh_builder.h"
 #include "random.h"

@@ -12,6 +12,7 @@
 
 #include "laser_raycast/core/mesh.h"
 #include "accel/wide_bvh.h"
+#include "wide_ray.h"
 #include "mesh_builder.h"
 #include "random.h"
 #include "test_geometry.h"

@@ -82,7 +82,7 @@ class MeasurementModel {
 
   explicit MeasurementModel(const MeasurementConfig& config);  // validates
 
-  // A new configuration for the next encode() (e.g. from dynamic_reconfigure): validates it, and
+  // A new configuration for the next measure() (e.g. from dynamic_reconfigure): validates it, and
   // restarts both random sequences if noise_seed changed; otherwise they continue.
   void setConfig(const MeasurementConfig& config);
 

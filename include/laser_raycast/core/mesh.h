@@ -30,8 +30,8 @@ class Mesh {
   const std::vector<Eigen::Vector3d>& vertices() const { return vertices_; }
   const std::vector<TriangleIndices>& triangles() const { return triangles_; }
   const Bvh& bvh() const { return bvh_; }
-  // The caster's BVH: 4-wide, over the same triangle slots; each connected component (triangles
-  // joined by shared vertex indices) fills whole subtrees, and childGroup() names it.
+  // The caster's BVH: 4-wide, over the same triangle slots (src/core/accel/wide_bvh.h, private to
+  // the core); a leaf holds the triangles of one connected component where the binary BVH allows.
   const WideBvh& wideBvh() const { return *wide_; }
   // The connected component of each triangle, numbered from 0, and how many there are.
   const std::vector<std::uint32_t>& components() const { return component_; }

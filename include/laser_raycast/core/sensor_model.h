@@ -1,6 +1,6 @@
 // Presets of real sensors: the beam pattern, range limits and scan rate of a named lidar, taken
-// from its datasheet (src/core/sensor_model.cpp says where each value comes from; docs/sensors.md
-// lists them). A preset fills a ScanSpec; explicit settings then override single fields of it.
+// from its datasheet (src/core/measurement/sensor_model.cpp says where each value comes from;
+// docs/sensors.md lists them). A preset fills a ScanSpec; explicit settings then override single fields of it.
 #pragma once
 
 #include <optional>

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "util/float_rounding.h"
+
 namespace laser_raycast {
 namespace core {
 namespace {
@@ -218,17 +220,6 @@ AabbT<T> castBounds(const Aabb& b) {
   return out;
 }
 
-// The largest float <= x, and the smallest float >= x: a float box that contains the exact one (and
-// the float-rounded vertices' box, since rounding to nearest is monotonic).
-float floatAtMost(double x) {
-  constexpr float kMax = std::numeric_limits<float>::max();
-  if (x > kMax) return kMax;
-  if (x < -kMax) return -std::numeric_limits<float>::infinity();
-  const float f = static_cast<float>(x);
-  return f > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
-}
-float floatAtLeast(double x) { return -floatAtMost(-x); }
-
 // The builder's tree as BvhT stores it: inner nodes depth first, each holding its children's boxes
 // (rounded outward to float); the two children of a node get adjacent indices.
 template <typename T>
@@ -259,8 +250,8 @@ typename BvhT<T>::Tree writeTree(const std::vector<BuildNode>& tree) {
       auto& node = out.nodes[to];
       node.child[k] = ref;
       for (int a = 0; a < 3; ++a) {
-        node.lo[k][a] = floatAtMost(child.bounds.lo[a]);
-        node.hi[k][a] = floatAtLeast(child.bounds.hi[a]);
+        node.lo[k][a] = floatBelow(child.bounds.lo[a]);
+        node.hi[k][a] = floatAbove(child.bounds.hi[a]);
       }
     }
   }

@@ -201,33 +201,5 @@ bool WideBoxRay::enters(const float lo[3], const float hi[3], float cull) const 
   return tnear <= (tfar < cull ? tfar : cull);
 }
 
-template <TriangleMethod M>
-bool WideRay<M>::closestHit(const WideBvh& bvh, WideBvh::Ref start, const float* start_lo,
-                            const float* start_hi, double* tmax,
-                            std::optional<MeshHit>* best) const {
-  if (start.isEmpty() || !box_.enters(start_lo, start_hi, box_.cullLimit(*tmax))) return false;
-  const Bvh& binary = bvh.binary();
-  const auto& slots = binary.triangleVertices();
-  const auto& ids = binary.triangleIds();
-  bool improved = false;
-  traceWide(bvh, start, box_, tmax, [&](std::uint32_t slot) {
-    const auto& tri = slots[slot];
-    const auto hit = prepared_.intersect(tri[0], tri[1], tri[2], *tmax);
-    if (!hit) return;
-    const std::uint32_t id = ids[slot];
-    if (*best && !(hit->t < (*best)->t || ((*best)->t == hit->t && id < (*best)->triangle))) return;
-    *best = MeshHit{hit->t, hit->u, hit->v, id};
-    improved = true;
-    *tmax = hit->t;
-  });
-  return improved;
-}
-
-template class WideRay<TriangleMethod::kSeedPlane>;
-template class WideRay<TriangleMethod::kSeedUv>;
-template class WideRay<TriangleMethod::kCramer>;
-template class WideRay<TriangleMethod::kMollerTrumbore>;
-template class WideRay<TriangleMethod::kWatertight>;
-
 }  // namespace core
 }  // namespace laser_raycast

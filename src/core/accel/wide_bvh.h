@@ -22,28 +22,10 @@
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
+#include "util/float_rounding.h"
 
 namespace laser_raycast {
 namespace core {
-
-// The float nearest to x in the direction of -inf (floatBelow) or +inf (floatAbove) that is not
-// beyond x: x itself if it is a float. Finite x only (infinities and NaN pass through).
-inline float floatBelow(double x) {
-  const float f = static_cast<float>(x);
-  // Stepping one float towards -inf is adding one to the bits of a negative float and subtracting
-  // one from those of a positive one; +0 steps as -0 does, to the negative smallest subnormal.
-  // Without branches: whether f rounded above x is a coin toss that a branch would mispredict.
-  std::uint32_t bits;
-  std::memcpy(&bits, &f, sizeof bits);
-  const std::uint32_t signed_bits = bits | (static_cast<std::uint32_t>(f == 0) << 31);
-  const std::uint32_t stepped = signed_bits + ((signed_bits >> 31) << 1) - 1;
-  const std::uint32_t above = 0u - static_cast<std::uint32_t>(f > x);  // all ones or none
-  const std::uint32_t result = bits ^ ((bits ^ stepped) & above);
-  float g;
-  std::memcpy(&g, &result, sizeof g);
-  return g;
-}
-inline float floatAbove(double x) { return -floatBelow(-x); }
 
 // How far apart a point can be in the frame of a tree's boxes and in the frame where the walk tests
 // what the boxes hold: a traced beam's boxes are in the body's (or the plane's) coordinates, but
@@ -400,32 +382,6 @@ void traceWidePair(const WideBvh& bvh, WideBvh::Ref start, const BoxRay& ray_a, 
   while (more_a) more_a = a.step(leaf_a);
   while (more_b) more_b = b.step(leaf_b);
 }
-
-// A ray prepared for the wide BVH (WideBoxRay) together with the exact triangle test. Every test of
-// one ray against one mesh goes through the same PreparedRay, so that a ray exactly on a shared
-// edge is decided the same way everywhere.
-template <TriangleMethod M>
-class WideRay {
- public:
-  // bounds: the box of everything the ray will be tested against (a mesh's), for the reach.
-  WideRay(const Ray& ray, bool cull_backfaces, const Aabb& bounds)
-      : prepared_(ray, cull_backfaces), box_(ray, bounds) {}
-
-  const PreparedRay<double, M>& prepared() const { return prepared_; }
-  const WideBoxRay& box() const { return box_; }
-
-  // Nearest hit with t in [ray.tmin, *tmax] in the subtree `start` whose box is start_box (float
-  // corners lo[3], hi[3], rounded outward), skipping triangles that do not improve *best: a hit
-  // improves it if it is nearer, or as near with a smaller triangle index (so the result does not
-  // depend on the order the tree is walked in). Shrinks *tmax to each improving hit. Returns true
-  // if *best changed.
-  bool closestHit(const WideBvh& bvh, WideBvh::Ref start, const float* start_lo,
-                  const float* start_hi, double* tmax, std::optional<MeshHit>* best) const;
-
- private:
-  PreparedRay<double, M> prepared_;
-  WideBoxRay box_;
-};
 
 }  // namespace core
 }  // namespace laser_raycast

@@ -4,9 +4,9 @@
 // fixed by the directions it covers).
 //
 // Beams are addressed as (row, col): rows are the rings in ascending elevation, cols the azimuth
-// indices. A hit is kept if it is nearer than the beam's current one, or as near from a lower body
-// index, then a lower triangle index: the result never depends on the order bodies, nodes or beams
-// are visited in (and so not on how beams are split between threads).
+// indices. A beam keeps the hit that goes first by the order of hit_order.h (keepNearestHit): the
+// result never depends on the order bodies, nodes or beams are visited in (and so not on how beams
+// are split between threads).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "beams/beam_window.h"
+#include "geometry/hit_order.h"
 #include "laser_raycast/core/cast_config.h"
 #include "beams/node_views.h"
 #include "beams/occlusion_tiles.h"
@@ -145,10 +146,13 @@ class BeamSet {
     row_tan_.find(lo, hi, row_lo, row_hi);
   }
 
-  // Offers a hit (t, body, triangle) to the beam at (row, col); normal() gives its unit normal in
-  // the sensor frame, asked only if the hit is kept and normals are wanted. True if kept.
+  // Where a beam's range is decided, the one place that writes it: the hit (t, body, triangle) is
+  // kept for the beam at (row, col) if it goes before the beam's current one by the order of
+  // hit_order.h (nearer, or as near on a lower body, then a lower triangle); normal() gives its
+  // unit normal in the sensor frame, asked only if the hit is kept and normals are wanted. True if
+  // kept.
   template <class Normal>
-  bool offer(int row, int col, double t, int body, int triangle, Normal&& normal);
+  bool keepNearestHit(int row, int col, double t, int body, int triangle, Normal&& normal);
 
  private:
   void rowsReached(const View& view, int* lo, int* hi) const {
@@ -269,15 +273,12 @@ void BeamSet::forEachChildRect(const NodeViews& views, int k, const BeamRect& wi
 }
 
 template <class Normal>
-bool BeamSet::offer(int row, int col, double t, int body, int triangle, Normal&& normal) {
+bool BeamSet::keepNearestHit(int row, int col, double t, int body, int triangle, Normal&& normal) {
   const int i = beam(row, col);
   double& range = result_->range[i];
   int& hit_body = result_->body[i];
   int& hit_triangle = result_->triangle[i];
-  const bool nearer =
-      t < range ||
-      (t == range && (body < hit_body || (body == hit_body && triangle < hit_triangle)));
-  if (!nearer) return false;
+  if (!hitBefore(t, body, triangle, range, hit_body, hit_triangle)) return false;
   range = t;
   hit_body = body;
   hit_triangle = triangle;

@@ -6,9 +6,6 @@ namespace laser_raycast {
 namespace core {
 namespace {
 
-// |[a, b, c]| below this fraction of |a| |b| |c|: the triangle is seen nearly edge-on, and the edge
-// planes say little about which beams meet it.
-constexpr double kEdgeOnRatio = 1e-6;
 // Normals scaled to |m|_1 = 1 must stay far from float's underflow: a smaller triple product (a
 // triangle of a few 1e-19 m, or one seen within 1e-20 of edge-on) tests every beam.
 constexpr double kSmallest = 1e-30;

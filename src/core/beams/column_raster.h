@@ -27,6 +27,11 @@
 namespace laser_raycast {
 namespace core {
 
+// |[a, b, c]| (the triangle's corners as seen from the sensor) below this fraction of |a| |b| |c|:
+// the triangle is seen nearly edge-on, and its edge planes say little about which beams meet it, so
+// the column raster (ColumnRaster) and the row scan (EdgeFilter, edge_filter.h) test every beam.
+inline constexpr double kEdgeOnRatio = 1e-6;
+
 class ColumnRaster {
  public:
   // a, b, c in the sensor frame. The pattern's rows must allow it (BeamSet::columnRaster()).

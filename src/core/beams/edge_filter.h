@@ -16,6 +16,7 @@
 #include <cmath>
 
 #include "beams/beam_set.h"
+#include "beams/column_raster.h"
 
 namespace laser_raycast {
 namespace core {
@@ -83,8 +84,6 @@ class EdgeFilter {
   }
 
  private:
-  // |[a, b, c]| below this fraction of |a| |b| |c|: the triangle is seen nearly edge-on.
-  static constexpr double kEdgeOnRatio = 1e-6;
   // The margin, as a fraction of |n|_1: about 30 times the float rounding it has to cover.
   static constexpr double kMarginRatio = 4e-6;
 

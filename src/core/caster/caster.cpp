@@ -209,6 +209,8 @@ const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
   if (!sensor_ok) return result_;
 
   state_->placeGroups(scene, key, pattern, &result_);
+  // The walks offer each hit to the BeamSet reset here on result_; BeamSet::keepNearestHit
+  // (beams/beam_set.h) decides every beam's range, body and triangle.
   state_->castBodies(scene, pattern, config, &result_);
   if (config.compute_incidence) computeIncidence(pattern, &result_);
   state_->previous = std::move(key);

@@ -54,6 +54,28 @@ SliceViewBasis::SliceViewBasis(const ScanPlane& p, double tmax, const ScanPatter
   pad_ = set(64 * std::numeric_limits<float>::epsilon() * magnitude + 0.01);
 }
 
+LASER_RAYCAST_HOT_INLINE void SliceViews::storeColumns(const SliceViewBasis& f, __m128 center,
+                                                       __m128 half, __m128 narrow) {
+  const __m128 zero = _mm_setzero_ps();
+  // Columns: the window's start in columns from the fan's start, reduced into [0, turn); known
+  // where the window neither starts before the fan nor ends after a turn (no wrap).
+  __m128 s = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(center, half), f.start_), f.inv_increment_);
+  s = _mm_sub_ps(s, _mm_mul_ps(f.turn_, floorPs(_mm_mul_ps(s, f.inv_turn_))));
+  const __m128 lo = _mm_sub_ps(s, f.pad_);
+  const __m128 hi =
+      _mm_add_ps(_mm_add_ps(s, _mm_mul_ps(_mm_add_ps(half, half), f.inv_increment_)), f.pad_);
+  const __m128 inside = _mm_and_ps(_mm_cmpge_ps(lo, zero), _mm_cmplt_ps(hi, f.turn_));
+  columns_known = _mm_movemask_ps(_mm_and_ps(narrow, inside)) & mask;
+  if (!columns_known) return;
+  // ceil(lo) and floor(hi), both >= 0 here; hi clamped to the last column (and far below 2^31).
+  const __m128i lo_i = _mm_cvttps_epi32(lo);
+  const __m128i lo_up =
+      _mm_sub_epi32(lo_i, _mm_castps_si128(_mm_cmpgt_ps(lo, _mm_cvtepi32_ps(lo_i))));
+  const __m128 hi_c = _mm_min_ps(hi, _mm_set1_ps(static_cast<float>(f.columns_ - 1)));
+  _mm_store_si128(reinterpret_cast<__m128i*>(col_lo), lo_up);
+  _mm_store_si128(reinterpret_cast<__m128i*>(col_hi), _mm_cvttps_epi32(hi_c));
+}
+
 void SliceViews::compute(const WideBvh::Node& node, const SliceViewBasis& f) {
   const __m128 half_ps = _mm_set1_ps(0.5f), slack = _mm_set1_ps(kViewSlack);
   const __m128 lo_x = _mm_load_ps(node.lo[0]), lo_y = _mm_load_ps(node.lo[1]);
@@ -116,24 +138,7 @@ void SliceViews::compute(const WideBvh::Node& node, const SliceViewBasis& f) {
   _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
   _mm_store_ps(az_center, center);
   if (!f.fast_) return;
-
-  // Columns: the window's start in columns from the fan's start, reduced into [0, turn); known
-  // where the window neither starts before the fan nor ends after a turn (no wrap).
-  __m128 s = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(center, half), f.start_), f.inv_increment_);
-  s = _mm_sub_ps(s, _mm_mul_ps(f.turn_, floorPs(_mm_mul_ps(s, f.inv_turn_))));
-  const __m128 lo = _mm_sub_ps(s, f.pad_);
-  const __m128 hi =
-      _mm_add_ps(_mm_add_ps(s, _mm_mul_ps(_mm_add_ps(half, half), f.inv_increment_)), f.pad_);
-  const __m128 inside = _mm_and_ps(_mm_cmpge_ps(lo, zero), _mm_cmplt_ps(hi, f.turn_));
-  columns_known = _mm_movemask_ps(_mm_and_ps(narrow, inside)) & mask;
-  if (!columns_known) return;
-  // ceil(lo) and floor(hi), both >= 0 here; hi clamped to the last column (and far below 2^31).
-  const __m128i lo_i = _mm_cvttps_epi32(lo);
-  const __m128i lo_up =
-      _mm_sub_epi32(lo_i, _mm_castps_si128(_mm_cmpgt_ps(lo, _mm_cvtepi32_ps(lo_i))));
-  const __m128 hi_c = _mm_min_ps(hi, _mm_set1_ps(static_cast<float>(f.columns_ - 1)));
-  _mm_store_si128(reinterpret_cast<__m128i*>(col_lo), lo_up);
-  _mm_store_si128(reinterpret_cast<__m128i*>(col_hi), _mm_cvttps_epi32(hi_c));
+  storeColumns(f, center, half, narrow);
 }
 
 }  // namespace core

@@ -47,6 +47,11 @@ struct SliceViews {
   alignas(16) float az_half[4];
 
   void compute(const WideBvh::Node& node, const SliceViewBasis& basis);
+
+ private:
+  // compute's last step: the columns of the children whose bearing window neither starts before
+  // the fan nor ends after a turn.
+  void storeColumns(const SliceViewBasis& f, __m128 center, __m128 half, __m128 narrow);
 };
 
 // A beam in plane coordinates, prepared for conservative box tests against a slice tree's nodes,

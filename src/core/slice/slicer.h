@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -17,18 +18,6 @@
 
 namespace laser_raycast {
 namespace core {
-
-// The per-beam nearest hit so far: distance, body and triangle.
-struct DepthBuffer {
-  std::vector<double>* range;
-  std::vector<int>* body;
-  std::vector<int>* triangle;
-  // If set, every segment a beam crosses within [tmin, tmax] is counted, nearest or not: a closed
-  // mesh's outline is crossed exactly once per beam from inside (the watertightness tests use it).
-  std::vector<int>* crossings = nullptr;
-  // If set, the hit triangle's front normal (sensor frame) is written with every nearer hit.
-  std::vector<Eigen::Vector3d>* normal = nullptr;
-};
 
 // The scan plane (the sensor's z = 0) in the frame that moves a group of bodies (scene_index.h):
 // side(p) = n . p + offset is the sensor z of p (frame coordinates). Points of the plane are
@@ -72,6 +61,13 @@ void boxInFrame(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box, Eigen
 // lying in the plane is cut once: a beam crosses a closed outline exactly once. A surface that only
 // touches the plane from below (the top of a box at exactly the sensor's height) is therefore not
 // seen; triangles lying in the plane are skipped, as the 3D tests skip a ray in a triangle's plane.
+// A triangle's front normal ((b - a) x (c - a), from its vertices v in a body's frame) rotated into
+// the sensor frame by sensor_rot, its x and y: what a planar test culls back faces by.
+inline Eigen::Vector2d planarFront(const Eigen::Matrix3d& sensor_rot,
+                                   const std::array<Eigen::Vector3d, 3>& v) {
+  return (sensor_rot * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
+}
+
 class Slicer {
  public:
   // A mesh placed in a frame (frame_from_mesh) cut by that frame's plane (plane): how the walk
@@ -132,10 +128,6 @@ class Slicer {
   double tmin_, tmax_, tmax2_, gamma_;
   bool cull_backfaces_;
 };
-
-// Slices one mesh body and keeps, per beam, the nearest hit with t in [tmin, tmax] in buffer.
-void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
-               double tmin, double tmax, bool cull_backfaces, int body_index, DepthBuffer buffer);
 
 // Whether the beam with direction (dx, dy) (sensor frame) crosses the segment with ends p != q
 // (sensor x, y) with t in [tmin, tmax], and where. With front (the triangle's front normal's
@@ -221,8 +213,7 @@ void Slicer::testSegment(const Eigen::Vector2d& plane_p, const Eigen::Vector2d& 
                               Open&& open) const {
   Eigen::Vector2d front;
   if (cull_backfaces_) {
-    const auto& v = mesh_.bvh().triangleVertices()[slot];
-    front = (rot_ * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
+    front = planarFront(rot_, mesh_.bvh().triangleVertices()[slot]);
   }
   testSegmentInFan(fan_, plane_.toSensor(plane_p), plane_.toSensor(plane_q), tmin_, tmax_,
                    cull_backfaces_ ? &front : nullptr, first, last, std::forward<Hit>(hit),

@@ -48,10 +48,12 @@ class FrameWalk {
       if (e.body >= 0) {
         const PlacedBody& a = bodies_[e.body];
         (*cast_)[a.index].store(1, std::memory_order_relaxed);
-        if (isPrimitive(a.index) && deferLargePrimitive(a)) {
+        if (!isPrimitive(a.index)) {
+          walkMesh(beams_, scene_, a, config_, e.rect);
+        } else if (deferLargePrimitive(a)) {
           deferred_.add(a, e.rect);
         } else {
-          walkMesh(beams_, scene_, a, config_, e.rect);
+          castPrimitive(beams_, scene_, a, config_, e.rect);
         }
       } else if (e.ref.isLeaf()) {
         for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {

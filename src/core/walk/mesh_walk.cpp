@@ -5,9 +5,10 @@
 #include <optional>
 
 #include "beams/column_raster.h"
+#include "geometry/hit_order.h"
 #include "beams/edge_filter.h"
 #include "slice/slicer.h"
-#include "walk/primitive_cast.h"
+#include "util/walk_stack.h"
 #include "accel/wide_bvh.h"
 
 namespace laser_raycast {
@@ -97,15 +98,15 @@ class MeshWalk {
     const View view = boxView(bounds.center(), bounds.extent() * 0.5, rot_, abs_rot_, trans_,
                               beams_.pattern().angleMin(), !planar_);
     if (!(view.near <= config_.tmax)) return;
-    top_ = 0;
+    stack_.clear();
     const Entry root{wide_.root(), BeamRect{}, floatBelow(view.near), wide_.rootTriangles()};
     beams_.forEachRect(view, within, [&](const BeamRect& rect) {
       Entry e = root;
       e.rect = rect;
       push(e);
     });
-    while (top_ > 0) {
-      const Entry e = stack_[--top_];
+    while (!stack_.empty()) {
+      const Entry e = stack_.pop();
       if (!beams_.anyOpen(e.rect, e.near)) continue;  // hidden behind nearer hits
       if (tracing_only_) {
         traceRect(e);
@@ -124,8 +125,7 @@ class MeshWalk {
   };
 
   void push(const Entry& e) {
-    if (top_ == static_cast<int>(stack_.size())) stack_.resize(stack_.size() * 2);
-    stack_[top_++] = e;
+    stack_.push(e);
   }
 
   void visit(const Entry& e) {
@@ -203,12 +203,12 @@ class MeshWalk {
     std::uint32_t slot = 0;
     bool found() const { return triangle != std::numeric_limits<std::uint32_t>::max(); }
     bool improves(double t2, std::uint32_t triangle2) const {
-      return t2 < t || (t2 == t && triangle2 < triangle);
+      return hitBefore(t2, triangle2, t, triangle);
     }
   };
 
   void offer(int row, int col, const Best& best) {
-    beams_.offer(row, col, best.t, active_.index, static_cast<int>(best.triangle), [&] {
+    beams_.keepNearestHit(row, col, best.t, active_.index, static_cast<int>(best.triangle), [&] {
       return slicing_ ? slicer_->sensorNormal(best.slot) : sensorNormal(best.triangle);
     });
   }
@@ -305,13 +305,13 @@ class MeshWalk {
       const std::uint32_t triangle = ids_[slot];
       auto test = [&](int row, int col) {
         // The range rounded up to float (compact, so cheaper to read here than the result's): a
-        // hit it lets through beyond the exact range is turned down by offer().
+        // hit it lets through beyond the exact range is turned down by keepNearestHit().
         const double range = beams_.rangeAbove(row)[col];
         if (!(range >= e.near)) return;
         const auto hit = beams_.template sensorRay<M>(row, col).intersect(
             s.a, s.b, s.c, std::min(config_.tmax, range));
         if (!hit) return;
-        beams_.offer(row, col, hit->t, active_.index, static_cast<int>(triangle),
+        beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
                      [&] { return sensorNormal(triangle); });
       };
       if (beams_.columnRaster()) {
@@ -352,7 +352,7 @@ class MeshWalk {
       slicer_->sliceSlot(
           slot, rect.col_lo, rect.col_hi,
           [&](int col, double t) {
-            beams_.offer(0, col, t, active_.index, static_cast<int>(ids_[slot]),
+            beams_.keepNearestHit(0, col, t, active_.index, static_cast<int>(ids_[slot]),
                          [&] { return slicer_->sensorNormal(slot); });
           },
           [&](int col, double segment_near) {
@@ -377,22 +377,16 @@ class MeshWalk {
   const ViewBasis basis_;
   const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame
   std::optional<Slicer> slicer_;
-  std::vector<Entry> stack_ = std::vector<Entry>(256);
-  int top_ = 0;
+  WalkStack<Entry> stack_;
 };
 
 }  // namespace
 
 void walkMesh(BeamSet& beams, const Scene& scene, const PlacedBody& active,
               const CastConfig& config, const BeamRect& within) {
-  const Body& body = scene.bodies()[active.index];
-  const auto* mesh = std::get_if<std::shared_ptr<const Mesh>>(&body.shape);
-  if (!mesh) {
-    castPrimitive(beams, scene, active, config, within);
-    return;
-  }
+  const Mesh& mesh = *std::get<std::shared_ptr<const Mesh>>(scene.bodies()[active.index].shape);
   dispatchTriangleMethod(config.method, [&](auto method) {
-    MeshWalk<decltype(method)::value> walk(beams, **mesh, active, config);
+    MeshWalk<decltype(method)::value> walk(beams, mesh, active, config);
     walk.run(within);
   });
 }

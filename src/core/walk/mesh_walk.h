@@ -6,10 +6,11 @@
 // remain, or at a leaf, each open beam is traced through the node's subtree with the exact
 // triangle test.
 //
-// Under a planar fan a mesh's triangles can instead be sliced by the scan plane (slicer.h). Per
-// connected component of the mesh, and the same for every beam and every thread, the cheaper of the
-// two is chosen: a component's triangles share edges only with each other, so one component never
-// mixes the two tests, and both are watertight on their own.
+// Under a planar fan (with its fast path) every triangle is tested as its cut by the scan plane, a
+// 2D segment (slicer.h), whether a beam is traced to it or meets it at a leaf; otherwise by the
+// exact 3D test, or first rasterised against the leaf's beams (column_raster.h). One test per cast:
+// neighbouring triangles share bitwise-equal segment ends or moved vertices however they are
+// reached, so the walk's choices change the speed only (docs/design.md §5).
 #pragma once
 
 #include "beams/beam_set.h"
@@ -21,7 +22,7 @@ namespace laser_raycast {
 namespace core {
 
 // Casts the open beams of `within` (a rect of beams the body's bounding sphere can reach) against
-// the body active.index of scene.
+// the mesh body active.index of scene (a primitive body is cast by castPrimitive, primitive_cast.h).
 void walkMesh(BeamSet& beams, const Scene& scene, const PlacedBody& active,
               const CastConfig& config, const BeamRect& within);
 

@@ -104,7 +104,7 @@ void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
   // The beams are valid rays (a unit direction, a finite pose): no check needed.
   const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
   if (!hit) return;
-  beams.offer(row, col, hit->t, a.index, -1,
+  beams.keepNearestHit(row, col, hit->t, a.index, -1,
               [&] { return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal); });
 }
 

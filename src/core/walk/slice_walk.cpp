@@ -6,7 +6,9 @@
 #include <optional>
 #include <vector>
 
+#include "geometry/hit_order.h"
 #include "slice/slice_views.h"
+#include "util/walk_stack.h"
 #include "walk/primitive_cast.h"
 #include "walk/frame_walk.h"
 
@@ -15,7 +17,10 @@ namespace core {
 namespace {
 
 // A node whose window holds at most this many beams has them traced through its subtree one ray at
-// a time instead of its children's windows being computed. Only speed depends on it.
+// a time instead of its children's windows being computed. Only speed depends on it. It is not the
+// mesh walk's kTraceBeams (12, mesh_walk.cpp) on purpose: each was measured on the benchmark's
+// scenes for its own walk, and here a traced beam tests 2D segments and walks paired with another
+// (traceWidePair), so tracing stays cheaper than expanding for somewhat wider windows.
 constexpr long long kTraceBeams = 16;
 
 // The map from plane coordinates (z = 0) to the sensor frame, for the node views.
@@ -46,7 +51,6 @@ class SliceWalk {
     inverse_ << plane.d / det, -plane.b / det, -plane.c / det, plane.a / det;
     origin_.emplace(-(inverse_ * Eigen::Vector2d(plane.tx, plane.ty)), slice.tree.bounds(),
                     config.tmin);
-    stack_.reserve(256);  // room for most walks: it would grow four or five times a scan
   }
 
   void run(const BeamRect& within) {
@@ -57,7 +61,7 @@ class SliceWalk {
                               sensor_from_plane_.translation(), beams_.pattern().angleMin(), false);
     if (!(view.near <= config_.tmax)) return;
     beams_.forEachRect(view, within, [&](const BeamRect& rect) {
-      stack_.push_back(Entry{slice_.wide.root(), rect, floatBelow(view.near)});
+      stack_.push(Entry{slice_.wide.root(), rect, floatBelow(view.near)});
     });
     walk();
     deferred_.cast(beams_, scene_, config_);
@@ -72,8 +76,7 @@ class SliceWalk {
 
   void walk() {
     while (!stack_.empty()) {
-      Entry e = stack_.back();
-      stack_.pop_back();
+      Entry e = stack_.pop();
       // The nearest child of an expanded node goes on at once, without a round trip through the
       // stack.
       while (beams_.anyOpen(e.rect, e.near)) {  // else hidden behind nearer hits
@@ -132,7 +135,7 @@ class SliceWalk {
     auto childEntry = [&](int j) {
       return Entry{node.child(child[j]), BeamRect{0, 0, lo[j], hi[j]}, near[j]};
     };
-    for (int i = 0; i + 1 < n; ++i) stack_.push_back(childEntry(order[i]));
+    for (int i = 0; i + 1 < n; ++i) stack_.push(childEntry(order[i]));
     *entry = childEntry(order[n - 1]);
     return true;
   }
@@ -159,7 +162,7 @@ class SliceWalk {
   void offerSegmentHit(int col, double t, const KeptSlice::Item& s) {
     const Mesh& mesh = meshOf(s.body);
     const std::uint32_t triangle = mesh.bvh().triangleIds()[s.slot];
-    beams_.offer(0, col, t, s.body, static_cast<int>(triangle), [&] {
+    beams_.keepNearestHit(0, col, t, s.body, static_cast<int>(triangle), [&] {
       return Eigen::Vector3d(sensorFromBody(s.body).linear() * mesh.normal(triangle));
     });
   }
@@ -265,16 +268,16 @@ class SliceWalk {
     if (b.best) offerSegmentHit(b.col, b.best_t, *b.best);
   }
 
-  // The tie rule of BeamSet::offer: the lower body, then the lower triangle.
+  // Which of two items hit at the same distance goes first (hit_order.h): the lower body, then the
+  // lower triangle.
   bool before(const KeptSlice::Item& a, const KeptSlice::Item& b) const {
     if (a.body != b.body) return a.body < b.body;
     const auto& ids = meshOf(a.body).bvh().triangleIds();
-    return ids[a.slot] < ids[b.slot];
+    return tieBefore(a.body, ids[a.slot], b.body, ids[b.slot]);
   }
 
   Eigen::Vector2d frontOf(const KeptSlice::Item& s) const {
-    const auto& v = meshOf(s.body).bvh().triangleVertices()[s.slot];
-    return (sensorFromBody(s.body).linear() * (v[1] - v[0]).cross(v[2] - v[0])).head<2>();
+    return planarFront(sensorFromBody(s.body).linear(), meshOf(s.body).bvh().triangleVertices()[s.slot]);
   }
 
   BeamSet& beams_;
@@ -288,7 +291,7 @@ class SliceWalk {
   const SliceViewBasis views_;
   Eigen::Matrix2d inverse_;
   std::optional<PlaneRay::Origin> origin_;
-  std::vector<Entry> stack_;
+  WalkStack<Entry> stack_;
   DeferredPrimitives deferred_;  // cast after the walk
 };
 
