@@ -12,6 +12,7 @@
 
 #include "laser_raycast/core/mesh.h"
 #include "accel/wide_bvh.h"
+#include "wide_bvh_groups.h"
 #include "wide_ray.h"
 #include "mesh_builder.h"
 #include "random.h"
@@ -99,7 +100,7 @@ TEST(WideBvh, ComponentsFillWholeSubtrees) {
   int tagged = 0;
   for (std::uint32_t n = 0; n < w.nodes().size(); ++n) {
     for (int k = 0; k < WideBvh::kWidth; ++k) {
-      const std::int32_t group = w.childGroup(n, k);
+      const std::int32_t group = childGroup(mesh, n, k);
       if (group < 0 || w.nodes()[n].index[k] == WideBvh::kEmpty) continue;
       ++tagged;
       // Every slot below carries that group.
@@ -124,7 +125,7 @@ TEST(WideBvh, ComponentsFillWholeSubtrees) {
     }
   }
   EXPECT_GT(tagged, 40);
-  for (std::int32_t g = 0; g < 40; ++g) EXPECT_FALSE(w.groupInMixedLeaf(g));
+  for (std::int32_t g = 0; g < 40; ++g) EXPECT_FALSE(groupInMixedLeaf(mesh, g));
 }
 
 template <TriangleMethod M>

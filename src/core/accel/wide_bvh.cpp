@@ -23,10 +23,9 @@ struct Gathered {
 // Collapses the binary BVH depth-first into wide nodes, filling the WideBvh's arrays.
 class WideBvh::Builder {
  public:
-  // The group and triangle count of a binary subtree, and its collapsed wide reference.
+  // The triangle count of a binary subtree, and its collapsed wide reference.
   struct Summary {
     Ref ref;
-    std::int32_t group;
     std::uint32_t triangles;
   };
 
@@ -38,14 +37,13 @@ class WideBvh::Builder {
   // The binary tree's depth is bounded (BvhConfig::max_depth), so the recursion is too.
   Summary collapse(const Bvh::Child& child) {
     if (const auto leaf = asLeaf(child)) {
-      return Summary{Ref{leaf->index, leaf->count}, leafGroup(*leaf), leaf->count};
+      return Summary{Ref{leaf->index, leaf->count}, leaf->count};
     }
     const std::vector<Gathered> gathered = gather(child);
     const auto index = static_cast<std::uint32_t>(out_.nodes_.size());
     out_.nodes_.emplace_back();
-    out_.child_group_.resize(out_.nodes_.size() * kWidth, -1);
     out_.child_triangles_.resize(out_.nodes_.size() * kWidth, 0);
-    Summary summary{Ref{index, 0}, -2, 0};  // -2: no child seen yet
+    Summary summary{Ref{index, 0}, 0};
     for (int k = 0; k < kWidth; ++k) {
       if (k >= static_cast<int>(gathered.size())) {
         setEmpty(&out_.nodes_[index], k);
@@ -59,9 +57,7 @@ class WideBvh::Builder {
       }
       node.index[k] = sub.ref.index;
       node.count[k] = sub.ref.count;
-      out_.child_group_[index * kWidth + k] = sub.group;
       out_.child_triangles_[index * kWidth + k] = sub.triangles;
-      summary.group = summary.group == -2 || summary.group == sub.group ? sub.group : -1;
       summary.triangles += sub.triangles;
     }
     return summary;
@@ -102,23 +98,6 @@ class WideBvh::Builder {
     const Span& sub = span_[c.index];
     if (sub.count <= kMaxLeafTriangles && sub.one_group) return Bvh::Child{sub.first, sub.count};
     return std::nullopt;
-  }
-
-  // The leaf's group, or -1 if it holds several (which are then marked as in a mixed leaf).
-  std::int32_t leafGroup(const Bvh::Child& leaf) {
-    if (slot_group_.empty()) return -1;
-    const std::uint32_t g = slot_group_[leaf.index];
-    bool mixed = false;
-    for (std::uint32_t s = leaf.index + 1; s < leaf.index + leaf.count; ++s) {
-      mixed |= slot_group_[s] != g;
-    }
-    if (!mixed) return static_cast<std::int32_t>(g);
-    auto& marked = out_.group_in_mixed_leaf_;
-    for (std::uint32_t s = leaf.index; s < leaf.index + leaf.count; ++s) {
-      if (slot_group_[s] >= marked.size()) marked.resize(slot_group_[s] + 1, 0);
-      marked[slot_group_[s]] = 1;
-    }
-    return -1;
   }
 
   // The inner node's children, opening the largest inner one until there are kWidth or only
@@ -172,7 +151,6 @@ WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) :
   Builder builder(this, bvh, slot_group);
   const Builder::Summary root = builder.collapse(bvh.root());
   root_ = root.ref;
-  root_group_ = root.group;
   root_triangles_ = root.triangles;
 }
 

@@ -83,22 +83,11 @@ class WideBvh {
   const std::vector<Node>& nodes() const { return nodes_; }
   Ref root() const { return root_; }
   bool empty() const { return root_.isEmpty(); }
-  // The group all triangles below a node's child k belong to, or -1 if they are mixed; the root's.
-  std::int32_t childGroup(std::uint32_t node, int k) const {
-    return child_group_[node * kWidth + k];
-  }
-  std::int32_t rootGroup() const { return root_group_; }
   // Triangles below a node's child k, and below the root.
   std::uint32_t childTriangles(std::uint32_t node, int k) const {
     return child_triangles_[node * kWidth + k];
   }
   std::uint32_t rootTriangles() const { return root_triangles_; }
-  // True if some of the group's triangles share a leaf with another group's (only where the binary
-  // BVH's depth limit stopped it from separating groups).
-  bool groupInMixedLeaf(std::int32_t group) const {
-    return group >= 0 && static_cast<std::size_t>(group) < group_in_mixed_leaf_.size() &&
-           group_in_mixed_leaf_[group];
-  }
 
  private:
   class Builder;  // the collapse of the binary BVH (wide_bvh.cpp)
@@ -106,10 +95,7 @@ class WideBvh {
   const Bvh* bvh_ = nullptr;
   std::vector<Node> nodes_;
   Ref root_{kEmpty, 0};
-  std::vector<std::int32_t> child_group_;
   std::vector<std::uint32_t> child_triangles_;
-  std::vector<char> group_in_mixed_leaf_;
-  std::int32_t root_group_ = -1;
   std::uint32_t root_triangles_ = 0;
 };
 
