@@ -81,9 +81,9 @@ struct FreshBeams {
 TEST(BeamSet, RebuiltDirectionsAreThePatternsBitForBit) {
   for (const core::ScanPattern& pattern : patterns()) {
     FreshBeams fresh(pattern, core::CastConfig{});
-    for (int row = 0; row < fresh.beams.rows(); ++row) {
-      for (int col = 0; col < fresh.beams.cols(); ++col) {
-        ASSERT_EQ(fresh.beams.rebuiltDirection(row, col), fresh.beams.direction(row, col))
+    for (int row = 0; row < fresh.beams.grid().rows(); ++row) {
+      for (int col = 0; col < fresh.beams.grid().cols(); ++col) {
+        ASSERT_EQ(fresh.beams.grid().rebuiltDirection(row, col), fresh.beams.grid().direction(row, col))
             << "row " << row << " col " << col;
       }
     }
@@ -111,23 +111,23 @@ TEST(NodeViews, EveryBeamThatEntersAChildBoxIsInItsWindow) {
           const Eigen::Vector3d hi(node.hi[0][k], node.hi[1][k], node.hi[2][k]);
           std::set<int> reached, reached_columns, entering_columns;
           if (views.mask & (1 << k)) {
-            beams.forEachChildRect(views, k, beams.all(), [&](const core::BeamRect& r) {
+            beams.grid().forEachChildRect(views, k, beams.grid().all(), [&](const core::BeamRect& r) {
               for (int row = r.row_lo; row <= r.row_hi; ++row) {
                 for (int col = r.col_lo; col <= r.col_hi; ++col) {
-                  reached.insert(beams.beam(row, col));
+                  reached.insert(beams.grid().beam(row, col));
                   reached_columns.insert(col);
                 }
               }
             });
           }
-          for (int row = 0; row < beams.rows(); ++row) {
-            for (int col = 0; col < beams.cols(); ++col) {
-              const auto t = entry(lo, hi, pose, beams.direction(row, col), 30.0);
+          for (int row = 0; row < beams.grid().rows(); ++row) {
+            for (int col = 0; col < beams.grid().cols(); ++col) {
+              const auto t = entry(lo, hi, pose, beams.grid().direction(row, col), 30.0);
               ++checked;
               if (!t) continue;
               ++inside;
               entering_columns.insert(col);
-              EXPECT_TRUE(reached.count(beams.beam(row, col)))
+              EXPECT_TRUE(reached.count(beams.grid().beam(row, col)))
                   << "row " << row << " col " << col << " enters child " << k << " at "
                   << double(*t);
               EXPECT_LE(views.near[k], double(*t) * (1 + 1e-12));
@@ -168,19 +168,19 @@ TEST(BoxView, EveryBeamThatEntersTheBoxIsInItsWindow) {
                                             pattern.angleMin(), !pattern.planar());
       std::set<int> reached;
       if (!pattern.planar() || view.crosses) {
-        beams.forEachRect(view, beams.all(), [&](const core::BeamRect& rect) {
+        beams.grid().forEachRect(view, beams.grid().all(), [&](const core::BeamRect& rect) {
           for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
             for (int col = rect.col_lo; col <= rect.col_hi; ++col)
-              reached.insert(beams.beam(row, col));
+              reached.insert(beams.grid().beam(row, col));
           }
         });
       }
-      for (int row = 0; row < beams.rows(); ++row) {
-        for (int col = 0; col < beams.cols(); ++col) {
-          const auto t = entry(center - half, center + half, pose, beams.direction(row, col), kInf);
+      for (int row = 0; row < beams.grid().rows(); ++row) {
+        for (int col = 0; col < beams.grid().cols(); ++col) {
+          const auto t = entry(center - half, center + half, pose, beams.grid().direction(row, col), kInf);
           if (!t) continue;
           ++inside;
-          EXPECT_TRUE(reached.count(beams.beam(row, col))) << "box " << i;
+          EXPECT_TRUE(reached.count(beams.grid().beam(row, col))) << "box " << i;
           EXPECT_LE(view.near, double(*t) * (1 + 1e-12));
         }
       }
@@ -207,8 +207,8 @@ FilterCase randomTriangle(Rng& rng) {
 
 // Casts nothing: sets the beams' ranges through keepNearestHit(), as the walks do.
 void setRandomRanges(Rng& rng, core::BeamSet* beams) {
-  for (int row = 0; row < beams->rows(); ++row) {
-    for (int col = 0; col < beams->cols(); ++col) {
+  for (int row = 0; row < beams->grid().rows(); ++row) {
+    for (int col = 0; col < beams->grid().cols(); ++col) {
       if (rng() % 3 == 0) continue;
       beams->keepNearestHit(row, col, uniform(rng, 0.05, 40), 0, 0, [] { return Eigen::Vector3d(); });
     }
@@ -228,19 +228,19 @@ void expectEveryKeptHitACandidate(Rng& rng, const core::ScanPattern& pattern, Ca
   for (int i = 0; i < 3000; ++i) {
     const FilterCase t = randomTriangle(rng);
     std::vector<char> candidate(pattern.size(), 0);
-    run(beams, t, [&](int row, int col) { candidate[beams.beam(row, col)] = 1; });
-    for (int row = 0; row < beams.rows(); ++row) {
-      for (int col = 0; col < beams.cols(); ++col) {
+    run(beams, t, [&](int row, int col) { candidate[beams.grid().beam(row, col)] = 1; });
+    for (int row = 0; row < beams.grid().rows(); ++row) {
+      for (int col = 0; col < beams.grid().cols(); ++col) {
         ++tested;
-        passed += candidate[beams.beam(row, col)];
+        passed += candidate[beams.grid().beam(row, col)];
         core::Ray ray;
-        ray.dir = beams.direction(row, col);
+        ray.dir = beams.grid().direction(row, col);
         ray.tmax = std::min(config.tmax, beams.range(row, col));
         if (!core::intersectTriangle<core::TriangleMethod::kWatertight>(ray, t.a, t.b, t.c)) {
           continue;
         }
         ++*hits;
-        EXPECT_TRUE(candidate[beams.beam(row, col)])
+        EXPECT_TRUE(candidate[beams.grid().beam(row, col)])
             << "triangle " << i << " row " << row << " col " << col;
       }
     }
@@ -258,8 +258,8 @@ TEST(EdgeFilter, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
       rng, pattern,
       [](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
         const core::EdgeFilter filter(t.a, t.b, t.c);
-        for (int row = 0; row < beams.rows(); ++row) {
-          filter.forEachCandidate(beams, row, 0, beams.cols() - 1,
+        for (int row = 0; row < beams.grid().rows(); ++row) {
+          filter.forEachCandidate(beams, row, 0, beams.grid().cols() - 1,
                                   [&](int col) { mark(row, col); });
         }
       },
@@ -273,7 +273,7 @@ TEST(ColumnRaster, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
   std::vector<double> lidar, steep;
   for (int r = 0; r < 32; ++r) lidar.push_back(-0.27 + 0.54 * r / 31);
   for (int r = 0; r < 9; ++r) {
-    steep.push_back(-core::BeamSet::kMaxColumnRasterElevation * (1 - r / 4.0));
+    steep.push_back(-core::BeamGrid::kMaxColumnRasterElevation * (1 - r / 4.0));
   }
   for (const auto& rings : {lidar, steep}) {
     const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 512), rings);
@@ -281,9 +281,9 @@ TEST(ColumnRaster, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
     expectEveryKeptHitACandidate(
         rng, pattern,
         [](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
-          ASSERT_TRUE(beams.columnRaster());
+          ASSERT_TRUE(beams.grid().columnRaster());
           core::ColumnRaster(beams, t.a, t.b, t.c)
-              .forEachCandidate(beams, beams.all(), [&](int row, int col) { mark(row, col); });
+              .forEachCandidate(beams, beams.grid().all(), [&](int row, int col) { mark(row, col); });
         },
         &hits);
     EXPECT_GT(hits, 1000);
@@ -310,19 +310,19 @@ TEST(ColumnRaster, ARectGetsTheWholeGridsCandidatesInsideIt) {
     const core::ColumnRaster raster(beams, t.a, t.b, t.c);
     std::set<int> whole, part;
     core::BeamRect rect;
-    rect.row_lo = static_cast<int>(uniform(rng, 0, beams.rows()));
-    rect.row_hi = std::min(beams.rows() - 1, rect.row_lo + static_cast<int>(uniform(rng, 0, 12)));
-    rect.col_lo = static_cast<int>(uniform(rng, 0, beams.cols()));
-    rect.col_hi = std::min(beams.cols() - 1, rect.col_lo + static_cast<int>(uniform(rng, 0, 40)));
-    raster.forEachCandidate(beams, beams.all(), [&](int row, int col) {
+    rect.row_lo = static_cast<int>(uniform(rng, 0, beams.grid().rows()));
+    rect.row_hi = std::min(beams.grid().rows() - 1, rect.row_lo + static_cast<int>(uniform(rng, 0, 12)));
+    rect.col_lo = static_cast<int>(uniform(rng, 0, beams.grid().cols()));
+    rect.col_hi = std::min(beams.grid().cols() - 1, rect.col_lo + static_cast<int>(uniform(rng, 0, 40)));
+    raster.forEachCandidate(beams, beams.grid().all(), [&](int row, int col) {
       if (row >= rect.row_lo && row <= rect.row_hi && col >= rect.col_lo && col <= rect.col_hi) {
-        whole.insert(beams.beam(row, col));
+        whole.insert(beams.grid().beam(row, col));
       }
     });
     raster.forEachCandidate(beams, rect, [&](int row, int col) {
       EXPECT_TRUE(row >= rect.row_lo && row <= rect.row_hi && col >= rect.col_lo &&
                   col <= rect.col_hi);
-      part.insert(beams.beam(row, col));
+      part.insert(beams.grid().beam(row, col));
     });
     ASSERT_EQ(whole, part) << "triangle " << i;
     inside += static_cast<long long>(part.size());
@@ -381,16 +381,16 @@ TEST(BeamSet, AWindowWithAnOpenBeamIsNeverClosed) {
   core::BeamSet& beams = fresh.beams;
   long long closed = 0;
   for (int step = 0; step < 20000; ++step) {
-    const int row = static_cast<int>(uniform(rng, 0, beams.rows())),
-              col = static_cast<int>(uniform(rng, 0, beams.cols()));
+    const int row = static_cast<int>(uniform(rng, 0, beams.grid().rows())),
+              col = static_cast<int>(uniform(rng, 0, beams.grid().cols()));
     beams.keepNearestHit(row, col, std::min(beams.range(row, col), uniform(rng, 0, 10)), 0, 0,
                 [] { return Eigen::Vector3d(); });
     core::BeamRect rect;
-    rect.row_lo = static_cast<int>(uniform(rng, 0, beams.rows()));
-    rect.row_hi = std::min(beams.rows() - 1, rect.row_lo + static_cast<int>(uniform(rng, 0, 3)));
-    rect.col_lo = static_cast<int>(uniform(rng, 0, beams.cols()));
+    rect.row_lo = static_cast<int>(uniform(rng, 0, beams.grid().rows()));
+    rect.row_hi = std::min(beams.grid().rows() - 1, rect.row_lo + static_cast<int>(uniform(rng, 0, 3)));
+    rect.col_lo = static_cast<int>(uniform(rng, 0, beams.grid().cols()));
     rect.col_hi =
-        std::min(beams.cols() - 1, rect.col_lo + static_cast<int>(logUniform(rng, 0, 2.5)));
+        std::min(beams.grid().cols() - 1, rect.col_lo + static_cast<int>(logUniform(rng, 0, 2.5)));
     const double near = uniform(rng, 0, 10);
     bool open = false;
     for (int r = rect.row_lo; r <= rect.row_hi; ++r) {

@@ -101,7 +101,7 @@ TEST(SliceViews, EveryBeamThatEntersAChildBoxIsAmongItsColumns) {
             } else if (!(views.az_half[k] >= 0)) {
               mark(0, fan.size() - 1);
             } else {
-              beams.forEachColumnRange(views.az_center[k], views.az_half[k], mark);
+              beams.grid().forEachColumnRange(views.az_center[k], views.az_half[k], mark);
             }
           }
           long long entering = 0;

@@ -35,7 +35,7 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
     upper_[k] = z < 0 ? ones : none;
     flat_[k] = z == 0 ? ones : none;
   }
-  edge_margin_ = _mm_set1_ps(kMargin / beams.smallestRowCos());
+  edge_margin_ = _mm_set1_ps(kMargin / beams.grid().smallestRowCos());
   // The plane's normal (b - a) x (c - a) is the sum of the edge normals, and its dot product with
   // a is det.
   const Eigen::Vector3d plane = m[0] + m[1] + m[2];

@@ -34,7 +34,7 @@ inline constexpr double kEdgeOnRatio = 1e-6;
 
 class ColumnRaster {
  public:
-  // a, b, c in the sensor frame. The pattern's rows must allow it (BeamSet::columnRaster()).
+  // a, b, c in the sensor frame. The pattern's rows must allow it (BeamGrid::columnRaster()).
   ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                const Eigen::Vector3d& c);
 
@@ -46,7 +46,7 @@ class ColumnRaster {
  private:
   // The margin of every float test, relative to the scaled normals: the rounding of a dot
   // product of float normals and float directions is a few 1e-7, tan E's up to tan 80 degrees
-  // (BeamSet::kMaxColumnRasterElevation) a few times that.
+  // (BeamGrid::kMaxColumnRasterElevation) a few times that.
   static constexpr float kMargin = 1e-5f;
   // Rects of fewer rows than this are scanned row by row, four columns at a time; taller ones
   // column by column, each column's rows looked up from its bounds. Only speed depends on it.
@@ -83,11 +83,11 @@ void ColumnRaster::forEachCandidate(const BeamSet& beams, const BeamRect& rect, 
     }
     return;
   }
-  const float* cos_a = beams.columnCos();
-  const float* sin_a = beams.columnSin();
+  const float* cos_a = beams.grid().columnCos();
+  const float* sin_a = beams.grid().columnSin();
   const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
-  const __m128 rows_tan_lo = _mm_set1_ps(beams.rowTanBelow(rect.row_lo));
-  const __m128 rows_tan_hi = _mm_set1_ps(beams.rowTanAbove(rect.row_hi));
+  const __m128 rows_tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(rect.row_lo));
+  const __m128 rows_tan_hi = _mm_set1_ps(beams.grid().rowTanAbove(rect.row_hi));
   const bool by_rows = rect.row_hi - rect.row_lo < kRowMajorRows;
   // The columns' bounds, a chunk of groups of four at a time: only the groups with a column
   // whose bounds meet the rect's rows.
@@ -141,10 +141,10 @@ void ColumnRaster::scanRows(const BeamSet& beams, const BeamRect& rect, const Gr
   const __m128 margin = _mm_set1_ps(kMargin), distance = _mm_set1_ps(plane_distance_);
   const __m128 nz = _mm_set1_ps(nz_);
   for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-    const __m128 tan_lo = _mm_set1_ps(beams.rowTanBelow(row));
-    const __m128 tan_hi = _mm_set1_ps(beams.rowTanAbove(row));
-    const __m128 cos_e = _mm_set1_ps(beams.rowCos(row));
-    const __m128 z = _mm_mul_ps(nz, _mm_set1_ps(beams.rowSin(row)));
+    const __m128 tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(row));
+    const __m128 tan_hi = _mm_set1_ps(beams.grid().rowTanAbove(row));
+    const __m128 cos_e = _mm_set1_ps(beams.grid().rowCos(row));
+    const __m128 z = _mm_mul_ps(nz, _mm_set1_ps(beams.grid().rowSin(row)));
     const float* range = beams.rangeAbove(row);
     for (int i = 0; i < n; ++i) {
       const Group& g = groups[i];
@@ -175,13 +175,13 @@ void ColumnRaster::scanColumns(const BeamSet& beams, const BeamRect& rect, const
       const int j = __builtin_ctz(static_cast<unsigned>(mask));
       const int col = g.base + j;
       int row_lo, row_hi;
-      beams.rowsWithTan(lo_v[j], hi_v[j], &row_lo, &row_hi);
+      beams.grid().rowsWithTan(lo_v[j], hi_v[j], &row_lo, &row_hi);
       row_lo = std::max(row_lo, rect.row_lo);
       row_hi = std::min(row_hi, rect.row_hi);
       for (int row = row_lo; row <= row_hi; ++row) {
         // Written so that a NaN range (a beam that could not be cast) is never held back.
         const float along =
-            std::abs(beams.rowCos(row) * hn_v[j] + nz_ * beams.rowSin(row)) + kMargin;
+            std::abs(beams.grid().rowCos(row) * hn_v[j] + nz_ * beams.grid().rowSin(row)) + kMargin;
         if (plane_distance_ > beams.rangeAbove(row)[col] * along) continue;
         f(row, col);
       }

@@ -51,10 +51,10 @@ class EdgeFilter {
       for (int col = first; col <= last; ++col) f(col);
       return;
     }
-    const float* x = beams.directionX(row);
-    const float* y = beams.directionY(row);
+    const float* x = beams.grid().directionX(row);
+    const float* y = beams.grid().directionY(row);
     const float* range = beams.rangeAbove(row);
-    const __m128 z = _mm_set1_ps(beams.directionZ(row));
+    const __m128 z = _mm_set1_ps(beams.grid().directionZ(row));
     const __m128 sign_bit = _mm_set1_ps(-0.0f);
     for (int base = first & ~3; base <= last; base += 4) {
       const __m128 dx = _mm_loadu_ps(x + base), dy = _mm_loadu_ps(y + base);

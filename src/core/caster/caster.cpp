@@ -280,11 +280,11 @@ void Caster::State::castBodies(const Scene& scene, const ScanPattern& pattern,
   // Waking threads costs more than a small scan does: each gets at least kMinBeamsPerThread.
   threads = std::max(1, std::min(threads, pattern.size() / kMinBeamsPerThread));
   if (threads == 1) {
-    castWithin(beams.all());
+    castWithin(beams.grid().all());
   } else {
     if (!pool || pool->threads() != threads) pool = std::make_unique<ThreadPool>(threads);
     const std::vector<BeamRect> pieces =
-        cutPieces(beams.all().row_hi + 1, pattern.azimuthCount(), threads);
+        cutPieces(beams.grid().all().row_hi + 1, pattern.azimuthCount(), threads);
     pool->run(static_cast<int>(pieces.size()), [&](int i) { castWithin(pieces[i]); });
   }
   int cast_count = 0;

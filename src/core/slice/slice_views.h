@@ -42,7 +42,7 @@ struct SliceViews {
   alignas(16) int col_lo[4];  // the child's columns, where known (may be empty: lo > hi)
   alignas(16) int col_hi[4];
   // Otherwise (a window that wraps around the fan's ends): its bearing window (rad), for
-  // BeamSet::forEachColumnRange; az_half < 0: every column.
+  // BeamGrid::forEachColumnRange; az_half < 0: every column.
   alignas(16) float az_center[4];
   alignas(16) float az_half[4];
 

@@ -24,7 +24,7 @@ class FrameWalk {
         sensor_from_frame_(sensor_from_frame),
         config_(config),
         cast_(cast),
-        planar_(beams.pattern().planar()),
+        planar_(beams.grid().pattern().planar()),
         basis_(sensor_from_frame, planar_, config.tmax) {
     if (planar_) plane_.emplace(sensor_from_frame);
   }
@@ -35,9 +35,9 @@ class FrameWalk {
     const Eigen::Matrix3d& rot = sensor_from_frame_.linear();
     const View view =
         boxView(bounds.center(), bounds.extent() * 0.5, rot, rot.cwiseAbs(),
-                sensor_from_frame_.translation(), beams_.pattern().angleMin(), !planar_);
+                sensor_from_frame_.translation(), beams_.grid().pattern().angleMin(), !planar_);
     if (!(view.near <= config_.tmax) || (planar_ && !view.crosses)) return;
-    beams_.forEachRect(view, within, [&](const BeamRect& rect) {
+    beams_.grid().forEachRect(view, within, [&](const BeamRect& rect) {
       push(Entry{group_.wide.root(), rect, floatBelow(view.near), -1});
     });
     while (!heap_.empty()) {
@@ -88,7 +88,7 @@ class FrameWalk {
     int n = 0;
     for (int k = 0; k < WideBvh::kWidth; ++k) {
       if (!(views.mask & (1 << k))) continue;
-      beams_.forEachChildRect(views, k, e.rect, [&](const BeamRect& rect) {
+      beams_.grid().forEachChildRect(views, k, e.rect, [&](const BeamRect& rect) {
         if (n < 12) children[n++] = Entry{node.child(k), rect, views.near[k], -1};
       });
     }
@@ -104,7 +104,7 @@ class FrameWalk {
     const double dist = a.center.norm();
     const double slack = kWindowSlack * (dist + a.radius + config_.tmax);
     if (dist - a.radius > config_.tmax + slack || dist + a.radius < config_.tmin - slack) return;
-    viewPlacedBody(scene_, beams_.pattern().angleMin(), !planar_, &a);
+    viewPlacedBody(scene_, beams_.grid().pattern().angleMin(), !planar_, &a);
     if (!(a.view.near <= config_.tmax) || (planar_ && !a.view.crosses)) return;
     if (plane_) {
       a.plane = &*plane_;
@@ -112,7 +112,7 @@ class FrameWalk {
     }
     const int slot = static_cast<int>(bodies_.size());
     bodies_.push_back(a);
-    beams_.forEachRect(a.view, rect, [&](const BeamRect& r) {
+    beams_.grid().forEachRect(a.view, rect, [&](const BeamRect& r) {
       push(Entry{WideBvh::Ref{WideBvh::kEmpty, 0}, r, floatBelow(a.view.near), slot});
     });
   }

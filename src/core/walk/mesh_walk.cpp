@@ -73,7 +73,7 @@ class MeshWalk {
         rot_(active.sensor_from_body.linear()),
         abs_rot_(rot_.cwiseAbs()),
         trans_(active.sensor_from_body.translation()),
-        planar_(beams.pattern().planar()),
+        planar_(beams.grid().pattern().planar()),
         slicing_(planar_ && config.planar_fast_path),
         // Without the fast paths every beam is traced from the root, as the reference.
         tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
@@ -84,9 +84,9 @@ class MeshWalk {
       // Cut in the frame's plane coordinates when the walk gives them (as a kept slice is).
       if (active.plane) {
         slicer_.emplace(mesh, *active.plane, active.frame_from_body, active.sensor_from_body,
-                        beams.pattern(), config.tmin, config.tmax, config.cull_backfaces);
+                        beams.grid().pattern(), config.tmin, config.tmax, config.cull_backfaces);
       } else {
-        slicer_.emplace(mesh, active.sensor_from_body, beams.pattern(), config.tmin, config.tmax,
+        slicer_.emplace(mesh, active.sensor_from_body, beams.grid().pattern(), config.tmin, config.tmax,
                         config.cull_backfaces);
       }
     }
@@ -96,11 +96,11 @@ class MeshWalk {
     if (wide_.empty()) return;
     const Aabb& bounds = wide_.binary().bounds();
     const View view = boxView(bounds.center(), bounds.extent() * 0.5, rot_, abs_rot_, trans_,
-                              beams_.pattern().angleMin(), !planar_);
+                              beams_.grid().pattern().angleMin(), !planar_);
     if (!(view.near <= config_.tmax)) return;
     stack_.clear();
     const Entry root{wide_.root(), BeamRect{}, floatBelow(view.near), wide_.rootTriangles()};
-    beams_.forEachRect(view, within, [&](const BeamRect& rect) {
+    beams_.grid().forEachRect(view, within, [&](const BeamRect& rect) {
       Entry e = root;
       e.rect = rect;
       push(e);
@@ -158,7 +158,7 @@ class MeshWalk {
     int n = 0;
     for (int k = 0; k < WideBvh::kWidth; ++k) {
       if (!(views.mask & (1 << k))) continue;
-      beams_.forEachChildRect(views, k, e.rect, [&](const BeamRect& rect) {
+      beams_.grid().forEachChildRect(views, k, e.rect, [&](const BeamRect& rect) {
         if (n < 12) {
           children[n++] =
               Entry{node.child(k), rect, views.near[k], wide_.childTriangles(e.ref.index, k)};
@@ -172,7 +172,7 @@ class MeshWalk {
   // The beam as a ray in the body's frame, for box tests: the same one for every box test of this
   // walk.
   WideBoxRay boxRay(int row, int col) const {
-    return WideBoxRay(origin_, active_.body_from_sensor_rot * beams_.rebuiltDirection(row, col));
+    return WideBoxRay(origin_, active_.body_from_sensor_rot * beams_.grid().rebuiltDirection(row, col));
   }
 
   // A triangle slot moved into the sensor frame. Every 3D test of this body's triangles is the
@@ -226,7 +226,7 @@ class MeshWalk {
             if (!hidden(slot)) sliceOne(slot, col, &tmax, &best);
           });
         } else {
-          const auto ray = beams_.template sensorRay<M>(row, col);
+          const auto ray = beams_.grid().template sensorRay<M>(row, col);
           traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
             if (hidden(slot)) return;
             const SensorTriangle& s = cachedTriangle(slot);
@@ -276,7 +276,7 @@ class MeshWalk {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
         if (!(range >= e.near)) continue;
-        const auto ray = beams_.template sensorRay<M>(row, col);
+        const auto ray = beams_.grid().template sensorRay<M>(row, col);
         double tmax = std::min(config_.tmax, range);
         Best best;
         for (std::uint32_t i = 0; i < e.ref.count; ++i) {
@@ -308,13 +308,13 @@ class MeshWalk {
         // hit it lets through beyond the exact range is turned down by keepNearestHit().
         const double range = beams_.rangeAbove(row)[col];
         if (!(range >= e.near)) return;
-        const auto hit = beams_.template sensorRay<M>(row, col).intersect(
+        const auto hit = beams_.grid().template sensorRay<M>(row, col).intersect(
             s.a, s.b, s.c, std::min(config_.tmax, range));
         if (!hit) return;
         beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
                      [&] { return sensorNormal(triangle); });
       };
-      if (beams_.columnRaster()) {
+      if (beams_.grid().columnRaster()) {
         ColumnRaster(beams_, s.a, s.b, s.c).forEachCandidate(beams_, e.rect, test);
         continue;
       }

@@ -98,7 +98,7 @@ void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
               const CastConfig& config, int row, int col, double current) {
   Ray ray;
   ray.origin = a.sensor_in_body;
-  ray.dir = a.body_from_sensor_rot * beams.direction(row, col);
+  ray.dir = a.body_from_sensor_rot * beams.grid().direction(row, col);
   ray.tmin = config.tmin;
   ray.tmax = std::min(config.tmax, current);
   // The beams are valid rays (a unit direction, a finite pose): no check needed.
@@ -114,10 +114,10 @@ void castShape(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
                const BoxPrefilter& filter, const CastConfig& config, const BeamRect& rect) {
   const __m128 near = _mm_set1_ps(floatBelow(a.view.near));
   for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-    const float* x = beams.directionX(row);
-    const float* y = beams.directionY(row);
+    const float* x = beams.grid().directionX(row);
+    const float* y = beams.grid().directionY(row);
     const float* range = beams.rangeAbove(row);
-    const __m128 z = _mm_set1_ps(beams.directionZ(row));
+    const __m128 z = _mm_set1_ps(beams.grid().directionZ(row));
     for (int base = rect.col_lo & ~3; base <= rect.col_hi; base += 4) {
       const __m128 r = _mm_loadu_ps(range + base);
       // Beams whose range (rounded up) is below the primitive's nearest distance are closed to it:

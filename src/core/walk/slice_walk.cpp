@@ -44,7 +44,7 @@ class SliceWalk {
         config_(config),
         cast_(cast),
         sensor_from_plane_(sensorFromPlane(plane)),
-        views_(plane, config.tmax, beams.pattern()) {
+        views_(plane, config.tmax, beams.grid().pattern()) {
     // The sensor and the beams in plane coordinates, for the traced rays' box tests: the inverse
     // of the map to the sensor frame.
     const double det = plane.a * plane.d - plane.b * plane.c;
@@ -58,9 +58,9 @@ class SliceWalk {
     const Aabb& bounds = slice_.tree.bounds();
     const Eigen::Matrix3d& rot = sensor_from_plane_.linear();
     const View view = boxView(bounds.center(), bounds.extent() * 0.5, rot, rot.cwiseAbs(),
-                              sensor_from_plane_.translation(), beams_.pattern().angleMin(), false);
+                              sensor_from_plane_.translation(), beams_.grid().pattern().angleMin(), false);
     if (!(view.near <= config_.tmax)) return;
-    beams_.forEachRect(view, within, [&](const BeamRect& rect) {
+    beams_.grid().forEachRect(view, within, [&](const BeamRect& rect) {
       stack_.push(Entry{slice_.wide.root(), rect, floatBelow(view.near)});
     });
     walk();
@@ -126,7 +126,7 @@ class SliceWalk {
       } else if (!(views.az_half[k] >= 0)) {
         add(col_lo, col_hi);
       } else {
-        beams_.forEachColumnRange(views.az_center[k], views.az_half[k], add);
+        beams_.grid().forEachColumnRange(views.az_center[k], views.az_half[k], add);
       }
     }
     if (n == 0) return false;
@@ -154,7 +154,7 @@ class SliceWalk {
   void testSegment(const KeptSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
     Eigen::Vector2d front;
     if (config_.cull_backfaces) front = frontOf(s);
-    testSegmentInFan(beams_.pattern(), plane_.toSensor(s.p), plane_.toSensor(s.q), config_.tmin,
+    testSegmentInFan(beams_.grid().pattern(), plane_.toSensor(s.p), plane_.toSensor(s.q), config_.tmin,
                      config_.tmax, config_.cull_backfaces ? &front : nullptr, first, last, hit,
                      open);
   }
@@ -185,9 +185,9 @@ class SliceWalk {
   // nearest first would test it with every beam before the nearer things in front of it).
   void castPrimitiveItem(int index, const BeamRect& rect) {
     PlacedBody a = placeBody(scene_, index, sensor_from_frame_);
-    viewPlacedBody(scene_, beams_.pattern().angleMin(), false, &a);
+    viewPlacedBody(scene_, beams_.grid().pattern().angleMin(), false, &a);
     if (!(a.view.near <= config_.tmax) || !a.view.crosses) return;
-    beams_.forEachRect(a.view, rect, [&](const BeamRect& r) {
+    beams_.grid().forEachRect(a.view, rect, [&](const BeamRect& r) {
       if (deferLargePrimitive(a)) {
         deferred_.add(a, r);
       } else if (beams_.anyOpen(r, a.view.near)) {
@@ -236,7 +236,7 @@ class SliceWalk {
   // Each open beam of the rect through the node's subtree, two at a time (their walks side by
   // side): box tests in plane coordinates, each item tested as testItem tests it.
   void traceRect(const Entry& e) {
-    const auto& dirs = beams_.pattern().directions();
+    const auto& dirs = beams_.grid().pattern().directions();
     Traced pair[2];
     int n = 0;
     for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
