@@ -14,19 +14,19 @@ namespace core {
 template <class Entry>
 class WalkStack {
  public:
-  explicit WalkStack(std::size_t capacity = 256) : items_(capacity) {}
+  explicit WalkStack(std::size_t capacity = 256) { items_.reserve(capacity); }
 
-  bool empty() const { return top_ == 0; }
-  void clear() { top_ = 0; }
-  void push(const Entry& e) {
-    if (top_ == items_.size()) items_.resize(items_.size() * 2);
-    items_[top_++] = e;
+  bool empty() const { return items_.empty(); }
+  void clear() { items_.clear(); }  // keeps the memory
+  void push(const Entry& e) { items_.push_back(e); }
+  Entry pop() {
+    const Entry e = items_.back();
+    items_.pop_back();
+    return e;
   }
-  Entry pop() { return items_[--top_]; }
 
  private:
   std::vector<Entry> items_;
-  std::size_t top_ = 0;
 };
 
 }  // namespace core
