@@ -76,14 +76,17 @@ MeshImportBoundError memoryBoundError(const MeshImportBounds& bounds) {
   return MeshImportBoundError(
       "importing it needs more than the memory bound of " + text(bounds.max_memory_mb) +
           " MB for one mesh file; stopped (a corrupt or hostile file can make assimp allocate "
-          "without limit)",
+          "without limit; a sound mesh this large needs a larger bound: the node's "
+          "~mesh_import_max_memory_mb, cast_scan's --mesh-import-max-memory-mb)",
       MeshImportBoundError::Bound::kMemory, bounds.max_memory_mb);
 }
 
 MeshImportBoundError timeBoundError(const MeshImportBounds& bounds) {
   return MeshImportBoundError(
       "importing it took longer than the time bound of " + text(bounds.max_seconds) +
-          " s for one mesh file; stopped (a corrupt or hostile file can make assimp loop)",
+          " s for one mesh file; stopped (a corrupt or hostile file can make assimp loop; a "
+          "sound mesh this large needs a longer bound: the node's ~mesh_import_timeout, "
+          "cast_scan's --mesh-import-timeout)",
       MeshImportBoundError::Bound::kTime, bounds.max_seconds);
 }
 

@@ -304,14 +304,29 @@ void commitBodies(std::vector<PendingBody> pending, const std::string& prefix,
 
 }  // namespace
 
-void MeshImportBounds::validate() const {
+MeshImportBounds MeshImportBounds::forFile(std::uintmax_t bytes) const {
+  const double mb = static_cast<double>(bytes) / (1024 * 1024);
+  const auto stepUp = [](double value, double step) { return std::ceil(value / step) * step; };
+  MeshImportBounds out = *this;
+  if (out.max_memory_mb == 0) {
+    out.max_memory_mb = std::max(kBaseMemoryMb, stepUp(kMemoryPerFileByte * mb, kMemoryStepMb));
+  }
+  if (out.max_seconds == 0) {
+    out.max_seconds = std::max(kBaseSeconds, stepUp(kSecondsPerFileMb * mb, kSecondsStep));
+  }
+  return out;
+}
+
+void MeshImportBounds::validate(const std::string& memory_name,
+                                const std::string& time_name) const {
   std::ostringstream msg;
   // Written so that NaN fails.
-  if (!(std::isfinite(max_memory_mb) && max_memory_mb >= kMinMemoryMb)) {
-    msg << "MeshImportBounds.max_memory_mb must be finite and >= " << kMinMemoryMb << ", got "
-        << max_memory_mb;
-  } else if (!(std::isfinite(max_seconds) && max_seconds > 0)) {
-    msg << "MeshImportBounds.max_seconds must be finite and > 0, got " << max_seconds;
+  if (!(std::isfinite(max_memory_mb) && (max_memory_mb == 0 || max_memory_mb >= kMinMemoryMb))) {
+    msg << memory_name << " must be 0 (from the file's size) or finite and >= " << kMinMemoryMb
+        << " MB, got " << max_memory_mb;
+  } else if (!(std::isfinite(max_seconds) && max_seconds >= 0)) {
+    msg << time_name << " must be 0 (from the file's size) or finite and > 0 s, got "
+        << max_seconds;
   } else {
     return;
   }
@@ -355,10 +370,11 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
     if (!std::ifstream(path, std::ios::binary).good()) {
       throw SceneLoadError("file cannot be opened for reading");
     }
-    if (fs::file_size(path, ec) == 0 && !ec) throw SceneLoadError("file is empty (0 bytes)");
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (size == 0 && !ec) throw SceneLoadError("file is empty (0 bytes)");
 
     if (!importer_) importer_ = std::make_unique<import_process::MeshImporter>();
-    mesh_file::MeshData data = importer_->import(path, scale, bounds);
+    mesh_file::MeshData data = importer_->import(path, scale, bounds.forFile(ec ? 0 : size));
     const Clock::time_point start = Clock::now();
     std::shared_ptr<const core::Mesh> mesh;
     try {

@@ -148,10 +148,24 @@ void readModels(ParamReader* r, std::vector<ModelSource>* models) {
   }
 }
 
+// The bounds of one mesh file's import (0: from the file's size), checked by
+// MeshImportBounds::validate() under the parameters' names.
+void readMeshImportBounds(ParamReader* r, MeshImportBounds* b) {
+  b->max_memory_mb = r->number("mesh_import_max_memory_mb", b->max_memory_mb, "MB (0: by size)");
+  b->max_seconds = r->number("mesh_import_timeout", b->max_seconds, "s (0: by size)");
+  const std::string name = "parameter " + r->prefix() + "mesh_import_";
+  try {
+    b->validate(name + "max_memory_mb:", name + "timeout:");
+  } catch (const std::invalid_argument& e) {
+    r->failWith(e.what());
+  }
+}
+
 // Which geometry is cast against.
 void readScene(ParamReader* r, NodeParams* p) {
   p->geometry = r->choice("geometry", p->geometry, kGeometrySourceNames);
   p->skip_bad_geometry = r->boolean("skip_bad_geometry", p->skip_bad_geometry);
+  readMeshImportBounds(r, &p->mesh_import);
   readModels(r, &p->models);
   p->ignore_links = r->textList("ignore_links");
 }

@@ -42,6 +42,7 @@ struct Args {
   Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
   core::ScanSpec scan;  // the fan, ranges and method; REP 117 with the default -inf policy
   GeometrySource geometry = laser_raycast::LoaderOptions().geometry;
+  laser_raycast::MeshImportBounds mesh_import;  // 0: from each file's size
   std::map<std::string, double> joints;
   int repeat = 0;
   int threads = core::CastConfig().threads;  // 0: every core
@@ -189,6 +190,11 @@ po::options_description flags(Args* args) {
   add("method",
       single("NAME", [args](const std::string& v) { args->scan.method = parseMethod(v); }),
       "the triangle test");
+  add("mesh-import-max-memory-mb",
+      number("--mesh-import-max-memory-mb", "MB", &args->mesh_import.max_memory_mb),
+      "address space for importing one mesh file (default 0: from the file's size)");
+  add("mesh-import-timeout", number("--mesh-import-timeout", "S", &args->mesh_import.max_seconds),
+      "time for importing one mesh file (default 0: from the file's size)");
   add("elevations",
       single("RAD,RAD,...",
              [args](const std::string& v) {
@@ -245,6 +251,11 @@ Args parseArgs(int argc, char** argv, bool* help) {
   } catch (const std::invalid_argument& e) {
     throw ArgError(underItsFlag(e.what(), beams_from));
   }
+  try {
+    args.mesh_import.validate("--mesh-import-max-memory-mb:", "--mesh-import-timeout:");
+  } catch (const std::invalid_argument& e) {
+    throw ArgError(e.what());
+  }
   return args;
 }
 
@@ -281,7 +292,7 @@ std::string synopsis() {
       << choices(laser_raycast::kGeometrySourceNames) << "]\n"
       << indent << "[--method " << choices(core::kTriangleMethodNames) << "]\n"
       << indent << "[--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n"
-      << indent << "[--threads N]\n";
+      << indent << "[--threads N] [--mesh-import-max-memory-mb MB] [--mesh-import-timeout S]\n";
   return out.str();
 }
 
@@ -343,6 +354,7 @@ LoadedScene loadScene(const Args& args) {
   for (std::size_t m = 0; m < args.models.size(); ++m) {
     laser_raycast::LoaderOptions options;
     options.geometry = args.geometry;
+    options.mesh_import = args.mesh_import;
     if (out.prefixed) options.tf_prefix = "m" + std::to_string(m) + "/";
     loaded.push_back(loader.addUrdfFile(args.models[m].path, options, &out.scene));
   }

@@ -144,7 +144,7 @@ TEST(NodeStartup, MissingMeshNamesTheFileAndLink) {
 TEST(NodeStartup, CorruptMeshIsRefusedAtTheMemoryBound) {
   ros::NodeHandle().setParam("/k/node/models", modelFile(data("corrupt_mesh.urdf")));
   expectRefused("__ns:=/k __name:=node",
-                {"regression_wall_p_letter.dae", "corrupt_link", "memory bound of 1536 MB"});
+                {"regression_wall_p_letter.dae", "corrupt_link", "memory bound of 512 MB"});
 }
 
 // The same file in a nodelet manager: the nodelet fails to load (its load command exits non-zero,
@@ -163,7 +163,7 @@ TEST(NodeStartup, CorruptMeshMakesTheNodeletFailToLoad) {
   EXPECT_NE(run.status, 0) << run.output;
   EXPECT_NE(run.status, 124) << "the load command should fail, not time out:\n" << run.output;
   for (const std::string& m : {"regression_wall_p_letter.dae", "corrupt_link",
-                               "memory bound of 1536 MB", "MANAGER_RUNNING"}) {
+                               "memory bound of 512 MB", "MANAGER_RUNNING"}) {
     EXPECT_NE(run.output.find(m), std::string::npos) << "the output should say '" << m << "':\n"
                                                      << run.output;
   }

@@ -3,6 +3,8 @@
 
 #include <unistd.h>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -31,6 +33,28 @@ inline const std::filesystem::path& tempDir() {
 inline std::string writeFile(const std::string& name, const std::string& content) {
   const std::filesystem::path path = tempDir() / name;
   std::ofstream(path, std::ios::binary) << content;
+  return path.string();
+}
+
+// Writes a binary STL of `triangles` triangles to name in tempDir(): a flat sheet of 1 cm squares,
+// two triangles each, facing +z, in rows of 1000 squares; returns its path.
+inline std::string writeBinaryStlGrid(const std::string& name, std::uint32_t triangles) {
+  const std::filesystem::path path = tempDir() / name;
+  std::ofstream out(path, std::ios::binary);
+  const std::string header(80, '\0');
+  out.write(header.data(), header.size());
+  out.write(reinterpret_cast<const char*>(&triangles), sizeof triangles);
+  for (std::uint32_t t = 0; t < triangles; ++t) {
+    const std::uint32_t square = t / 2;
+    const float x = 0.01f * (square % 1000), y = 0.01f * (square / 1000), d = 0.01f;
+    const float upper[9] = {x, y, 0, x + d, y, 0, x, y + d, 0};
+    const float lower[9] = {x + d, y, 0, x + d, y + d, 0, x, y + d, 0};
+    const float normal[3] = {0, 0, 1};
+    char record[50] = {};  // normal, three vertices, attribute count
+    std::memcpy(record, normal, sizeof normal);
+    std::memcpy(record + 12, t % 2 ? lower : upper, sizeof upper);
+    out.write(record, sizeof record);
+  }
   return path.string();
 }
 

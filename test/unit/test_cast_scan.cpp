@@ -491,7 +491,7 @@ TEST(CastScan, BadSceneExitsThree) {
 // tool allocated until the machine's memory ran out).
 TEST(CastScan, CorruptMeshExitsThreeAtTheMemoryBound) {
   expectBadScene(kData + "corrupt_mesh.urdf", "regression_wall_p_letter.dae");
-  expectBadScene(kData + "corrupt_mesh.urdf", "memory bound of 1536 MB");
+  expectBadScene(kData + "corrupt_mesh.urdf", "memory bound of 512 MB");
 }
 
 }  // namespace

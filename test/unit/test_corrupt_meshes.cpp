@@ -25,6 +25,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "temp_files.h"
@@ -135,9 +136,10 @@ TEST(CorruptMeshes, CastScanRefusesEveryOneWithinTheTimeAndMemoryBounds) {
     EXPECT_LT(run.seconds, kTimeBound);
     EXPECT_LT(run.peak_kb, kMemoryBoundKb);
     EXPECT_NE(run.err.find("mesh '" + mesh.string() + "'"), std::string::npos) << run.err;
-    // Which of the importer's bounds stopped it, or its crash.
-    const bool says_why = run.err.find("memory bound of 1536 MB") != std::string::npos ||
-                          run.err.find("time bound of 10 s") != std::string::npos ||
+    // Which of the importer's bounds stopped it (these files are a few KB: the bounds that follow
+    // their size are the base ones), or its crash.
+    const bool says_why = run.err.find("memory bound of 512 MB") != std::string::npos ||
+                          run.err.find("time bound of 5 s") != std::string::npos ||
                           run.err.find("crashed on it") != std::string::npos;
     EXPECT_TRUE(says_why) << run.err;
     EXPECT_EQ(run.out, "");
@@ -147,6 +149,32 @@ TEST(CorruptMeshes, CastScanRefusesEveryOneWithinTheTimeAndMemoryBounds) {
   std::cout << meshes.size() << " files in " << std::setprecision(1) << total
             << " s; largest resident set of any child: " << children.ru_maxrss / 1024 << " MB\n";
   EXPECT_LT(children.ru_maxrss, kMemoryBoundKb);
+}
+
+// The bounds set on the command line replace those that follow the file's size, and bad ones are
+// refused before anything is read (exit status 2, naming the flag and the value).
+TEST(CorruptMeshes, CastScanTakesTheBoundsFromItsFlags) {
+  const fs::path mesh = kCorpus / "mesh_loader" / "regression_wall_p_letter.dae";
+  ASSERT_TRUE(fs::exists(mesh)) << mesh;
+  const BoundedRun run =
+      runBounded({CAST_SCAN_PATH, "--urdf", urdfFor(mesh), "--sensor", "0,0,0,0,0,0",
+                  "--mesh-import-max-memory-mb", "128", "--mesh-import-timeout", "7"},
+                 kTimeBound);
+  EXPECT_EQ(run.status, 3) << run.err;
+  EXPECT_NE(run.err.find("memory bound of 128 MB"), std::string::npos) << run.err;
+  for (const auto& [flag, value, expected] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"--mesh-import-max-memory-mb", "32", "--mesh-import-max-memory-mb: must be 0"},
+           {"--mesh-import-max-memory-mb", "-1", "got -1"},
+           {"--mesh-import-timeout", "-5", "--mesh-import-timeout: must be 0"},
+           {"--mesh-import-timeout", "soon", "--mesh-import-timeout"}}) {
+    const BoundedRun bad = runBounded(
+        {CAST_SCAN_PATH, "--urdf", urdfFor(mesh), "--sensor", "0,0,0,0,0,0", flag, value},
+        kTimeBound);
+    EXPECT_EQ(bad.status, 2) << flag << " " << value << ": " << bad.err;
+    EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find(value), std::string::npos) << bad.err;
+  }
 }
 
 }  // namespace

@@ -102,8 +102,9 @@ TEST(MeshImport, CorruptFilesFoundByFuzzingAreRefused) {
   EXPECT_EQ(loader.meshesLoaded(), 0u);
 }
 
-// The case under the default bound, through a URDF: the named error keeps its type through
-// the loader's context and names the URDF, the link, the mesh and the bound.
+// The case under the default bounds, through a URDF: the named error keeps its type through
+// the loader's context and names the URDF, the link, the mesh, the bound (the 4.7 KB file's: 512 MB)
+// and the parameters that raise it.
 TEST(MeshImport, CorruptColladaIsRefusedAtTheDefaultMemoryBound) {
   const std::string mesh = kCorpus + "/regression_wall_p_letter.dae";
   SceneLoader loader(nullptr);
@@ -113,9 +114,11 @@ TEST(MeshImport, CorruptColladaIsRefusedAtTheDefaultMemoryBound) {
     ADD_FAILURE() << "loaded";
   } catch (const MeshImportBoundError& e) {
     EXPECT_EQ(e.bound(), MeshImportBoundError::Bound::kMemory);
-    EXPECT_EQ(e.limit(), MeshImportBounds().max_memory_mb);
-    for (const std::string& part : {std::string("the test URDF"), std::string("'shell'"), mesh,
-                                    std::string("memory bound of 1536 MB for one mesh file")}) {
+    EXPECT_EQ(e.limit(), MeshImportBounds::kBaseMemoryMb);
+    for (const std::string& part :
+         {std::string("the test URDF"), std::string("'shell'"), mesh,
+          std::string("memory bound of 512 MB for one mesh file"),
+          std::string("~mesh_import_max_memory_mb"), std::string("--mesh-import-max-memory-mb")}) {
       EXPECT_EQ(contains(e.what(), part), "");
     }
   }
@@ -172,15 +175,59 @@ TEST(MeshImportBounds, ValidateNamesFieldAndValue) {
     EXPECT_THROW(loader.addUrdfString(meshUrdf(kCuboid), "", options, &scene), SceneLoadError);
   };
   expectInvalid(63, 10, "max_memory_mb", "63");
+  expectInvalid(-1, 10, "max_memory_mb", "-1");
   expectInvalid(NAN, 10, "max_memory_mb", "nan");
   expectInvalid(INFINITY, 10, "max_memory_mb", "inf");
-  expectInvalid(1536, 0, "max_seconds", "0");
   expectInvalid(1536, -1, "max_seconds", "-1");
   expectInvalid(1536, NAN, "max_seconds", "nan");
+  expectInvalid(1536, INFINITY, "max_seconds", "inf");
   MeshImportBounds smallest;
   smallest.max_memory_mb = MeshImportBounds::kMinMemoryMb;
   smallest.max_seconds = 1e-3;
   EXPECT_NO_THROW(smallest.validate());
+  // The names a caller gives (a node's parameters, a tool's flags) replace the fields'.
+  MeshImportBounds bad;
+  bad.max_seconds = -2;
+  expectMentions(invalidMessage([&] { bad.validate("--memory:", "--timeout:"); }),
+                 {"--timeout: must be", "got -2"});
+}
+
+// Bounds left 0 follow the file's size, worked out by hand from the documented rule: the larger of
+// 512 MB and 48 bytes per byte of file in steps of 256 MB, the larger of 5 s and 0.2 s per MB in
+// steps of 5 s. A bound that is set stays as set.
+TEST(MeshImportBounds, BoundsFollowTheFilesSizeUnlessSet) {
+  const auto expectFor = [](std::uintmax_t bytes, double memory, double seconds) {
+    const MeshImportBounds b = MeshImportBounds().forFile(bytes);
+    EXPECT_EQ(b.max_memory_mb, memory) << bytes << " bytes";
+    EXPECT_EQ(b.max_seconds, seconds) << bytes << " bytes";
+  };
+  const std::uintmax_t mb = 1024 * 1024;
+  expectFor(0, 512, 5);
+  expectFor(5000, 512, 5);             // 0.2 MB, 0.001 s
+  expectFor(16 * mb, 768, 5);          // 48 * 16 = 768 MB, 3.2 s
+  expectFor(16 * mb + 1, 1024, 5);     // just over 768 MB: the next step
+  expectFor(25 * mb, 1280, 5);         // 1200 MB -> 1280; 5 s
+  expectFor(25 * mb + 1, 1280, 10);    // just over 5 s: the next step
+  expectFor(200000084, 9216, 40);      // 4 million triangles: 9155 MB -> 9216, 38.1 s -> 40
+  expectFor(1024 * mb, 49152, 205);    // a 1 GB STL: 48 GB, 204.8 s -> 205 s
+  MeshImportBounds set;
+  set.max_memory_mb = 2000;
+  EXPECT_EQ(set.forFile(1024 * mb).max_memory_mb, 2000);
+  EXPECT_EQ(set.forFile(1024 * mb).max_seconds, 205);
+  set.max_seconds = 7;
+  EXPECT_EQ(set.forFile(5000).max_seconds, 7);
+}
+
+// A binary STL of 500,000 triangles (24 MB) needs more address space than a small file's 512 MB:
+// refused under that fixed bound, it loads under the one its size gives it (1280 MB).
+TEST(MeshImportBounds, ALargeMeshLoadsUnderTheBoundOfItsSize) {
+  const std::string path = writeBinaryStlGrid("large.stl", 500000);
+  MeshImportBounds small;
+  small.max_memory_mb = MeshImportBounds::kBaseMemoryMb;
+  SceneLoader loader(nullptr);
+  EXPECT_THROW(loader.loadMesh(path, "", Vector3d::Ones(), {}, small), MeshImportBoundError);
+  SceneLoader by_size(nullptr);
+  EXPECT_EQ(by_size.loadMesh(path, "", Vector3d::Ones(), {}, {})->triangles().size(), 500000u);
 }
 
 // The smallest memory bound is enough for the importer itself and a small mesh.
@@ -247,13 +294,13 @@ TEST(MeshImportProcess, ItsCrashIsAnErrorNamingTheSignal) {
 TEST(MeshImportProcess, ItsCpuLimitIsTheTimeBound) {
   const FakeImporter fake("cpu.sh", "kill -XCPU $$");
   EXPECT_EQ(contains(importError(), "bound: "), "");
-  EXPECT_EQ(contains(importError(), "time bound of 10 s"), "");
+  EXPECT_EQ(contains(importError(), "time bound of 5 s"), "");
 }
 
 TEST(MeshImportProcess, ItsOutOfMemoryReplyIsTheMemoryBound) {
   const FakeImporter fake("oom.sh", kReply + "\\002\\000\\000\\000\\002\\000\\000\\000no'");
   EXPECT_EQ(contains(importError(), "bound: "), "");
-  EXPECT_EQ(contains(importError(), "memory bound of 1536 MB"), "");
+  EXPECT_EQ(contains(importError(), "memory bound of 512 MB"), "");
 }
 
 TEST(MeshImportProcess, ItsErrorReplyIsTheMessage) {

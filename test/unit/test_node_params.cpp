@@ -54,6 +54,8 @@ const std::vector<std::string> kReadmeParameters = {"frame_id",
                                                     "geometry",
                                                     "ignore_links",
                                                     "skip_bad_geometry",
+                                                    "mesh_import_max_memory_mb",
+                                                    "mesh_import_timeout",
                                                     "noise_stddev",
                                                     "noise_seed",
                                                     "intensity",
@@ -124,6 +126,8 @@ TEST(NodeParams, EveryDefault) {
     EXPECT_EQ(s.scan.output.dropout_probability, 0.0);
     EXPECT_EQ(p.geometry, laser_raycast::GeometrySource::kVisual);
     EXPECT_FALSE(p.skip_bad_geometry);
+    EXPECT_EQ(p.mesh_import.max_memory_mb, 0.0);  // by the file's size
+    EXPECT_EQ(p.mesh_import.max_seconds, 0.0);
     ASSERT_EQ(p.models.size(), 1u);
     EXPECT_EQ(p.models[0].param, "robot_description");
     EXPECT_EQ(p.models[0].file, "");
@@ -178,6 +182,8 @@ TEST(NodeParams, EveryValueReachesItsField) {
                                       {"geometry", "collision"},
                                       {"ignore_links", list({"base_scan", "w/wall"})},
                                       {"skip_bad_geometry", true},
+                                      {"mesh_import_max_memory_mb", 4096},
+                                      {"mesh_import_timeout", 120.5},
                                       {"noise_stddev", 0.01},
                                       {"noise_seed", 42},
                                       {"intensity", "reflectivity"},
@@ -213,6 +219,8 @@ TEST(NodeParams, EveryValueReachesItsField) {
   EXPECT_EQ(p.geometry, laser_raycast::GeometrySource::kCollision);
   EXPECT_EQ(p.ignore_links, (std::vector<std::string>{"base_scan", "w/wall"}));
   EXPECT_TRUE(p.skip_bad_geometry);
+  EXPECT_EQ(p.mesh_import.max_memory_mb, 4096.0);
+  EXPECT_EQ(p.mesh_import.max_seconds, 120.5);
   EXPECT_EQ(p.sensors.at(0).scan.output.noise_stddev, 0.01);
   EXPECT_EQ(p.sensors.at(0).scan.output.noise_seed, 42u);
   EXPECT_TRUE(p.sensors.at(0).scan.output.intensity);
@@ -243,6 +251,7 @@ TEST(NodeParams, WrongTypesNameTheParameterAndTheValue) {
       {"frame_id", 5, {"~frame_id", "int (5)", "expected a string"}},
       {"method", 1, {"~method", "int (1)", "expected a string"}},
       {"skip_bad_geometry", "yes", {"~skip_bad_geometry", "'yes'", "true or false"}},
+      {"mesh_import_max_memory_mb", "2G", {"~mesh_import_max_memory_mb", "'2G'", "a number"}},
       {"cull_backfaces", 1, {"~cull_backfaces", "int (1)", "true or false"}},
       {"ignore_links", "base", {"~ignore_links", "'base'", "a list of strings"}},
       {"ignore_links", list({"a", 3}), {"~ignore_links[1]", "int (3)", "expected a string"}},
@@ -273,6 +282,11 @@ TEST(NodeParams, OutOfRangeValuesNameTheParameterAndTheValue) {
       {"default_reflectivity", kInf, {"~default_reflectivity", "got inf"}},
       {"reflectivity", values({{"wall", -1}}), {"~reflectivity/wall", "got -1"}},
       {"reflectivity", values({{"wall", kNan}}), {"~reflectivity/wall", "got nan"}},
+      {"mesh_import_max_memory_mb", 32, {"~mesh_import_max_memory_mb", ">= 64", "got 32"}},
+      {"mesh_import_max_memory_mb", -1, {"~mesh_import_max_memory_mb", "got -1"}},
+      {"mesh_import_max_memory_mb", kInf, {"~mesh_import_max_memory_mb", "got inf"}},
+      {"mesh_import_timeout", -1, {"~mesh_import_timeout", "got -1"}},
+      {"mesh_import_timeout", kNan, {"~mesh_import_timeout", "got nan"}},
       // Checked by the core, which names its fields as the parameters are named. FanSpec reads
       // an angle_increment or samples of 0 as unset, and asks for exactly one of the two.
       {"angle_increment", 0.0, {"~angle_increment", "angle_increment 0 rad"}},
@@ -295,6 +309,8 @@ TEST(NodeParams, TheLimitsThemselvesAreAccepted) {
   expectAccepted(values({{"threads", laser_raycast::core::CastConfig::kMaxThreads}}));
   expectAccepted(values({{"pose_timeout", kInf}}));  // never stale
   expectAccepted(values({{"samples", 2}}));
+  expectAccepted(values({{"mesh_import_max_memory_mb", laser_raycast::MeshImportBounds::kMinMemoryMb},
+                         {"mesh_import_timeout", 1e-3}}));
   expectAccepted(values({{"noise_seed", 0}, {"default_reflectivity", 0}}));
   expectAccepted(values({{"reflectivity", values({{"black", 0}})}, {"intensity", "reflectivity"}}));
 }

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -37,17 +38,34 @@ inline bool parseGeometrySource(const std::string& name, GeometrySource* source)
 // make assimp allocate without limit, loop, or crash, and the child's failure is then a
 // SceneLoadError (MeshImportBoundError for a bound) instead of the caller's.
 struct MeshImportBounds {
-  // MB of address space for the importing process (assimp, its libraries and the mesh). 1.5 GB
-  // imports meshes of several million triangles.
-  double max_memory_mb = 1536;
-  // s of wall-clock time for one file, start-up included (a few ms).
-  double max_seconds = 10;
+  // MB of address space for the importing process (assimp, its libraries and the mesh), and s of
+  // wall-clock time for one file, start-up included (a few ms). 0 (the default): each file's bound
+  // follows its size (forFile), so that a large mesh loads and a small one cannot take much.
+  double max_memory_mb = 0;
+  double max_seconds = 0;
+
+  // The bounds for a file of `bytes` bytes: those set, and for each one left 0 the larger of a
+  // base and a multiple of the file's size, rounded up to a whole step (so that files of similar
+  // sizes share one importer process): memory kBaseMemoryMb, or kMemoryPerFileByte bytes of
+  // address space per byte of file, in steps of kMemoryStepMb; time kBaseSeconds, or
+  // kSecondsPerFileMb per MB of file, in steps of kSecondsStep. Measured: a binary STL of 500,000
+  // triangles (24 MB) needs 512-768 MB, one of 4 million (191 MB) 6-8 GB (docs/faults.md). A 5 KB
+  // file gets 512 MB and 5 s, the 191 MB one 9,216 MB and 40 s, a 1 GB one 48 GB and 205 s.
+  MeshImportBounds forFile(std::uintmax_t bytes) const;
 
   // Throws std::invalid_argument naming the field and its value: each must be finite,
-  // max_memory_mb >= kMinMemoryMb and max_seconds > 0.
-  void validate() const;
+  // max_memory_mb 0 or >= kMinMemoryMb and max_seconds >= 0. The fields are named as given (a
+  // node's parameters, a tool's flags), by default "MeshImportBounds.max_memory_mb" and so on.
+  void validate(const std::string& memory_name = "MeshImportBounds.max_memory_mb",
+                const std::string& time_name = "MeshImportBounds.max_seconds") const;
   // The importer itself (its libraries, unused) maps about 40 MB of address space.
   static constexpr double kMinMemoryMb = 64;
+  static constexpr double kBaseMemoryMb = 512;
+  static constexpr double kMemoryPerFileByte = 48;
+  static constexpr double kMemoryStepMb = 256;
+  static constexpr double kBaseSeconds = 5;
+  static constexpr double kSecondsPerFileMb = 0.2;
+  static constexpr double kSecondsStep = 5;
 };
 
 struct LoaderOptions {

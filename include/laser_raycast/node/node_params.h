@@ -101,6 +101,9 @@ struct NodeParams {
   int threads = 1;
   GeometrySource geometry = GeometrySource::kVisual;
   bool skip_bad_geometry = false;
+  // ~mesh_import_max_memory_mb, ~mesh_import_timeout: the bounds of one mesh file's import, 0 (the
+  // default) for bounds that follow the file's size (MeshImportBounds).
+  MeshImportBounds mesh_import;
   std::vector<ModelSource> models = {ModelSource{"robot_description", "", ""}};
   std::vector<std::string> ignore_links;
   std::map<std::string, double> reflectivity;  // link name (with TF prefix) -> reflectivity
