@@ -88,7 +88,7 @@ TEST(MeasurementModelRealism, QuantizeRangeByHand) {
 
 // Through the measurement model: every valid output is a multiple of the resolution (to float), within half
 // a step of the range, and inside the limits.
-TEST(MeasurementModelRealism, QuantisationInTheEncoder) {
+TEST(MeasurementModelRealism, QuantisationInTheMeasurementModel) {
   std::vector<double> ranges;
   for (int i = 0; i < 2000; ++i) ranges.push_back(0.5 + 0.004749 * i);  // 0.5 .. 9.99
   MeasurementConfig c = measurementConfig(0.5, 10.0);
