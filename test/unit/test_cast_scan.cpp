@@ -4,18 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstdio>
-#include <fstream>
 #include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "cast_scan_cli.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/scene_loader.h"
-#include "run_command.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -25,56 +22,12 @@ const std::string kData = std::string(LASER_RAYCAST_SOURCE_DIR) + "/test/data/";
 const std::string kFour =
     " --angle-min -1.5707963267948966 --angle-max 3.141592653589793 --samples 4";
 
-struct CliRun {
-  int status = -1;
-  std::string out, err;
-};
-
-CliRun runCli(const std::string& args) {
-  const std::string err_file = ::testing::TempDir() + "cast_scan_stderr.txt";
-  const auto result = runCommand(std::string(CAST_SCAN_PATH) + " " + args + " 2>" + err_file);
-  CliRun run;
-  run.status = result.status;
-  run.out = result.output;
-  std::ifstream err(err_file);
-  std::stringstream s;
-  s << err.rdbuf();
-  run.err = s.str();
-  return run;
-}
-
 struct Row {
   int index;
   double angle;
   std::string range;  // as printed
   std::string link;
 };
-
-// The rows of a CSV with this header, each split into as many fields as the header has (a trailing
-// empty field kept); a bad header or row is a test failure.
-std::vector<std::vector<std::string>> csvRows(const std::string& csv, const std::string& header) {
-  const std::size_t columns = std::count(header.begin(), header.end(), ',') + 1;
-  std::istringstream in(csv);
-  std::string line;
-  std::vector<std::vector<std::string>> rows;
-  if (!std::getline(in, line) || line != header) {
-    ADD_FAILURE() << "bad header: '" << line << "'";
-    return rows;
-  }
-  while (std::getline(in, line)) {
-    std::vector<std::string> fields;
-    std::stringstream ls(line);
-    std::string f;
-    while (std::getline(ls, f, ',')) fields.push_back(f);
-    if (!line.empty() && line.back() == ',') fields.push_back("");
-    if (fields.size() != columns) {
-      ADD_FAILURE() << "bad row: '" << line << "'";
-      continue;
-    }
-    rows.push_back(fields);
-  }
-  return rows;
-}
 
 std::vector<Row> parse(const std::string& csv) {
   std::vector<Row> rows;
@@ -418,14 +371,6 @@ TEST(CastScan, ValuesAfterAnEqualsSign) {
                                "--samples=4");
   ASSERT_EQ(joined.status, 0) << joined.err;
   EXPECT_EQ(joined.out, spaced.out);
-}
-
-// Exit status 2 for bad arguments, with a message naming the problem and nothing on stdout.
-void expectBadArguments(const std::string& args, const std::string& mention) {
-  const CliRun run = runCli(args);
-  EXPECT_EQ(run.status, 2) << args << "\n" << run.err;
-  EXPECT_NE(run.err.find(mention), std::string::npos) << args << "\n" << run.err;
-  EXPECT_EQ(run.out, "") << args;
 }
 
 TEST(CastScan, BadArgumentsExitTwo) {
