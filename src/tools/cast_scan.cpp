@@ -1,6 +1,6 @@
-// cast_scan: one simulated scan of URDF models from a sensor pose, printed as CSV. Needs no
-// roscore: package:// URIs are resolved through ROS_PACKAGE_PATH. See synopsis(), flags() and the
-// README.
+// cast_scan: simulated scans of URDF models from a sensor pose, or from each pose of a path,
+// printed as CSV. Needs no roscore: package:// URIs are resolved through ROS_PACKAGE_PATH. See
+// synopsis(), flags() and the README; the path is cast_path.h's.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "cast_path.h"
 #include "command_line.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/measurement_model.h"
@@ -26,6 +27,8 @@ namespace {
 
 using laser_raycast::GeometrySource;
 using laser_raycast::tools::ArgError;
+using laser_raycast::tools::parseNumber;
+using laser_raycast::tools::single;
 namespace core = laser_raycast::core;
 namespace po = boost::program_options;
 
@@ -39,7 +42,7 @@ struct Model {
 
 struct Args {
   std::vector<Model> models;
-  Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
+  laser_raycast::tools::PathArgs path;  // the sensor poses: --sensor or --poses
   core::ScanSpec scan;  // the fan, ranges and method; REP 117 with the default -inf policy
   GeometrySource geometry = laser_raycast::LoaderOptions().geometry;
   laser_raycast::MeshImportBounds mesh_import;  // 0: from each file's size
@@ -48,15 +51,6 @@ struct Args {
   int threads = core::CastConfig().threads;  // 0: every core
   bool rings = false;  // --elevations given: one fan per elevation, and the ring columns
 };
-
-double parseNumber(const std::string& flag, const std::string& text) {
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(value)) {
-    throw ArgError(flag + ": '" + text + "' is not a finite number");
-  }
-  return value;
-}
 
 int parseCount(const std::string& flag, const std::string& text) {
   char* end = nullptr;
@@ -67,39 +61,17 @@ int parseCount(const std::string& flag, const std::string& text) {
   return static_cast<int>(value);
 }
 
-// "x,y,z,roll,pitch,yaw"
-bool parsePose(const std::string& text, Eigen::Isometry3d* pose) {
-  double v[6];
-  std::size_t start = 0;
-  for (int k = 0; k < 6; ++k) {
-    const std::size_t comma = text.find(',', start);
-    if ((k < 5) != (comma != std::string::npos)) return false;
-    const std::string item = text.substr(start, k < 5 ? comma - start : std::string::npos);
-    char* end = nullptr;
-    v[k] = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(v[k])) return false;
-    start = comma + 1;
-  }
-  *pose = laser_raycast::poseFromXyzRpy(v[0], v[1], v[2], v[3], v[4], v[5]);
-  return true;
-}
-
 // "PATH" or "PATH@x,y,z,roll,pitch,yaw"
 Model parseModel(const std::string& spec) {
   Model model;
   model.path = spec;
   const std::size_t at = spec.rfind('@');
-  if (at != std::string::npos && parsePose(spec.substr(at + 1), &model.pose)) {
+  if (at != std::string::npos &&
+      laser_raycast::tools::parsePose(spec.substr(at + 1), &model.pose)) {
     model.path = spec.substr(0, at);
   }
   if (model.path.empty()) throw ArgError("--urdf: empty path");
   return model;
-}
-
-void parseSensor(const std::string& spec, Eigen::Isometry3d* pose) {
-  if (!parsePose(spec, pose)) {
-    throw ArgError("--sensor: '" + spec + "' is not x,y,z,roll,pitch,yaw (6 finite numbers)");
-  }
 }
 
 // "E1,E2,...": radians, any order, at least one.
@@ -138,12 +110,6 @@ core::TriangleMethod parseMethod(const std::string& name) {
   return method;
 }
 
-// A flag with one value, which store converts and keeps.
-po::typed_value<std::string>* single(const char* value_name,
-                                     std::function<void(const std::string&)> store) {
-  return po::value<std::string>()->value_name(value_name)->notifier(std::move(store));
-}
-
 // A flag that may be given several times, each value kept by store.
 po::typed_value<std::vector<std::string>>* repeated(const char* value_name,
                                                     std::function<void(const std::string&)> store) {
@@ -172,8 +138,7 @@ po::options_description flags(Args* args) {
                [args](const std::string& v) { args->models.push_back(parseModel(v)); }),
       "a URDF file or package:// URI, placed at POSE x,y,z,roll,pitch,yaw (default: the "
       "identity); repeat for several models");
-  add("sensor", single("POSE", [args](const std::string& v) { parseSensor(v, &args->sensor); }),
-      "the sensor pose x,y,z,roll,pitch,yaw (required)");
+  laser_raycast::tools::addPathFlags(add, &args->path);
   add("angle-min", number("--angle-min", "RAD", &args->scan.fan.angle_min), "the first beam");
   add("angle-max", number("--angle-max", "RAD", &args->scan.fan.angle_max), "the last beam");
   add("samples", count("--samples", &args->scan.fan.samples),
@@ -241,7 +206,7 @@ Args parseArgs(int argc, char** argv, bool* help) {
   if (*help) return args;
   const bool has_samples = values.count("samples"), has_increment = values.count("angle-increment");
   if (args.models.empty()) throw ArgError("give at least one --urdf");
-  if (!values.count("sensor")) throw ArgError("--sensor is required");
+  laser_raycast::tools::checkPathFlags(values);
   if (has_samples && has_increment) throw ArgError("give --samples or --angle-increment, not both");
   if (!has_samples && !has_increment) args.scan.fan.samples = core::FanSpec::kDefaultSamples;
   // The angles, the beam count, the range limits and the elevations: checked once, by the core.
@@ -285,8 +250,8 @@ std::string formatAngle(double rad) {
 std::string synopsis() {
   const char* const indent = "                 ";
   std::ostringstream out;
-  out << "usage: cast_scan --urdf PATH[@x,y,z,roll,pitch,yaw] [--urdf ...] "
-      << "--sensor x,y,z,roll,pitch,yaw\n"
+  out << "usage: cast_scan --urdf PATH[@x,y,z,roll,pitch,yaw] [--urdf ...]\n"
+      << indent << "(--sensor x,y,z,roll,pitch,yaw | --poses FILE)\n"
       << indent << "[--angle-min RAD] [--angle-max RAD] [--samples N | --angle-increment RAD]\n"
       << indent << "[--range-min M] [--range-max M] [--geometry "
       << choices(laser_raycast::kGeometrySourceNames) << "]\n"
@@ -303,7 +268,8 @@ std::string notes() {
   const core::ScanSpec& scan = defaults.scan;
   std::ostringstream out;
   out << "Prints CSV 'index,angle,range,link' (REP 117: inf, -inf, nan); with --elevations\n"
-      << "'index,ring,elevation,angle,range,link' (ring 0 the lowest).\n"
+      << "'index,ring,elevation,angle,range,link' (ring 0 the lowest). With --poses, a scan\n"
+      << "from each pose of FILE in turn, its rows led by 'pose' (0: the file's first pose line).\n"
       << "Defaults: angles " << formatAngle(scan.fan.angle_min) << ".."
       << formatAngle(scan.fan.angle_max) << ", " << core::FanSpec::kDefaultSamples
       << " samples, ranges " << formatNumber(scan.output.range_min) << ".."
@@ -369,33 +335,57 @@ LoadedScene loadScene(const Args& args) {
   return out;
 }
 
-// Casts the scan `repeat` more times and prints the median time to stderr. Each cast is computed
-// anew (forget(): not the previous scan's result), as the node casts scan after scan: a planar
-// fan's kept slices of its plane (kept_slice.h) serve the casts after the first two.
-void reportMedianCastTime(const Args& args, const LoadedScene& loaded,
-                          const core::ScanPattern& pattern, const core::CastConfig& config,
-                          core::Caster& caster) {
-  std::vector<long long> ns;
-  ns.reserve(args.repeat);
+// The scans' pattern and settings, and the one caster that casts them all, as the node's sensor
+// keeps one from scan to scan: a scan is reused only if nothing moved relative to the sensor.
+struct Casting {
+  core::ScanPattern pattern;
+  core::CastConfig config;
+  core::Caster caster;
+};
+
+// The scan from sensor; *ns, if given, the time of the cast alone.
+const core::ScanResult& castFrom(const LoadedScene& loaded, const Eigen::Isometry3d& sensor,
+                                 Casting* casting, long long* ns) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const core::ScanResult& result =
+      casting->caster.cast(loaded.scene, loaded.poses, sensor, casting->pattern, casting->config);
+  const auto t1 = std::chrono::steady_clock::now();
+  if (ns) *ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
+  return result;
+}
+
+// Casts every scan of the path `repeat` more times and prints the median time of a scan over all
+// of them to stderr. Each cast is computed anew (forget(): not the previous scan's result), as the
+// node casts scan after scan: a planar fan's kept slices of its plane (kept_slice.h) serve the
+// casts after the first two.
+void reportMedianCastTime(const Args& args, const LoadedScene& loaded, Casting* casting) {
+  std::vector<long long> ns(args.repeat * args.path.sensors.size());
+  auto next = ns.begin();
   for (int k = 0; k < args.repeat; ++k) {
-    caster.forget();  // time the cast itself, not the reuse of an unchanged scan
-    const auto t0 = std::chrono::steady_clock::now();
-    caster.cast(loaded.scene, loaded.poses, args.sensor, pattern, config);
-    const auto t1 = std::chrono::steady_clock::now();
-    ns.push_back(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());
+    for (const Eigen::Isometry3d& sensor : args.path.sensors) {
+      casting->caster.forget();  // time the cast itself, not the reuse of an unchanged scan
+      castFrom(loaded, sensor, casting, &*next++);
+    }
   }
   std::nth_element(ns.begin(), ns.begin() + ns.size() / 2, ns.end());
   std::cerr << "cast_ns_per_scan_median=" << ns[ns.size() / 2] << "\n";
 }
 
-// One CSV row per beam, in beam order (ring-major).
-std::string formatCsv(const Args& args, const LoadedScene& loaded, const core::ScanPattern& pattern,
-                      const core::ScanResult& result) {
-  std::string out =
-      args.rings ? "index,ring,elevation,angle,range,link\n" : "index,angle,range,link\n";
+// The CSV's header: with --poses, the pose's number first.
+std::string csvHeader(const Args& args) {
+  return std::string(args.path.pose_column ? "pose," : "") +
+         (args.rings ? "index,ring,elevation,angle,range,link\n" : "index,angle,range,link\n");
+}
+
+// One CSV row per beam of the scan from the path's pose number `pose`, in beam order
+// (ring-major).
+std::string csvRows(const Args& args, const LoadedScene& loaded, const core::ScanPattern& pattern,
+                    const core::ScanResult& result, std::size_t pose) {
+  std::string out;
   const int azimuths = pattern.azimuthCount();
   for (int i = 0; i < pattern.size(); ++i) {
     const int ring = i / azimuths;
+    if (args.path.pose_column) out += std::to_string(pose) + ",";
     out += std::to_string(i) + ",";
     if (args.rings) {
       out += std::to_string(ring) + "," + formatNumber(pattern.elevations()[ring]) + ",";
@@ -410,6 +400,8 @@ std::string formatCsv(const Args& args, const LoadedScene& loaded, const core::S
   }
   return out;
 }
+
+void print(const std::string& text) { std::fwrite(text.data(), 1, text.size(), stdout); }
 
 }  // namespace
 
@@ -437,14 +429,14 @@ int main(int argc, char** argv) {
     std::cerr << "cast_scan: " << e.what() << "\n";
     return kExitBadArguments;
   }
-  const core::ScanPattern pattern = args.scan.pattern();
-  core::CastConfig config = args.scan.castConfig();
-  config.threads = args.threads;
-  core::Caster caster;
-  const core::ScanResult& result =
-      caster.cast(loaded.scene, loaded.poses, args.sensor, pattern, config);
-  if (args.repeat > 0) reportMedianCastTime(args, loaded, pattern, config, caster);
-  const std::string csv = formatCsv(args, loaded, pattern, result);
-  std::fwrite(csv.data(), 1, csv.size(), stdout);
+  Casting casting{args.scan.pattern(), args.scan.castConfig(), core::Caster()};
+  casting.config.threads = args.threads;
+  // The path in order, each scan printed before the next is cast (the result is the caster's).
+  print(csvHeader(args));
+  for (std::size_t p = 0; p < args.path.sensors.size(); ++p) {
+    print(csvRows(args, loaded, casting.pattern,
+                  castFrom(loaded, args.path.sensors[p], &casting, nullptr), p));
+  }
+  if (args.repeat > 0) reportMedianCastTime(args, loaded, &casting);
   return 0;
 }

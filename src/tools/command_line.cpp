@@ -1,6 +1,7 @@
 #include "command_line.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -38,6 +39,20 @@ bool parseCommandLine(int argc, char** argv, const po::options_description& opti
     throw ArgError(e.what());
   }
   return true;
+}
+
+po::typed_value<std::string>* single(const char* value_name,
+                                     std::function<void(const std::string&)> store) {
+  return po::value<std::string>()->value_name(value_name)->notifier(std::move(store));
+}
+
+double parseNumber(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !std::isfinite(value)) {
+    throw ArgError(flag + ": '" + text + "' is not a finite number");
+  }
+  return value;
 }
 
 int parseThreads(const std::string& flag, const std::string& text) {

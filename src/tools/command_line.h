@@ -3,6 +3,7 @@
 #pragma once
 
 #include <boost/program_options.hpp>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -22,6 +23,13 @@ class ArgError : public std::runtime_error {
 bool parseCommandLine(int argc, char** argv,
                       const boost::program_options::options_description& options,
                       boost::program_options::variables_map* values);
+
+// A flag with one value, which store converts and keeps (and may refuse with an ArgError).
+boost::program_options::typed_value<std::string>* single(
+    const char* value_name, std::function<void(const std::string&)> store);
+
+// A finite number. Throws ArgError naming the flag and the text.
+double parseNumber(const std::string& flag, const std::string& text);
 
 // A thread count as core::CastConfig::threads takes it (0: every core). Throws ArgError naming
 // the flag and the text.
