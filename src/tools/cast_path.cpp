@@ -29,6 +29,30 @@ bool parseSix(const std::string& text, double v[6]) {
   return true;
 }
 
+// "vx,vy,vz,wx,wy,wz"
+Twist parseTwist(const std::string& text) {
+  double v[6];
+  if (!parseSix(text, v)) {
+    throw ArgError("--twist: '" + text + "' is not vx,vy,vz,wx,wy,wz (6 finite numbers)");
+  }
+  Twist twist;
+  twist.linear = Eigen::Vector3d(v[0], v[1], v[2]);
+  twist.angular = Eigen::Vector3d(v[3], v[4], v[5]);
+  return twist;
+}
+
+Sweep parseSweep(const std::string& name) {
+  Sweep sweep;
+  if (!kSweepNames.parse(name, &sweep)) throw ArgError("--sweep: " + kSweepNames.notOneOf(name));
+  return sweep;
+}
+
+double parseScanTime(const std::string& text) {
+  const double seconds = parseNumber("--scan-time", text);
+  if (!(seconds > 0)) throw ArgError("--scan-time: '" + text + "' is not > 0 s");
+  return seconds;
+}
+
 // The line without the white space around it.
 std::string trimmed(const std::string& line) {
   const char* const space = " \t\r\n\f\v";
@@ -58,12 +82,40 @@ void addPathFlags(boost::program_options::options_description_easy_init& add, Pa
                path->pose_column = true;
              }),
       "a scan from each pose of FILE in turn: x,y,z,roll,pitch,yaw a line, '#' a comment");
+  add("sweep", single("NAME", [path](const std::string& v) { path->sweep = parseSweep(v); }),
+      "instant (default): every beam at once; rotating: azimuth column c at c * angle increment * "
+      "S / 2pi s after the first beam, the sensor moving on with --twist");
+  add("scan-time",
+      single("S", [path](const std::string& v) { path->scan_time = parseScanTime(v); }),
+      "one turn of the rotating head, s (> 0; required with --sweep rotating)");
+  add("twist",
+      single("vx,vy,vz,wx,wy,wz", [path](const std::string& v) { path->twist = parseTwist(v); }),
+      "the sensor's constant velocity during a rotating sweep, in the fixed frame: m/s, then "
+      "rad/s about the fixed axes (default 0)");
 }
 
-void checkPathFlags(const boost::program_options::variables_map& values) {
+void checkPathFlags(const boost::program_options::variables_map& values, const PathArgs& path) {
   const bool sensor = values.count("sensor"), poses = values.count("poses");
   if (sensor && poses) throw ArgError("give --sensor or --poses, not both");
   if (!sensor && !poses) throw ArgError("--sensor (or --poses) is required");
+  const bool rotating = path.sweep == Sweep::kRotating;
+  for (const char* flag : {"scan-time", "twist"}) {
+    if (values.count(flag) && !rotating) {
+      throw ArgError(std::string("--") + flag + ": only with --sweep rotating");
+    }
+  }
+  if (rotating && !values.count("scan-time")) {
+    throw ArgError("--sweep rotating: give --scan-time S (s, one turn of the head)");
+  }
+}
+
+void checkSweepTimes(const PathArgs& path, const core::FanSpec& fan) {
+  if (path.sweep != Sweep::kRotating) return;
+  const double increment = timeIncrement(path, fan.increment());
+  if (!(increment > 0)) throw ArgError("--scan-time: too short: every beam's time is 0 s");
+  if (!std::isfinite((fan.beamCount() - 1) * increment)) {
+    throw ArgError("--scan-time: too long: the last beam's time is not finite");
+  }
 }
 
 bool parsePose(const std::string& text, Eigen::Isometry3d* pose) {
@@ -93,6 +145,35 @@ std::vector<Eigen::Isometry3d> readPoses(const std::string& path) {
     throw ArgError("--poses " + path + ": no pose (every line is blank or a comment)");
   }
   return poses;
+}
+
+double timeIncrement(const PathArgs& path, double angle_increment) {
+  if (path.sweep != Sweep::kRotating) return 0.0;
+  return angle_increment * path.scan_time / (2 * M_PI);
+}
+
+Eigen::Isometry3d poseAfter(const Eigen::Isometry3d& start, const Twist& twist, double t) {
+  const Eigen::Vector3d turn = twist.angular * t;
+  const double angle = turn.norm();
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = angle > 0
+                      ? Eigen::AngleAxisd(angle, turn / angle).toRotationMatrix() * start.linear()
+                      : Eigen::Matrix3d(start.linear());
+  pose.translation() = start.translation() + twist.linear * t;
+  return pose;
+}
+
+core::PoseSamples sweepSamples(const PathArgs& path, const Eigen::Isometry3d& start,
+                               const core::FramePoses& frames, const core::ScanPattern& pattern) {
+  const double increment = timeIncrement(path, pattern.angleIncrement());
+  core::PoseSamples samples;
+  for (int c = 0; c < pattern.azimuthCount(); ++c) {
+    const double t = c * increment;  // as Caster::castSweep reckons a column's time
+    samples.times.push_back(t);
+    samples.world_from_sensor.push_back(poseAfter(start, path.twist, t));
+    samples.frames.push_back(frames);
+  }
+  return samples;
 }
 
 }  // namespace tools

@@ -172,7 +172,8 @@ po::options_description flags(Args* args) {
           ->multitoken(),
       "joint values (rad or m; 0 if not given): several after one --joint, or one each");
   add("repeat", count("--repeat", &args->repeat),
-      "cast N more times after loading and print the median cast time to stderr");
+      "cast N more times after loading (the whole path) and print the median cast time of a "
+      "scan to stderr");
   add("threads",
       single("N",
              [args](const std::string& v) {
@@ -206,7 +207,7 @@ Args parseArgs(int argc, char** argv, bool* help) {
   if (*help) return args;
   const bool has_samples = values.count("samples"), has_increment = values.count("angle-increment");
   if (args.models.empty()) throw ArgError("give at least one --urdf");
-  laser_raycast::tools::checkPathFlags(values);
+  laser_raycast::tools::checkPathFlags(values, args.path);
   if (has_samples && has_increment) throw ArgError("give --samples or --angle-increment, not both");
   if (!has_samples && !has_increment) args.scan.fan.samples = core::FanSpec::kDefaultSamples;
   // The angles, the beam count, the range limits and the elevations: checked once, by the core.
@@ -221,6 +222,7 @@ Args parseArgs(int argc, char** argv, bool* help) {
   } catch (const std::invalid_argument& e) {
     throw ArgError(e.what());
   }
+  laser_raycast::tools::checkSweepTimes(args.path, args.scan.fan);
   return args;
 }
 
@@ -248,10 +250,14 @@ std::string formatAngle(double rad) {
 
 // The usage lines: each flag's choices from its name table.
 std::string synopsis() {
+  using laser_raycast::tools::Sweep;
+  const auto& sweeps = laser_raycast::tools::kSweepNames;
   const char* const indent = "                 ";
   std::ostringstream out;
   out << "usage: cast_scan --urdf PATH[@x,y,z,roll,pitch,yaw] [--urdf ...]\n"
       << indent << "(--sensor x,y,z,roll,pitch,yaw | --poses FILE)\n"
+      << indent << "[--sweep " << sweeps.name(Sweep::kInstant) << " | --sweep "
+      << sweeps.name(Sweep::kRotating) << " --scan-time S [--twist vx,vy,vz,wx,wy,wz]]\n"
       << indent << "[--angle-min RAD] [--angle-max RAD] [--samples N | --angle-increment RAD]\n"
       << indent << "[--range-min M] [--range-max M] [--geometry "
       << choices(laser_raycast::kGeometrySourceNames) << "]\n"
@@ -270,6 +276,7 @@ std::string notes() {
   out << "Prints CSV 'index,angle,range,link' (REP 117: inf, -inf, nan); with --elevations\n"
       << "'index,ring,elevation,angle,range,link' (ring 0 the lowest). With --poses, a scan\n"
       << "from each pose of FILE in turn, its rows led by 'pose' (0: the file's first pose line).\n"
+      << "With --sweep rotating, each row ends with 'time', s after the scan's first beam.\n"
       << "Defaults: angles " << formatAngle(scan.fan.angle_min) << ".."
       << formatAngle(scan.fan.angle_max) << ", " << core::FanSpec::kDefaultSamples
       << " samples, ranges " << formatNumber(scan.output.range_min) << ".."
@@ -341,14 +348,24 @@ struct Casting {
   core::ScanPattern pattern;
   core::CastConfig config;
   core::Caster caster;
+  double time_increment;  // s between two azimuth columns: > 0 for a rotating sweep
 };
 
-// The scan from sensor; *ns, if given, the time of the cast alone.
-const core::ScanResult& castFrom(const LoadedScene& loaded, const Eigen::Isometry3d& sensor,
-                                 Casting* casting, long long* ns) {
+// The scan from sensor, at once or as a rotating sweep starting there; *ns, if given, the time of
+// the cast alone (not of the sweep's samples).
+const core::ScanResult& castFrom(const Args& args, const LoadedScene& loaded,
+                                 const Eigen::Isometry3d& sensor, Casting* casting, long long* ns) {
+  const bool rotating = args.path.sweep == laser_raycast::tools::Sweep::kRotating;
+  core::PoseSamples samples;
+  if (rotating) {
+    samples = laser_raycast::tools::sweepSamples(args.path, sensor, loaded.poses, casting->pattern);
+  }
   const auto t0 = std::chrono::steady_clock::now();
   const core::ScanResult& result =
-      casting->caster.cast(loaded.scene, loaded.poses, sensor, casting->pattern, casting->config);
+      rotating ? casting->caster.castSweep(loaded.scene, samples, casting->pattern, casting->config,
+                                           casting->time_increment)
+               : casting->caster.cast(loaded.scene, loaded.poses, sensor, casting->pattern,
+                                      casting->config);
   const auto t1 = std::chrono::steady_clock::now();
   if (ns) *ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
   return result;
@@ -364,24 +381,27 @@ void reportMedianCastTime(const Args& args, const LoadedScene& loaded, Casting* 
   for (int k = 0; k < args.repeat; ++k) {
     for (const Eigen::Isometry3d& sensor : args.path.sensors) {
       casting->caster.forget();  // time the cast itself, not the reuse of an unchanged scan
-      castFrom(loaded, sensor, casting, &*next++);
+      castFrom(args, loaded, sensor, casting, &*next++);
     }
   }
   std::nth_element(ns.begin(), ns.begin() + ns.size() / 2, ns.end());
   std::cerr << "cast_ns_per_scan_median=" << ns[ns.size() / 2] << "\n";
 }
 
-// The CSV's header: with --poses, the pose's number first.
-std::string csvHeader(const Args& args) {
+// The CSV's header: with --poses, the pose's number first; with a rotating sweep, the beam's time
+// last.
+std::string csvHeader(const Args& args, const Casting& casting) {
   return std::string(args.path.pose_column ? "pose," : "") +
-         (args.rings ? "index,ring,elevation,angle,range,link\n" : "index,angle,range,link\n");
+         (args.rings ? "index,ring,elevation,angle,range,link" : "index,angle,range,link") +
+         (casting.time_increment > 0 ? ",time\n" : "\n");
 }
 
 // One CSV row per beam of the scan from the path's pose number `pose`, in beam order
 // (ring-major).
-std::string csvRows(const Args& args, const LoadedScene& loaded, const core::ScanPattern& pattern,
+std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& casting,
                     const core::ScanResult& result, std::size_t pose) {
   std::string out;
+  const core::ScanPattern& pattern = casting.pattern;
   const int azimuths = pattern.azimuthCount();
   for (int i = 0; i < pattern.size(); ++i) {
     const int ring = i / azimuths;
@@ -395,6 +415,9 @@ std::string csvRows(const Args& args, const LoadedScene& loaded, const core::Sca
     if (result.body[i] >= 0) {
       const std::string& label = loaded.scene.labels()[loaded.scene.bodies()[result.body[i]].label];
       out += loaded.prefixed ? label.substr(label.find('/') + 1) : label;
+    }
+    if (casting.time_increment > 0) {
+      out += "," + formatNumber(i % azimuths * casting.time_increment);  // castSweep's column time
     }
     out += "\n";
   }
@@ -429,13 +452,14 @@ int main(int argc, char** argv) {
     std::cerr << "cast_scan: " << e.what() << "\n";
     return kExitBadArguments;
   }
-  Casting casting{args.scan.pattern(), args.scan.castConfig(), core::Caster()};
+  Casting casting{args.scan.pattern(), args.scan.castConfig(), core::Caster(),
+                  laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment())};
   casting.config.threads = args.threads;
   // The path in order, each scan printed before the next is cast (the result is the caster's).
-  print(csvHeader(args));
+  print(csvHeader(args, casting));
   for (std::size_t p = 0; p < args.path.sensors.size(); ++p) {
-    print(csvRows(args, loaded, casting.pattern,
-                  castFrom(loaded, args.path.sensors[p], &casting, nullptr), p));
+    print(csvRows(args, loaded, casting,
+                  castFrom(args, loaded, args.path.sensors[p], &casting, nullptr), p));
   }
   if (args.repeat > 0) reportMedianCastTime(args, loaded, &casting);
   return 0;

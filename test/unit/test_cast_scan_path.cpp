@@ -1,8 +1,10 @@
-// cast_scan along a path, run as a user would: a scan from each pose of a --poses file. Expected
-// ranges are worked out by hand from test/data/cli_rings.urdf: a wall whose near face is the plane
-// x = 2 and a floor whose top is the plane z = -1, both 20 m wide.
+// cast_scan along a path, run as a user would: a scan from each pose of a --poses file, and
+// rotating sweeps of a sensor moving at a constant twist. Expected ranges are worked out by hand
+// from test/data/cli_rings.urdf: a wall whose near face is the plane x = 2 and a floor whose top is
+// the plane z = -1, both 20 m wide.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <regex>
 #include <string>
@@ -15,7 +17,7 @@ namespace laser_raycast_test {
 namespace {
 
 const std::string kRings = std::string(LASER_RAYCAST_SOURCE_DIR) + "/test/data/cli_rings.urdf";
-// Three beams: -0.4, 0, 0.4.
+// Three beams: -0.4, 0, 0.4. (The CSV's times, below 0.1 s here, carry 9 significant digits.)
 const std::string kThree = " --angle-min -0.4 --angle-max 0.4 --samples 3";
 
 struct PoseRow {
@@ -111,11 +113,151 @@ TEST(CastScanPath, PosesAndSensorAreExclusive) {
   expectBadArguments("--urdf " + kRings + " --poses " + poses + " --poses " + poses, "--poses");
 }
 
+struct SweepRow {
+  int index;
+  double angle;
+  std::string range, link;
+  double time;
+};
+
+std::vector<SweepRow> parseSweep(const std::string& csv) {
+  std::vector<SweepRow> rows;
+  for (const auto& f : csvRows(csv, "index,angle,range,link,time")) {
+    rows.push_back(SweepRow{std::stoi(f[0]), std::stod(f[1]), f[2], f[3], std::stod(f[4])});
+  }
+  return rows;
+}
+
+// Nine beams a quarter turn apart, from -pi; S = 0.1 s, so column c is taken at
+// c * (pi / 4) * 0.1 / (2 pi) = c * 0.0125 s, by then 1 m/s has carried the sensor c * 0.0125 m
+// towards the wall: the beams in front meet it at (2 - c * 0.0125) / cos(az), the others nothing.
+TEST(CastScanPath, RotatingSweepTowardsAWall) {
+  const CliRun run = runCli("--urdf " + kRings +
+                            " --sensor 0,0,0,0,0,0 --angle-min -3.141592653589793 --angle-max "
+                            "3.141592653589793 --samples 9 --sweep rotating --scan-time 0.1 "
+                            "--twist 1,0,0,0,0,0");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parseSweep(run.out);
+  ASSERT_EQ(rows.size(), 9u);
+  for (int c = 0; c < 9; ++c) {
+    const double az = -M_PI + c * M_PI / 4, t = c * 0.0125;
+    EXPECT_EQ(rows[c].index, c);
+    EXPECT_NEAR(rows[c].angle, az, 1e-8) << c;
+    EXPECT_NEAR(rows[c].time, t, 1e-10) << c;
+    if (std::abs(az) < M_PI / 2) {
+      EXPECT_NEAR(std::stod(rows[c].range), (2 - t) / std::cos(az), 1e-8) << c;
+      EXPECT_EQ(rows[c].link, "wall") << c;
+    } else {
+      EXPECT_EQ(rows[c].range, "inf") << c;
+    }
+  }
+  EXPECT_EQ(rows[4].range, "1.95");  // straight at the wall, 0.05 s (and m) after the first beam
+  EXPECT_EQ(rows[8].time, 0.1);      // the last beam a whole turn after the first
+}
+
+// The turn is about the fixed frame's axes, applied on the left: rolled a quarter turn, the sensor
+// scans the vertical plane y = 0, and turning about the world's z at 5 rad/s swings that plane
+// sideways by th = 5 t. Beam az then points along (cos az cos th, cos az sin th, sin az): the wall
+// at 2 / (cos az cos th), the floor below at 1 / sin(-az). (A turn about the sensor's own z would
+// tilt the beam within its plane instead, to 2 / cos(az + th).)
+TEST(CastScanPath, RotatingSweepTurnsAboutTheFixedAxes) {
+  const CliRun run = runCli("--urdf " + kRings +
+                            " --sensor 0,0,0,1.5707963267948966,0,0 --angle-min -0.6 --angle-max "
+                            "0.6 --samples 7 --sweep rotating --scan-time 0.1 --twist 0,0,0,0,0,5");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parseSweep(run.out);
+  ASSERT_EQ(rows.size(), 7u);
+  for (int c = 0; c < 7; ++c) {
+    const double az = -0.6 + 0.2 * c, t = c * 0.2 * 0.1 / (2 * M_PI), th = 5 * t;
+    const double wall = 2 / (std::cos(az) * std::cos(th));
+    const double floor = az < 0 ? 1 / std::sin(-az) : HUGE_VAL;
+    EXPECT_NEAR(rows[c].time, t, 1e-10) << c;
+    EXPECT_NEAR(std::stod(rows[c].range), std::min(wall, floor), 1e-8) << c;
+    EXPECT_EQ(rows[c].link, floor < wall ? "floor" : "wall") << c;
+  }
+  EXPECT_NEAR(std::stod(rows[6].range), 2.43434749, 1e-8);  // 2 / (cos 0.6 cos(0.3 / pi))
+}
+
+// Without motion a rotating sweep is the instant scan, with the time column; planar and in rings.
+TEST(CastScanPath, SweepWithoutTwistIsTheInstantScan) {
+  const std::string base = "--urdf " + kRings +
+                           " --sensor 0.3,-0.5,0.2,0.1,-0.05,0.4 --angle-min -1 --angle-max 1 "
+                           "--samples 21";
+  for (const std::string rings : {"", " --elevations -0.3,0,0.2"}) {
+    const std::string sweep_args = rings + " --sweep rotating --scan-time 0.05";
+    const CliRun instant = runCli(base + rings);
+    const CliRun sweep = runCli(base + sweep_args);
+    ASSERT_EQ(instant.status, 0) << instant.err;
+    ASSERT_EQ(sweep.status, 0) << sweep.err;
+    EXPECT_EQ(runCli(base + sweep_args + " --twist 0,0,0,0,0,0").out, sweep.out);
+    const std::string header =
+        rings.empty() ? "index,angle,range,link" : "index,ring,elevation,angle,range,link";
+    const auto a = csvRows(instant.out, header);
+    const auto b = csvRows(sweep.out, header + ",time");
+    ASSERT_EQ(a.size(), rings.empty() ? 21u : 63u);
+    ASSERT_EQ(b.size(), a.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::size_t range = a[i].size() - 2;  // then the link; before it, as printed
+      EXPECT_TRUE(std::equal(a[i].begin(), a[i].begin() + range, b[i].begin())) << i;
+      EXPECT_NEAR(std::stod(b[i][range]), std::stod(a[i][range]), 1e-9) << i;
+      EXPECT_EQ(b[i][range + 1], a[i][range + 1]) << i;
+      EXPECT_NEAR(std::stod(b[i].back()), i % 21 * 0.1 * 0.05 / (2 * M_PI), 1e-10) << i;
+    }
+  }
+}
+
+// Each pose of the file starts a sweep of its own at the same twist: pose p at x = p meets the wall
+// at (2 - p - t) / cos(az).
+TEST(CastScanPath, RotatingSweepFromEachPose) {
+  const std::string poses = writeFile("sweeps.txt", "0,0,0,0,0,0\n1,0.5,0,0,0,0\n");
+  const CliRun run = runCli("--urdf " + kRings + " --poses " + poses + kThree +
+                            " --sweep rotating --scan-time 0.1 --twist 1,0,0,0,0,0 --repeat 2");
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_TRUE(std::regex_search(run.err, std::regex("(^|\n)cast_ns_per_scan_median=[0-9]+\n")))
+      << run.err;
+  const auto rows = csvRows(run.out, "pose,index,angle,range,link,time");
+  ASSERT_EQ(rows.size(), 6u);
+  for (int i = 0; i < 6; ++i) {
+    const int pose = i / 3, c = i % 3;
+    const double az = -0.4 + 0.4 * c, t = c * 0.4 * 0.1 / (2 * M_PI);
+    EXPECT_EQ(rows[i][0], std::to_string(pose));
+    EXPECT_EQ(rows[i][1], std::to_string(c));
+    EXPECT_NEAR(std::stod(rows[i][3]), (2 - pose - t) / std::cos(az), 1e-8) << i;
+    EXPECT_NEAR(std::stod(rows[i][5]), t, 1e-10) << i;
+  }
+}
+
+TEST(CastScanPath, BadSweepsExitTwo) {
+  const std::string base = "--urdf " + kRings + " --sensor 0,0,0,0,0,0 ";
+  expectBadArguments(base + "--twist 1,0,0,0,0,0", "--twist: only with --sweep rotating");
+  expectBadArguments(base + "--sweep instant --twist 1,0,0,0,0,0",
+                     "--twist: only with --sweep rotating");
+  expectBadArguments(base + "--scan-time 0.1", "--scan-time: only with --sweep rotating");
+  expectBadArguments(base + "--sweep rotating", "--sweep rotating: give --scan-time");
+  expectBadArguments(base + "--sweep rotating --twist 1,0,0,0,0,0",
+                     "--sweep rotating: give --scan-time");
+  expectBadArguments(base + "--sweep spinning",
+                     "--sweep: 'spinning' is not one of instant, rotating");
+  const std::string rotating = base + "--sweep rotating --scan-time ";
+  expectBadArguments(rotating + "0", "--scan-time: '0' is not > 0 s");
+  expectBadArguments(rotating + "-0.1", "--scan-time: '-0.1' is not > 0 s");
+  expectBadArguments(rotating + "inf", "--scan-time: 'inf' is not a finite number");
+  expectBadArguments(rotating + "nan", "--scan-time: 'nan' is not a finite number");
+  expectBadArguments(rotating + "0.1 --twist 1,0,0", "--twist: '1,0,0' is not vx,vy,vz,wx,wy,wz");
+  expectBadArguments(rotating + "0.1 --twist 1,0,0,0,0,inf", "--twist: '1,0,0,0,0,inf'");
+  // Column times that doubles cannot tell apart, or that overflow.
+  expectBadArguments(rotating + "1e-323", "--scan-time: too short: every beam's time is 0 s");
+  expectBadArguments(rotating + "1e308 --samples 3",
+                     "--scan-time: too long: the last beam's time is not finite");
+}
+
 TEST(CastScanPath, HelpListsThePathFlags) {
   const CliRun run = runCli("--help");
   ASSERT_EQ(run.status, 0);
   for (const char* text :
-       {"(--sensor x,y,z,roll,pitch,yaw | --poses FILE)", "--poses FILE", "led by 'pose'"}) {
+       {"(--sensor x,y,z,roll,pitch,yaw | --poses FILE)", "--poses FILE",
+        "[--sweep instant | --sweep rotating --scan-time S [--twist vx,vy,vz,wx,wy,wz]]",
+        "--scan-time S", "--twist vx,vy,vz,wx,wy,wz", "led by 'pose'", "ends with 'time'"}) {
     EXPECT_NE(run.out.find(text), std::string::npos) << text << "\n" << run.out;
   }
 }
