@@ -271,7 +271,7 @@ class SliceWalk {
   // Which of two items hit at the same distance goes first (hit_order.h): the lower body, then the
   // lower triangle.
   bool before(const KeptSlice::Item& a, const KeptSlice::Item& b) const {
-    if (a.body != b.body) return a.body < b.body;
+    if (a.body != b.body) return a.body < b.body;  // before reading a.body's mesh for b's slot
     const auto& ids = meshOf(a.body).bvh().triangleIds();
     return tieBefore(a.body, ids[a.slot], b.body, ids[b.slot]);
   }
