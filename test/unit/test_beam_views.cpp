@@ -15,6 +15,7 @@
 #include "fan_specs.h"
 #include "laser_raycast/core/aabb.h"
 #include "beams/beam_set.h"
+#include "beams/column_motion.h"
 #include "beams/column_raster.h"
 #include "beams/edge_filter.h"
 #include "laser_raycast/core/mesh.h"
@@ -53,6 +54,34 @@ std::optional<long double> entry(const Eigen::Vector3d& lo, const Eigen::Vector3
   }
   if (t0 > t1) return std::nullopt;
   return t0;
+}
+
+// The same for a ray from `origin` (sensor frame) along d.
+std::optional<long double> entryFrom(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                     const Eigen::Isometry3d& sensor_from_body,
+                                     const Eigen::Vector3d& origin, const Eigen::Vector3d& d,
+                                     double tmax) {
+  Eigen::Isometry3d shifted = sensor_from_body;
+  shifted.translation() -= origin;  // the box as seen from the ray's origin
+  return entry(lo, hi, shifted, d, tmax);
+}
+
+// A sweep block's columns: each a random pose at most `shift` m and `turn` rad from the reference.
+core::ColumnMotion randomColumns(Rng& rng, int cols, double shift, double turn,
+                                 double steepest) {
+  std::vector<Eigen::Isometry3d> m(cols);
+  for (Eigen::Isometry3d& p : m) {
+    p = Eigen::Isometry3d::Identity();
+    p.linear() = Eigen::AngleAxisd(turn * uniform(rng, 0, 1), randomUnitVector(rng)).toRotationMatrix();
+    p.translation() = shift * uniform(rng, 0, 1) * randomUnitVector(rng);
+  }
+  return core::ColumnMotion(0, m, steepest);
+}
+
+double steepest(const core::ScanPattern& pattern) {
+  double e = 0;
+  for (double x : pattern.elevations()) e = std::max(e, std::abs(x));
+  return e;
 }
 
 // A few beam patterns: fans and rings.
@@ -152,42 +181,110 @@ TEST(NodeViews, EveryBeamThatEntersAChildBoxIsInItsWindow) {
       << window_columns << " window columns, " << entered_columns << " entered";
 }
 
-TEST(BoxView, EveryBeamThatEntersTheBoxIsInItsWindow) {
-  Rng rng(23);
+// Every beam that enters a random box is in its view's window, no nearer than its near distance;
+// with `spread`, each column's beams leave from a random pose near the sensor (a sweep block's
+// ColumnMotion) and the view is widened by the block's spread.
+void expectBoxViewsHoldEveryBeam(Rng& rng, bool spread, int boxes, long long min_inside) {
   long long inside = 0;
   for (const core::ScanPattern& pattern : patterns()) {
     FreshBeams fresh(pattern, core::CastConfig{});
-    core::BeamSet& beams = fresh.beams;
-    for (int i = 0; i < 400; ++i) {
+    const core::BeamGrid& grid = fresh.beams.grid();
+    for (int i = 0; i < boxes; ++i) {
       const Eigen::Vector3d center = uniformInCube(rng, 8);
       const Eigen::Vector3d half(uniform(rng, 0.01, 3), uniform(rng, 0.01, 3),
                                  uniform(rng, 0.01, 3));
       const Eigen::Isometry3d pose = randomPose(rng, 5);
+      const core::ColumnMotion motion =
+          spread ? randomColumns(rng, grid.cols(), uniform(rng, 0, 0.3), uniform(rng, 0, 0.1),
+                                 steepest(pattern))
+                 : randomColumns(rng, grid.cols(), 0, 0, 0);
       const Eigen::Matrix3d& r = pose.linear();
-      const core::View view = core::boxView(center, half, r, r.cwiseAbs(), pose.translation(),
-                                            pattern.angleMin(), !pattern.planar());
+      const core::View view =
+          core::boxView(center, half, r, r.cwiseAbs(), pose.translation(), pattern.angleMin(),
+                        !pattern.planar(), spread ? motion.spread() : core::Spread());
       std::set<int> reached;
       if (!pattern.planar() || view.crosses) {
-        beams.grid().forEachRect(view, beams.grid().all(), [&](const core::BeamRect& rect) {
+        grid.forEachRect(view, grid.all(), [&](const core::BeamRect& rect) {
           for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-            for (int col = rect.col_lo; col <= rect.col_hi; ++col)
-              reached.insert(beams.grid().beam(row, col));
+            for (int col = rect.col_lo; col <= rect.col_hi; ++col) reached.insert(grid.beam(row, col));
           }
         });
       }
-      for (int row = 0; row < beams.grid().rows(); ++row) {
-        for (int col = 0; col < beams.grid().cols(); ++col) {
-          const auto t = entry(center - half, center + half, pose, beams.grid().direction(row, col), kInf);
+      for (int row = 0; row < grid.rows(); ++row) {
+        for (int col = 0; col < grid.cols(); ++col) {
+          const core::Ray ray = motion.ray(col, grid.direction(row, col), 0.0);
+          const auto t = entryFrom(center - half, center + half, pose, ray.origin, ray.dir, kInf);
           if (!t) continue;
           ++inside;
-          EXPECT_TRUE(reached.count(beams.grid().beam(row, col))) << "box " << i;
+          EXPECT_TRUE(reached.count(grid.beam(row, col))) << "box " << i;
           EXPECT_LE(view.near, double(*t) * (1 + 1e-12));
         }
       }
-      if (HasFailure()) return;
+      if (::testing::Test::HasFailure()) return;
     }
   }
-  EXPECT_GT(inside, 10000);
+  EXPECT_GT(inside, min_inside);
+}
+
+TEST(BoxView, EveryBeamThatEntersTheBoxIsInItsWindow) {
+  Rng rng(23);
+  expectBoxViewsHoldEveryBeam(rng, false, 400, 10000);
+}
+
+TEST(BoxView, WithASpreadEveryColumnsBeamThatEntersTheBoxIsInItsWindow) {
+  Rng rng(37);
+  expectBoxViewsHoldEveryBeam(rng, true, 400, 8000);
+}
+
+// With a sweep block's spread (ColumnMotion): every beam of every column, from the column's own
+// pose, that enters a box is in the box's widened window, and no nearer than its near distance;
+// the float views of four children and the double view of one box alike.
+TEST(NodeViews, WithASpreadEveryColumnsBeamThatEntersAChildBoxIsInItsWindow) {
+  Rng rng(31);
+  long long inside = 0;
+  for (const core::ScanPattern& pattern : patterns()) {
+    FreshBeams fresh(pattern, core::CastConfig{});
+    const core::BeamGrid& grid = fresh.beams.grid();
+    for (int scene = 0; scene < 6; ++scene) {
+      const Soup s = scene % 2 ? clusteredSoup(rng, 200) : spreadSoup(rng, 200);
+      const core::Mesh mesh(s.vertices, s.triangles);
+      const Eigen::Isometry3d pose = randomPose(rng, 6);
+      const core::ColumnMotion motion =
+          randomColumns(rng, grid.cols(), uniform(rng, 0, 0.3), uniform(rng, 0, 0.1),
+                        steepest(pattern));
+      const core::ViewBasis frame(pose, pattern.planar(), 30.0, motion.spread());
+      for (const core::WideBvh::Node& node : mesh.wideBvh().nodes()) {
+        core::NodeViews views;
+        views.compute(node, frame);
+        for (int k = 0; k < core::WideBvh::kWidth; ++k) {
+          if (node.index[k] == core::WideBvh::kEmpty) continue;
+          const Eigen::Vector3d lo(node.lo[0][k], node.lo[1][k], node.lo[2][k]);
+          const Eigen::Vector3d hi(node.hi[0][k], node.hi[1][k], node.hi[2][k]);
+          std::set<int> reached;
+          if (views.mask & (1 << k)) {
+            grid.forEachChildRect(views, k, grid.all(), [&](const core::BeamRect& r) {
+              for (int row = r.row_lo; row <= r.row_hi; ++row) {
+                for (int col = r.col_lo; col <= r.col_hi; ++col) reached.insert(grid.beam(row, col));
+              }
+            });
+          }
+          for (int row = 0; row < grid.rows(); ++row) {
+            for (int col = 0; col < grid.cols(); ++col) {
+              const core::Ray ray = motion.ray(col, grid.direction(row, col), 0.0);
+              const auto t = entryFrom(lo, hi, pose, ray.origin, ray.dir, 30.0);
+              if (!t) continue;
+              ++inside;
+              EXPECT_TRUE(reached.count(grid.beam(row, col)))
+                  << "row " << row << " col " << col << " enters child " << k;
+              EXPECT_LE(views.near[k], double(*t) * (1 + 1e-12));
+            }
+          }
+          if (HasFailure()) return;
+        }
+      }
+    }
+  }
+  EXPECT_GT(inside, 5000);
 }
 
 // Random triangles near the sensor and far, large and tiny, some through the sensor's axis; each
@@ -218,7 +315,7 @@ void setRandomRanges(Rng& rng, core::BeamSet* beams) {
 // The candidates a filter gave, and the beams that must be among them.
 template <class Candidates>
 void expectEveryKeptHitACandidate(Rng& rng, const core::ScanPattern& pattern, Candidates&& run,
-                                  long long* hits) {
+                                  long long* hits, const core::ColumnMotion* motion = nullptr) {
   core::CastConfig config;
   config.tmax = 25;
   FreshBeams fresh(pattern, config);
@@ -235,6 +332,7 @@ void expectEveryKeptHitACandidate(Rng& rng, const core::ScanPattern& pattern, Ca
         passed += candidate[beams.grid().beam(row, col)];
         core::Ray ray;
         ray.dir = beams.grid().direction(row, col);
+        if (motion) ray = motion->ray(col, ray.dir, 0.0);  // a sweep's beam from its column
         ray.tmax = std::min(config.tmax, beams.range(row, col));
         if (!core::intersectTriangle<core::TriangleMethod::kWatertight>(ray, t.a, t.b, t.c)) {
           continue;
@@ -246,7 +344,9 @@ void expectEveryKeptHitACandidate(Rng& rng, const core::ScanPattern& pattern, Ca
     }
     if (::testing::Test::HasFailure()) return;
   }
-  EXPECT_LT(passed, tested / 4);  // and it does filter
+  // And it does filter (less for a sweep's block: triangles within a few shifts of the sensor let
+  // every beam through).
+  EXPECT_LT(passed, motion ? tested / 2 : tested / 4);
 }
 
 TEST(EdgeFilter, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
@@ -268,6 +368,40 @@ TEST(EdgeFilter, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
 }
 
 // The same for the column raster, on a lidar's rings and on rings up to its steepest elevation.
+// Widened for a sweep block (ColumnMotion): every beam from its column's pose whose exact hit could
+// be kept is a candidate, with the triangle's plane distance as the near distance.
+TEST(ColumnRaster, WithASpreadLetsThroughEveryColumnsBeamWhoseExactHitCouldBeKept) {
+  Rng rng(47);
+  std::vector<double> lidar;
+  for (int r = 0; r < 16; ++r) lidar.push_back(-0.27 + 0.54 * r / 15);
+  for (const auto& rings : {lidar, std::vector<double>{0.0}}) {
+    const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 512), rings);
+    long long hits = 0;
+    for (int trial = 0; trial < 4; ++trial) {
+      const core::ColumnMotion motion = randomColumns(rng, pattern.azimuthCount(),
+                                                      uniform(rng, 0, 0.05), uniform(rng, 0, 0.03),
+                                                      steepest(pattern));
+      const core::Spread& spread = motion.spread();
+      expectEveryKeptHitACandidate(
+          rng, pattern,
+          [&](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
+            const Eigen::Vector3d n = (t.b - t.a).cross(t.c - t.a);
+            const double near = std::abs(n.dot(t.a)) / n.norm();
+            const double widen =
+                near > 2 * spread.shift
+                    ? std::sin(std::min(M_PI / 2, spread.turn + std::asin(spread.shift / near)))
+                    : 1.0;
+            core::ColumnRaster(beams, t.a, t.b, t.c, widen, spread.shift, spread.turn)
+                .forEachCandidate(beams, beams.grid().all(),
+                                  [&](int row, int col) { mark(row, col); });
+          },
+          &hits, &motion);
+      if (HasFailure()) return;
+    }
+    EXPECT_GT(hits, 1000);
+  }
+}
+
 TEST(ColumnRaster, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
   Rng rng(43);
   std::vector<double> lidar, steep;

@@ -17,6 +17,8 @@
 namespace laser_raycast {
 namespace core {
 
+struct CasterState;  // src/core/caster/caster_state.h
+
 class Caster {
  public:
   Caster();
@@ -46,10 +48,9 @@ class Caster {
   void forget();
 
  private:
-  struct State;  // caster.cpp: the scene's index, the walk's buffers, the threads, kept slices
-
   ScanResult result_;
-  std::unique_ptr<State> state_;
+  // The scene's index, the walk's buffers, the threads, the kept slices.
+  std::unique_ptr<CasterState> state_;
 };
 
 }  // namespace core

@@ -30,6 +30,8 @@ struct PoseSamples {
   // either neighbouring sample's is not; a frame is invalid if it is invalid in either.
   Eigen::Isometry3d sensorAt(double t) const;
   void framesAt(double t, FramePoses* out) const;
+  // One frame's pose at time t as framesAt gives it; false (and *pose untouched) if it is invalid.
+  bool frameAt(double t, std::size_t frame, Eigen::Isometry3d* pose) const;
 
  private:
   // The samples around t and the fraction of the way from the first to the second.

@@ -26,20 +26,47 @@ View sphereView(const Eigen::Vector3d& center, double radius, double angle_min) 
   return v;
 }
 
+Spread Spread::of(double shift, double turn, double tilt, double steepest) {
+  Spread s;
+  // The offsets and angles were computed in double from poses a few roundings off: a relative
+  // widening of 1e-9 and an absolute one far above double's rounding at these magnitudes.
+  s.shift = shift > 0 ? shift * (1 + 1e-9) + 1e-12 : 0;
+  s.turn = turn > 0 ? turn * (1 + 1e-9) + 1e-12 : 0;
+  s.tilt = tilt > 0 ? tilt * (1 + 1e-9) + 1e-12 : 0;
+  // Two unit vectors at most `turn` apart, both within E of the horizontal, have horizontal
+  // parts of length >= cos E whose angle b satisfies cos E sin b <= 2 sin(turn / 2) (the chord).
+  const double e = std::min(M_PI / 2, steepest + s.turn);
+  const double chord = 2 * std::sin(s.turn / 2) * (1 + 4 * kEps);
+  const double cos_e = std::cos(e) * (1 - 4 * kEps);
+  s.azimuth = s.turn == 0 ? 0
+              : chord < 0.5 * cos_e ? std::asin(chord / cos_e) * (1 + 4 * kEps) + 4 * kEps
+                                    : std::numeric_limits<double>::infinity();
+  return s;
+}
+
 View boxView(const Eigen::Vector3d& center, const Eigen::Vector3d& half, const Eigen::Matrix3d& rot,
              const Eigen::Matrix3d& abs_rot, const Eigen::Vector3d& trans, double angle_min,
-             bool elevations) {
+             bool elevations, const Spread& spread) {
   View v;
   const Eigen::Vector3d c = rot * center + trans;
-  // The sensor-frame bounding box, widened for the rounding of c and e (a few ulps of the terms).
+  // The sensor-frame bounding box, widened for the rounding of c and e (a few ulps of the terms),
+  // and by the spread's shift.
   Eigen::Vector3d e = abs_rot * half;
   e += 4 * kEps * (abs_rot * center.cwiseAbs() + trans.cwiseAbs() + e);
+  e.array() += spread.shift;
   const Eigen::Vector3d gap = (c.cwiseAbs() - e).cwiseMax(0.0);
   const double magnitude = c.cwiseAbs().sum() + e.sum();
   v.near = std::max(0.0, gap.norm() * (1 - 4 * kEps) - kNearSlack * magnitude);
-  v.crosses = std::abs(c.z()) <= e.z();
+  // A point of a tilted column's plane is at most (its distance + shift) sin(tilt) above the
+  // reference plane (beyond the shift, which e holds).
+  v.crosses = std::abs(c.z()) <= e.z() + (magnitude + spread.shift) * std::sin(spread.tilt);
   const double r_xy = std::sqrt(e.x() * e.x() + e.y() * e.y()) * (1 + 4 * kEps);
   v.azimuth_limited = azimuthWindow(c, r_xy, angle_min, &v.azimuth_start, &v.azimuth_width);
+  if (v.azimuth_limited && spread.azimuth > 0) {
+    v.azimuth_width += 2 * spread.azimuth;
+    v.azimuth_start = wrapToTurn(v.azimuth_start - spread.azimuth);
+    v.azimuth_limited = v.azimuth_width < M_PI;
+  }
   if (!elevations) {
     v.elevation_lo = -M_PI / 2;
     v.elevation_hi = M_PI / 2;
@@ -52,8 +79,8 @@ View boxView(const Eigen::Vector3d& center, const Eigen::Vector3d& half, const E
   const double rho_min = std::max(0.0, (rho - r_xy) * (1 - 4 * kEps));
   const double rho_max = (rho + r_xy) * (1 + 4 * kEps);
   const double z_lo = c.z() - e.z(), z_hi = c.z() + e.z();
-  v.elevation_hi = approxAtan2(z_hi, z_hi > 0 ? rho_min : rho_max) + kBearingError;
-  v.elevation_lo = approxAtan2(z_lo, z_lo < 0 ? rho_min : rho_max) - kBearingError;
+  v.elevation_hi = approxAtan2(z_hi, z_hi > 0 ? rho_min : rho_max) + kBearingError + spread.turn;
+  v.elevation_lo = approxAtan2(z_lo, z_lo < 0 ? rho_min : rho_max) - kBearingError - spread.turn;
   return v;
 }
 

@@ -131,13 +131,30 @@ struct View {
   double elevation_lo, elevation_hi;    // rad
 };
 
+// How far the beams of a block of a rotating sweep stray from the pose they are culled from
+// (beams/column_motion.h): each beam leaves from its own column's pose, at most `shift` m from the
+// reference origin and turned by at most `turn` rad from its pattern direction, its column's z axis
+// tilted by at most `tilt` rad. A view of a box is widened to hold every such beam that meets it:
+// the box grown by `shift` on each axis (which holds every origin's offset), its elevations by
+// `turn`, its azimuths by `azimuth` (the most a turn of `turn` moves the azimuth of a direction at
+// most `steepest` rad from the horizontal; infinite: every azimuth), and its crossing of the scan
+// plane by the tilt. All zero: a scan from one pose, nothing widened.
+struct Spread {
+  double shift = 0, turn = 0, tilt = 0, azimuth = 0;
+  bool any() const { return shift > 0 || turn > 0; }
+  // From the largest offset, turn and tilt of a block's columns (each widened here for the
+  // rounding of how they were found) and the steepest beam of the pattern (rad from horizontal).
+  static Spread of(double shift, double turn, double tilt, double steepest);
+};
+
 // The view of a sphere; of a box given by its centre and half extents in a frame whose pose in the
 // sensor frame is (rot, trans) (abs_rot: rot with its entries' magnitudes). The box view bounds the
-// box by its sensor-frame bounding box.
+// box by its sensor-frame bounding box; with a spread, the view holds every beam of it that meets
+// the box.
 View sphereView(const Eigen::Vector3d& center, double radius, double angle_min);
 View boxView(const Eigen::Vector3d& center, const Eigen::Vector3d& half, const Eigen::Matrix3d& rot,
              const Eigen::Matrix3d& abs_rot, const Eigen::Vector3d& trans, double angle_min,
-             bool elevations);
+             bool elevations, const Spread& spread = Spread());
 
 }  // namespace core
 }  // namespace laser_raycast

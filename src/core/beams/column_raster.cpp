@@ -2,6 +2,8 @@
 
 #include <limits>
 
+#include "util/float_rounding.h"
+
 namespace laser_raycast {
 namespace core {
 namespace {
@@ -13,7 +15,7 @@ constexpr double kSmallest = 1e-30;
 }  // namespace
 
 ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                           const Eigen::Vector3d& c) {
+                           const Eigen::Vector3d& c, double widen, double shift, double turn) {
   // In double: a small or far triangle's edge normals cancel far beyond float's precision.
   const Eigen::Vector3d m[3] = {b.cross(c), c.cross(a), a.cross(b)};
   const double det = a.dot(m[0]);
@@ -21,7 +23,7 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
   // The 1-norms bound the 2-norms from above, so this flags a few more triangles than the ratio
   // says: they are tested with every beam of the rect.
   all_ = !(abs_det > kEdgeOnRatio * a.lpNorm<1>() * b.lpNorm<1>() * c.lpNorm<1>()) ||
-         !(abs_det > kSmallest);
+         !(abs_det > kSmallest) || !(widen < 0.5);
   if (all_) return;
   const double sign = det > 0 ? 1 : -1;
   const __m128 ones = _mm_castsi128_ps(_mm_set1_epi32(-1)), none = _mm_setzero_ps();
@@ -35,7 +37,8 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
     upper_[k] = z < 0 ? ones : none;
     flat_[k] = z == 0 ? ones : none;
   }
-  edge_margin_ = _mm_set1_ps(kMargin / beams.grid().smallestRowCos());
+  edge_margin_ = _mm_set1_ps(
+      floatAbove((kMargin + widen * (1 + 1e-6)) / beams.grid().smallestRowCos()));
   // The plane's normal (b - a) x (c - a) is the sum of the edge normals, and its dot product with
   // a is det.
   const Eigen::Vector3d plane = m[0] + m[1] + m[2];
@@ -43,7 +46,9 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
   nx_ = _mm_set1_ps(static_cast<float>(plane.x() * scale));
   ny_ = _mm_set1_ps(static_cast<float>(plane.y() * scale));
   nz_ = static_cast<float>(plane.z() * scale);
-  plane_distance_ = static_cast<float>(abs_det * scale * (1 - kMargin));
+  plane_distance_ = static_cast<float>(
+      std::max(0.0, abs_det * scale * (1 - kMargin) - shift * (1 + 1e-6)));
+  if (turn > 0) along_margin_ = floatAbove(kMargin + turn * (1 + 1e-6));
 }
 
 }  // namespace core

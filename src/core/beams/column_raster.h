@@ -14,6 +14,14 @@
 //
 // A beam is also held back when its current range is clearly nearer than the triangle's plane
 // along it (t = |n.a| / |n.d| for the plane's normal n): such a hit could not be kept.
+//
+// For a block of a rotating sweep (beams/column_motion.h), whose beams leave from poses near the
+// reference one, `widen` is sin(alpha): a beam turned by at most `turn` from d and leaving from at
+// most `shift` from the sensor meets the triangle only if d lies within alpha = turn +
+// asin(shift / near) of the triangle's cone from the sensor (near: no point of it is nearer), so
+// within sin(alpha) of each unit edge plane, and |m|_2 <= |m|_1 = 1 makes that m.d >= -sin(alpha).
+// The range test then takes the plane's distance from the sensor less `shift` (no origin is nearer
+// to the plane by more) over |n.d| plus `turn` (|n.d' - n.d| <= |d' - d| <= turn for the scaled n).
 #pragma once
 
 #include <emmintrin.h>
@@ -36,7 +44,7 @@ class ColumnRaster {
  public:
   // a, b, c in the sensor frame. The pattern's rows must allow it (BeamGrid::columnRaster()).
   ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-               const Eigen::Vector3d& c);
+               const Eigen::Vector3d& c, double widen = 0, double shift = 0, double turn = 0);
 
   // Calls f(row, col) for every beam of rect that may hit the triangle nearer than its current
   // range: row by row in a rect of fewer than kRowMajorRows rows, else column by column.
@@ -73,6 +81,7 @@ class ColumnRaster {
   // The plane: normal (scaled), |n.a| rounded down.
   __m128 nx_, ny_;
   float nz_, plane_distance_;
+  float along_margin_ = kMargin;  // kMargin, plus a sweep block's turn
 };
 
 template <class F>
@@ -138,7 +147,7 @@ void ColumnRaster::forEachCandidate(const BeamSet& beams, const BeamRect& rect, 
 template <class F>
 void ColumnRaster::scanRows(const BeamSet& beams, const BeamRect& rect, const Group* groups, int n,
                             F&& f) const {
-  const __m128 margin = _mm_set1_ps(kMargin), distance = _mm_set1_ps(plane_distance_);
+  const __m128 margin = _mm_set1_ps(along_margin_), distance = _mm_set1_ps(plane_distance_);
   const __m128 nz = _mm_set1_ps(nz_);
   for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
     const __m128 tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(row));
@@ -181,7 +190,8 @@ void ColumnRaster::scanColumns(const BeamSet& beams, const BeamRect& rect, const
       for (int row = row_lo; row <= row_hi; ++row) {
         // Written so that a NaN range (a beam that could not be cast) is never held back.
         const float along =
-            std::abs(beams.grid().rowCos(row) * hn_v[j] + nz_ * beams.grid().rowSin(row)) + kMargin;
+            std::abs(beams.grid().rowCos(row) * hn_v[j] + nz_ * beams.grid().rowSin(row)) +
+            along_margin_;
         if (plane_distance_ > beams.rangeAbove(row)[col] * along) continue;
         f(row, col);
       }

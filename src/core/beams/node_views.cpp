@@ -41,8 +41,15 @@ void storeElevations(const __m128 c[3], const __m128 e[3], __m128 rho2, __m128 r
 
 }  // namespace
 
-ViewBasis::ViewBasis(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax)
+ViewBasis::ViewBasis(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax,
+                     const Spread& spread)
     : planar_(planar) {
+  spread_ = spread.any();
+  shift_ = _mm_set1_ps(floatAbove(spread.shift));
+  sin_tilt_ = _mm_set1_ps(floatAbove(std::sin(spread.tilt) * (1 + 1e-9)));
+  turn_ = _mm_set1_ps(floatAbove(spread.turn));
+  azimuth_all_ = !(spread.azimuth < 1.5);
+  azimuth_ = _mm_set1_ps(azimuth_all_ ? 0.0f : floatAbove(spread.azimuth));
   const Eigen::Matrix3d& r = sensor_from_body.linear();
   const Eigen::Vector3d& t = sensor_from_body.translation();
   for (int i = 0; i < 3; ++i) {
@@ -77,6 +84,7 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewBasis& f) {
     c[i] = ci;
     mag[i] = m;
     e[i] = _mm_add_ps(ei, _mm_mul_ps(slack, _mm_add_ps(m, ei)));
+    if (f.spread_) e[i] = _mm_add_ps(e[i], f.shift_);  // every origin of the block's beams
   }
   // Nearest distance: the norm of the gap between the sensor and the box, lowered by the slack.
   // If the squares overflow, the largest gap is still a lower bound.
@@ -95,7 +103,14 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewBasis& f) {
 
   // Present, within tmax, and (planar) meeting the plane.
   __m128 ok = _mm_cmple_ps(near, f.tmax_);
-  if (f.planar_) ok = _mm_and_ps(ok, _mm_cmple_ps(absPs(c[2]), e[2]));
+  if (f.planar_ && !f.spread_) ok = _mm_and_ps(ok, _mm_cmple_ps(absPs(c[2]), e[2]));
+  if (f.planar_ && f.spread_) {
+    // A tilted column's plane rises at most (distance + shift) sin(tilt) above the reference one;
+    // magnitude bounds the distance, and the factor the rounding of the product.
+    const __m128 rise = _mm_mul_ps(_mm_add_ps(magnitude, f.shift_), f.sin_tilt_);
+    const __m128 reach = _mm_mul_ps(_mm_add_ps(e[2], rise), _mm_set1_ps(1 + 8 * kViewSlack));
+    ok = _mm_and_ps(ok, _mm_cmple_ps(absPs(c[2]), reach));
+  }
   mask = _mm_movemask_ps(ok) & node.presentMask();
   if (!mask) return;
 
@@ -109,9 +124,26 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewBasis& f) {
   __m128 half = _mm_mul_ps(_mm_div_ps(_mm_sqrt_ps(r2), denom), _mm_set1_ps(1 + 8 * kViewSlack));
   __m128 center = atan2Ps(c[1], c[0]);
   // The circle is loose (up to 1.4 times a square box's azimuths, many times a long box's seen end
-  // on): the corners' x, y narrow it (simd::CornerTangents). A corner is the centre plus or minus
-  // the three rotated half extents; each of its x, y is a few roundings off, at most the slack
-  // times that axis's magnitude.
+  // on): the corners narrow it, but not with a spread, whose shift can move a corner too far for
+  // the narrowing's bound.
+  if (!f.spread_) narrowByCorners(f, c, eb, mag, rho2, &center, &half);
+  half = _mm_add_ps(half, _mm_set1_ps(static_cast<float>(2 * kBearingError)));
+  if (f.spread_) half = _mm_add_ps(half, f.azimuth_);
+  __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
+  if (f.azimuth_all_) narrow = _mm_setzero_ps();
+  _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
+  _mm_store_ps(az_center, center);
+  if (f.planar_) return;
+  storeElevations(c, e, rho2, r2, el_lo, el_hi);
+  if (!f.spread_) return;
+  _mm_store_ps(el_lo, _mm_sub_ps(_mm_load_ps(el_lo), f.turn_));
+  _mm_store_ps(el_hi, _mm_add_ps(_mm_load_ps(el_hi), f.turn_));
+}
+
+void NodeViews::narrowByCorners(const ViewBasis& f, const __m128 c[3], const __m128 eb[3],
+                                const __m128 mag[3], __m128 rho2, __m128* center, __m128* half) {
+  // A corner is the centre plus or minus the three rotated half extents; each of its x, y is a
+  // few roundings off, at most the slack times that axis's magnitude.
   __m128 px[3], py[3];
   for (int k = 0; k < 3; ++k) {
     px[k] = _mm_mul_ps(f.rot_[0][k], eb[k]);
@@ -126,13 +158,8 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewBasis& f) {
     }
     corners.add(x, y, c[0], c[1], rho2);
   }
-  corners.narrow(_mm_mul_ps(slack, _mm_add_ps(mag[0], mag[1])), rho2, &center, &half);
-  half = _mm_add_ps(half, _mm_set1_ps(static_cast<float>(2 * kBearingError)));
-  const __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
-  _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
-  _mm_store_ps(az_center, center);
-  if (f.planar_) return;
-  storeElevations(c, e, rho2, r2, el_lo, el_hi);
+  corners.narrow(_mm_mul_ps(_mm_set1_ps(kViewSlack), _mm_add_ps(mag[0], mag[1])), rho2, center,
+                 half);
 }
 
 int planeMask(const WideBvh::Node& node, const ViewBasis& f) {

@@ -11,6 +11,8 @@
 #include <Eigen/Geometry>
 
 #include "accel/wide_bvh.h"
+#include "beams/beam_window.h"
+#include "util/float_rounding.h"
 
 namespace laser_raycast {
 namespace core {
@@ -18,14 +20,20 @@ namespace core {
 // A body's pose relative to the sensor, prepared for node views.
 class ViewBasis {
  public:
-  // planar: only whether a box meets the sensor's xy plane matters, not its elevations.
-  ViewBasis(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax);
+  // planar: only whether a box meets the sensor's xy plane matters, not its elevations. spread:
+  // the beams of a sweep's block leave from poses near the reference one (beam_window.h).
+  ViewBasis(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax,
+            const Spread& spread = Spread());
 
  private:
   friend struct NodeViews;
   friend int planeMask(const WideBvh::Node& node, const ViewBasis& basis);
   __m128 rot_[3][3], abs_rot_[3][3], trans_[3], abs_trans_[3];
   __m128 tmax_;
+  // The spread, rounded outwards to float: the shift, sin(tilt), the elevations' and the
+  // azimuths' widening (azimuth_all_: every azimuth).
+  __m128 shift_, sin_tilt_, turn_, azimuth_;
+  bool spread_ = false, azimuth_all_ = false;
   bool planar_;
 };
 
@@ -39,6 +47,11 @@ struct NodeViews {
 
   // Fills the views of node's children.
   void compute(const WideBvh::Node& node, const ViewBasis& basis);
+
+ private:
+  // The azimuth windows narrowed by the boxes' corners (simd::CornerTangents).
+  static void narrowByCorners(const ViewBasis& f, const __m128 c[3], const __m128 eb[3],
+                              const __m128 mag[3], __m128 rho2, __m128* center, __m128* half);
 };
 
 // Which of node's children may meet the sensor's xy plane (bit k for child k): the cheap part of

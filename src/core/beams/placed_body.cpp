@@ -17,10 +17,11 @@ void placeSensorInBody(PlacedBody* a) {
   a->sensor_in_body = -(a->body_from_sensor_rot * a->sensor_from_body.translation());
 }
 
-void viewPlacedBody(const Scene& scene, double angle_min, bool elevations, PlacedBody* a) {
+void viewPlacedBody(const Scene& scene, double angle_min, bool elevations, PlacedBody* a,
+                    const Spread& spread) {
   const Eigen::Matrix3d& rot = a->sensor_from_body.linear();
   a->view = boxView(scene.boxCenter(a->index), scene.boxHalf(a->index), rot, rot.cwiseAbs(),
-                    a->sensor_from_body.translation(), angle_min, elevations);
+                    a->sensor_from_body.translation(), angle_min, elevations, spread);
   placeSensorInBody(a);
 }
 

@@ -10,6 +10,7 @@
 namespace laser_raycast {
 namespace core {
 
+class ColumnMotion;
 struct ScanPlane;
 
 struct PlacedBody {
@@ -24,15 +25,19 @@ struct PlacedBody {
   // body is in that frame: a mesh is cut there, as a kept slice of the frame is.
   const ScanPlane* plane = nullptr;
   Eigen::Isometry3d frame_from_body = Eigen::Isometry3d::Identity();
+  // A block of a rotating sweep: each column's beams leave from the column's own pose
+  // (column_motion.h); the view above is widened by its spread. Null for a scan from one pose.
+  const ColumnMotion* motion = nullptr;
 };
 
 // A body placed in steps, so that a walk can cull by the cheap one first: its pose relative to the
 // sensor and its bounding sphere there (placeBody); then the sensor in the body's frame (what the
 // exact tests need, placeSensorInBody); then how its box looks from the sensor (with elevation
-// windows if `elevations`; viewPlacedBody does both).
+// windows if `elevations`, widened by a sweep block's spread; viewPlacedBody does both).
 PlacedBody placeBody(const Scene& scene, int index, const Eigen::Isometry3d& sensor_from_frame);
 void placeSensorInBody(PlacedBody* a);
-void viewPlacedBody(const Scene& scene, double angle_min, bool elevations, PlacedBody* a);
+void viewPlacedBody(const Scene& scene, double angle_min, bool elevations, PlacedBody* a,
+                    const Spread& spread = Spread());
 
 }  // namespace core
 }  // namespace laser_raycast

@@ -11,15 +11,11 @@
 #include <thread>
 #include <vector>
 
-#include "beams/beam_set.h"
 #include "beams/beam_window.h"
-#include "walk/mesh_walk.h"
-#include "slice/kept_slice.h"
-#include "walk/slice_walk.h"
+#include "caster/caster_state.h"
 #include "laser_raycast/core/pose.h"
-#include "scene/scene_index.h"
 #include "walk/frame_walk.h"
-#include "util/thread_pool.h"
+#include "walk/slice_walk.h"
 
 namespace laser_raycast {
 namespace core {
@@ -79,40 +75,8 @@ std::vector<BeamRect> cutPieces(int rows, int columns, int threads) {
 }
 
 
-// What a result was computed from: if all of it is equal, the result is too.
-struct ReuseKey {
-  std::uint64_t scene_version = 0;
-  CastConfig config;
-  double angle_min = 0, angle_increment = 0;
-  int azimuths = 0;
-  std::vector<double> elevations;
-  std::vector<Eigen::Isometry3d> sensor_from_frame;  // meaningful where valid
-  std::vector<char> valid;
+}  // namespace
 
-  bool operator==(const ReuseKey& o) const {
-    if (scene_version != o.scene_version || !(config == o.config) || angle_min != o.angle_min ||
-        angle_increment != o.angle_increment || azimuths != o.azimuths ||
-        elevations != o.elevations || valid != o.valid) {
-      return false;
-    }
-    for (std::size_t f = 0; f < sensor_from_frame.size(); ++f) {
-      if (valid[f] && sensor_from_frame[f].matrix() != o.sensor_from_frame[f].matrix()) {
-        return false;
-      }
-    }
-    return true;
-  }
-};
-
-// A scene frame with bodies this scan, with its pose in the sensor frame.
-struct PlacedGroup {
-  const SceneIndex::Group* group;
-  const Eigen::Isometry3d* sensor_from_frame;
-  double near;
-};
-
-// Every frame relative to the sensor, in double, once per scan (so that a scene far from the origin
-// loses nothing), together with everything else the result depends on.
 ReuseKey relativeInputs(const Scene& scene, const FramePoses& poses,
                         const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
                         const CastConfig& config) {
@@ -159,27 +123,7 @@ void computeIncidence(const ScanPattern& pattern, ScanResult* result) {
   }
 }
 
-}  // namespace
-
-// What a caster keeps between casts: the scene's body trees (rebuilt when the scene changes), the
-// walk's per-scan state (kept to reuse its memory), the threads, the kept slices and the inputs of
-// the last result.
-struct Caster::State {
-  std::unique_ptr<SceneIndex> index;
-  std::vector<PlacedGroup> placed;
-  std::vector<std::atomic<char>> cast;  // per body: cast against this scan (for the stats)
-  BeamSet beams;
-  std::unique_ptr<ThreadPool> pool;           // for CastConfig::threads > 1
-  std::unique_ptr<KeptSlices> planes;    // CastConfig::keep_slices
-  std::optional<ReuseKey> previous;           // the inputs of the result, if it is complete
-
-  void placeGroups(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,
-                   ScanResult* result);
-  void castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,
-                  ScanResult* result);
-};
-
-Caster::Caster() : state_(std::make_unique<State>()) {}
+Caster::Caster() : state_(std::make_unique<CasterState>()) {}
 Caster::~Caster() = default;
 Caster::Caster(Caster&&) noexcept = default;
 Caster& Caster::operator=(Caster&&) noexcept = default;
@@ -208,7 +152,7 @@ const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
               config.compute_incidence, &result_);
   if (!sensor_ok) return result_;
 
-  state_->placeGroups(scene, key, pattern, &result_);
+  state_->placeGroups(scene, key, pattern, &state_->placed, &result_.stats.bodies_skipped);
   // The walks offer each hit to the BeamSet reset here on result_; BeamSet::keepNearestHit
   // (beams/beam_set.h) decides every beam's range, body and triangle.
   state_->castBodies(scene, pattern, config, &result_);
@@ -217,17 +161,23 @@ const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
   return result_;
 }
 
-// Where each frame's body tree is this scan, nearest first; the bodies of frames without a pose
-// are skipped.
-void Caster::State::placeGroups(const Scene& scene, const ReuseKey& key,
-                                const ScanPattern& pattern, ScanResult* result) {
+const SceneIndex& CasterState::indexOf(const Scene& scene) {
   if (!index || index->sceneVersion() != scene.version()) {
     index = std::make_unique<SceneIndex>(scene);
   }
+  return *index;
+}
+
+// Where each frame's body tree is this scan, nearest first; the bodies of frames without a pose
+// are skipped.
+void CasterState::placeGroups(const Scene& scene, const ReuseKey& key,
+                                const ScanPattern& pattern, std::vector<PlacedGroup>* out,
+                                int* skipped) {
+  std::vector<PlacedGroup>& placed = *out;
   placed.clear();
-  for (const auto& group : index->groups()) {
+  for (const auto& group : indexOf(scene).groups()) {
     if (!key.valid[group->frame]) {
-      result->stats.bodies_skipped += static_cast<int>(group->bodies.size());
+      *skipped += static_cast<int>(group->bodies.size());
       continue;
     }
     const Eigen::Isometry3d& pose = key.sensor_from_frame[group->frame];
@@ -243,12 +193,8 @@ void Caster::State::placeGroups(const Scene& scene, const ReuseKey& key,
 
 // Every frame's bodies, nearest frame first, against the open beams of the pattern; with threads,
 // each thread takes pieces of the pattern's columns (all rows) in turn.
-void Caster::State::castBodies(const Scene& scene, const ScanPattern& pattern,
+void CasterState::castBodies(const Scene& scene, const ScanPattern& pattern,
                                const CastConfig& config, ScanResult* result) {
-  beams.reset(pattern, config, result);
-  const std::size_t bodies = scene.bodies().size();
-  if (cast.size() != bodies) cast = std::vector<std::atomic<char>>(bodies);
-  for (auto& mark : cast) mark.store(0, std::memory_order_relaxed);
   KeptSlices* kept = nullptr;
   if (pattern.planar() && config.planar_fast_path && config.keep_slices) {
     if (!planes) planes = std::make_unique<KeptSlices>();
@@ -264,7 +210,7 @@ void Caster::State::castBodies(const Scene& scene, const ScanPattern& pattern,
       result->stats.kept_slices += slices.back().second != nullptr;
     }
   }
-  auto castWithin = [&](const BeamRect& within) {
+  castOnThreads(scene, pattern, config, result, [&](const BeamRect& within) {
     for (std::size_t g = 0; g < placed.size(); ++g) {
       const PlacedGroup& p = placed[g];
       if (g < slices.size() && slices[g].second) {
@@ -274,7 +220,16 @@ void Caster::State::castBodies(const Scene& scene, const ScanPattern& pattern,
         walkFrame(beams, scene, *p.group, *p.sensor_from_frame, config, within, &cast);
       }
     }
-  };
+  });
+}
+
+void CasterState::castOnThreads(const Scene& scene, const ScanPattern& pattern,
+                                  const CastConfig& config, ScanResult* result,
+                                  const std::function<void(const BeamRect&)>& castWithin) {
+  beams.reset(pattern, config, result);
+  const std::size_t bodies = scene.bodies().size();
+  if (cast.size() != bodies) cast = std::vector<std::atomic<char>>(bodies);
+  for (auto& mark : cast) mark.store(0, std::memory_order_relaxed);
   int threads = config.threads;
   if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   // Waking threads costs more than a small scan does: each gets at least kMinBeamsPerThread.

@@ -1,14 +1,173 @@
 // Caster::castSweep: a rotating scan, each azimuth column cast from the poses at its own time.
+//
+// The columns are cast in blocks: a block is walked once, as a scan from the poses at its middle
+// column's time (its reference), with windows widened by how far its columns' poses stray from the
+// reference (beams/column_motion.h, the Spread of beams/beam_window.h), and every beam is tested
+// exactly as the ray its column's poses give it. So a sweep costs about what a scan from one pose
+// does, and each beam's range is the one its column's own cast would give (to the rounding of
+// double).
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
+#include "caster/caster_state.h"
 #include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/pose.h"
+#include "walk/frame_walk.h"
 
 namespace laser_raycast {
 namespace core {
+namespace {
+
+// How the columns are cut into blocks. These change only the speed, never a range: a wider block
+// pays for its columns' spread with wider windows, a narrower one walks the scene's trees more
+// often. A block is halved while its poses turn by more than kMaxBlockTurn or move by more than
+// kMaxBlockShift, or a frame's pose or the sensor's is valid at some of its columns only.
+constexpr int kBlockColumns = 32;
+constexpr double kMaxBlockTurn = 0.02;   // rad
+constexpr double kMaxBlockShift = 0.05;  // m
+
+// The poses of a sweep's columns: the sensor's, and each frame with bodies (static frames, at one
+// pose in every sample, are not interpolated).
+class ColumnPoses {
+ public:
+  ColumnPoses(const Scene& scene, const SceneIndex& index, const PoseSamples& samples,
+              int columns, double time_increment)
+      : samples_(samples), dt_(time_increment) {
+    sensor_.resize(columns);
+    sensor_valid_.resize(columns);
+    for (int c = 0; c < columns; ++c) {
+      sensor_[c] = samples.sensorAt(c * dt_);
+      sensor_valid_[c] = isValidPose(sensor_[c]);
+    }
+    static_.assign(scene.frames().size(), 0);
+    for (const auto& group : index.groups()) {
+      const int f = group->frame;
+      frames_.push_back(f);
+      bool same = true;
+      for (const FramePoses& sample : samples.frames) {
+        same = same && sample.valid[f] && isValidPose(sample.pose[f]) &&
+               sample.pose[f].matrix() == samples.frames.front().pose[f].matrix();
+      }
+      static_[f] = same;
+    }
+  }
+
+  double time(int col) const { return col * dt_; }
+  bool sensorValid(int col) const { return sensor_valid_[col]; }
+  const Eigen::Isometry3d& sensor(int col) const { return sensor_[col]; }
+  const std::vector<int>& framesWithBodies() const { return frames_; }
+  bool isStatic(int frame) const { return static_[frame]; }
+  bool frameAt(int col, int frame, Eigen::Isometry3d* pose) const {
+    if (static_[frame]) {
+      *pose = samples_.frames.front().pose[frame];
+      return true;
+    }
+    return samples_.frameAt(time(col), frame, pose);
+  }
+
+ private:
+  const PoseSamples& samples_;
+  double dt_;
+  std::vector<Eigen::Isometry3d> sensor_;
+  std::vector<char> sensor_valid_;
+  std::vector<int> frames_;
+  std::vector<char> static_;
+};
+
+class BlockPlanner {
+ public:
+  BlockPlanner(const Scene& scene, const ColumnPoses& poses, const PoseSamples& samples,
+               const ScanPattern& pattern, const CastConfig& config)
+      : scene_(scene), poses_(poses), samples_(samples), pattern_(pattern), config_(config) {
+    for (double e : pattern.elevations()) steepest_ = std::max(steepest_, std::abs(e));
+  }
+
+  // Blocks over [lo, hi], every column of which has a sensor pose, in column order.
+  void plan(int lo, int hi, std::vector<SweepBlock>* out) {
+    for (int start = lo; start <= hi; start += kBlockColumns) {
+      split(start, std::min(hi, start + kBlockColumns - 1), out);
+    }
+  }
+
+ private:
+  // The block [lo, hi], or its halves if it strays too far or its frames' validity changes.
+  void split(int lo, int hi, std::vector<SweepBlock>* out) {
+    SweepBlock block;
+    if (make(lo, hi, &block) || lo == hi) {
+      out->push_back(std::move(block));
+      return;
+    }
+    const int mid = lo + (hi - lo) / 2;
+    split(lo, mid, out);
+    split(mid + 1, hi, out);
+  }
+
+  // False if the block should be halved (a single column never is: its reference is itself).
+  bool make(int lo, int hi, SweepBlock* block) {
+    const int ref = lo + (hi - lo) / 2;
+    block->col_lo = lo;
+    block->col_hi = hi;
+    FramePoses frames;
+    samples_.framesAt(poses_.time(ref), &frames);
+    block->key = relativeInputs(scene_, frames, poses_.sensor(ref), pattern_, config_);
+    block->motion.assign(scene_.frames().size(), nullptr);
+    std::shared_ptr<const ColumnMotion> static_motion;
+    for (int f : poses_.framesWithBodies()) {
+      if (!block->key.valid[f]) continue;
+      if (poses_.isStatic(f)) {
+        // A frame that stays put: each column's pose relative to the reference is the sensor's.
+        if (!static_motion) static_motion = sensorMotion(lo, hi, ref);
+        block->motion[f] = static_motion;
+        continue;
+      }
+      std::vector<Eigen::Isometry3d> ref_from_column(hi - lo + 1);
+      for (int c = lo; c <= hi; ++c) {
+        Eigen::Isometry3d world_from_frame;
+        if (!poses_.frameAt(c, f, &world_from_frame)) return false;  // not valid throughout
+        const Eigen::Isometry3d column_from_frame = relativePose(poses_.sensor(c), world_from_frame);
+        ref_from_column[c - lo] = block->key.sensor_from_frame[f] * column_from_frame.inverse();
+      }
+      block->motion[f] = std::make_shared<ColumnMotion>(lo, std::move(ref_from_column), steepest_);
+      if (!small(*block->motion[f])) return false;
+    }
+    // A frame valid at some column but not at the reference: halved until it is one or the other.
+    for (int f : poses_.framesWithBodies()) {
+      if (block->key.valid[f] || poses_.isStatic(f)) continue;
+      Eigen::Isometry3d unused;
+      for (int c = lo; c <= hi; ++c) {
+        if (poses_.frameAt(c, f, &unused)) return false;
+      }
+    }
+    return !static_motion || small(*static_motion);
+  }
+
+  std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
+    std::vector<Eigen::Isometry3d> ref_from_column(hi - lo + 1);
+    for (int c = lo; c <= hi; ++c) {
+      ref_from_column[c - lo] = relativePose(poses_.sensor(ref), poses_.sensor(c));
+    }
+    return std::make_shared<ColumnMotion>(lo, std::move(ref_from_column), steepest_);
+  }
+
+  static bool small(const ColumnMotion& m) {
+    return m.spread().turn <= kMaxBlockTurn && m.spread().shift <= kMaxBlockShift;
+  }
+
+  const Scene& scene_;
+  const ColumnPoses& poses_;
+  const PoseSamples& samples_;
+  const ScanPattern& pattern_;
+  const CastConfig& config_;
+  double steepest_ = 0;
+};
+
+}  // namespace
 
 const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& samples,
                                     const ScanPattern& pattern, const CastConfig& config,
@@ -20,46 +179,56 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
     msg << "time_increment must be finite and >= 0 s, got " << time_increment;
     throw std::invalid_argument(msg.str());
   }
-  // Each column is cast on its own, as a two-azimuth fan whose first azimuth is the column's (the
-  // same angle, so the same directions bit for bit), from the poses at its time.
-  const int azimuths = pattern.azimuthCount(), rings = pattern.ringCount();
-  const int beams = pattern.size();
-  const bool with_normals = config.compute_incidence;
-  ScanResult out;
-  out.range.assign(beams, std::numeric_limits<double>::quiet_NaN());
-  out.body.assign(beams, -1);
-  out.triangle.assign(beams, -1);
-  if (with_normals) {
-    out.normal.assign(beams, Eigen::Vector3d::Zero());
-    out.cos_incidence.assign(beams, 0.0);
+  forget();  // a sweep is never reused, and the last single cast is not this one
+  const int azimuths = pattern.azimuthCount();
+  const ColumnPoses poses(scene, state_->indexOf(scene), samples, azimuths, time_increment);
+  // Blocks over each run of columns with a sensor pose; the others' beams are NaN.
+  BlockPlanner planner(scene, poses, samples, pattern, config);
+  std::vector<SweepBlock> blocks;
+  for (int c = 0; c < azimuths;) {
+    if (!poses.sensorValid(c)) {
+      ++c;
+      continue;
+    }
+    int end = c;
+    while (end + 1 < azimuths && poses.sensorValid(end + 1)) ++end;
+    planner.plan(c, end, &blocks);
+    c = end + 1;
   }
-  out.stats.bodies = static_cast<int>(scene.bodies().size());
-  Caster column_caster;
-  FramePoses frames;
+  resetResult(pattern.size(), static_cast<int>(scene.bodies().size()), true,
+              config.compute_incidence, &result_);
+  for (SweepBlock& block : blocks) {
+    int skipped = 0;
+    state_->placeGroups(scene, block.key, pattern, &block.placed, &skipped);
+    result_.stats.bodies_skipped = std::max(result_.stats.bodies_skipped, skipped);
+  }
+  state_->castBlocks(scene, blocks, pattern, config, &result_);
+  const int rows = pattern.ringCount();
   for (int c = 0; c < azimuths; ++c) {
-    const double t = c * time_increment;
-    samples.framesAt(t, &frames);
-    FanSpec column;
-    column.angle_min = pattern.azimuth(c);
-    column.angle_max = pattern.azimuth(c) + pattern.angleIncrement();
-    column.samples = 2;
-    const ScanPattern one(column, pattern.elevations());
-    const ScanResult& r = column_caster.cast(scene, frames, samples.sensorAt(t), one, config);
-    for (int ring = 0; ring < rings; ++ring) {
-      const int from = ring * 2, to = ring * azimuths + c;
-      out.range[to] = r.range[from];
-      out.body[to] = r.body[from];
-      out.triangle[to] = r.triangle[from];
-      if (with_normals) {
-        out.normal[to] = r.normal[from];
-        out.cos_incidence[to] = r.cos_incidence[from];
+    if (poses.sensorValid(c)) continue;
+    for (int ring = 0; ring < rows; ++ring) {
+      result_.range[ring * azimuths + c] = std::numeric_limits<double>::quiet_NaN();
+    }
+  }
+  if (config.compute_incidence) computeIncidence(pattern, &result_);
+  return result_;
+}
+
+void CasterState::castBlocks(const Scene& scene, const std::vector<SweepBlock>& blocks,
+                               const ScanPattern& pattern, const CastConfig& config,
+                               ScanResult* result) {
+  castOnThreads(scene, pattern, config, result, [&](const BeamRect& within) {
+    for (const SweepBlock& block : blocks) {
+      BeamRect rect = within;
+      rect.col_lo = std::max(rect.col_lo, block.col_lo);
+      rect.col_hi = std::min(rect.col_hi, block.col_hi);
+      if (rect.empty()) continue;
+      for (const PlacedGroup& p : block.placed) {
+        walkFrame(beams, scene, *p.group, *p.sensor_from_frame, config, rect, &cast,
+                  block.motion[p.group->frame].get());
       }
     }
-    out.stats.bodies_skipped = std::max(out.stats.bodies_skipped, r.stats.bodies_skipped);
-  }
-  forget();  // a sweep is never reused, and the last single cast is not this one
-  result_ = std::move(out);
-  return result_;
+  });
 }
 
 }  // namespace core

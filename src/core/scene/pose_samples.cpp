@@ -75,19 +75,23 @@ Eigen::Isometry3d PoseSamples::sensorAt(double t) const {
 }
 
 void PoseSamples::framesAt(double t, FramePoses* out) const {
-  std::size_t i, j;
-  double s;
-  bracket(t, &i, &j, &s);
-  const std::size_t n = frames[i].pose.size();
+  const std::size_t n = frames.front().pose.size();
   out->pose.resize(n);
   out->valid.assign(n, 0);
   for (std::size_t f = 0; f < n; ++f) {
-    const bool ok = frames[i].valid[f] && frames[j].valid[f] && isValidPose(frames[i].pose[f]) &&
-                    isValidPose(frames[j].pose[f]);
-    out->valid[f] = ok;
-    out->pose[f] = ok ? interpolatePose(frames[i].pose[f], frames[j].pose[f], s)
-                      : Eigen::Isometry3d::Identity();
+    out->pose[f] = Eigen::Isometry3d::Identity();
+    out->valid[f] = frameAt(t, f, &out->pose[f]);
   }
+}
+
+bool PoseSamples::frameAt(double t, std::size_t f, Eigen::Isometry3d* pose) const {
+  std::size_t i, j;
+  double s;
+  bracket(t, &i, &j, &s);
+  const bool ok = frames[i].valid[f] && frames[j].valid[f] && isValidPose(frames[i].pose[f]) &&
+                  isValidPose(frames[j].pose[f]);
+  if (ok) *pose = interpolatePose(frames[i].pose[f], frames[j].pose[f], s);
+  return ok;
 }
 
 }  // namespace core

@@ -17,16 +17,19 @@ class FrameWalk {
  public:
   FrameWalk(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
             const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
-            std::vector<std::atomic<char>>* cast)
+            std::vector<std::atomic<char>>* cast, const ColumnMotion* motion)
       : beams_(beams),
         scene_(scene),
         group_(group),
         sensor_from_frame_(sensor_from_frame),
         config_(config),
         cast_(cast),
+        motion_(motion),
+        spread_(motion ? motion->spread() : Spread()),
         planar_(beams.grid().pattern().planar()),
-        basis_(sensor_from_frame, planar_, config.tmax) {
-    if (planar_) plane_.emplace(sensor_from_frame);
+        basis_(sensor_from_frame, planar_, config.tmax, spread_) {
+    // A sweep's planar beams are traced, not sliced (their planes differ from column to column).
+    if (planar_ && !motion) plane_.emplace(sensor_from_frame);
   }
 
   void run(const BeamRect& within) {
@@ -35,7 +38,8 @@ class FrameWalk {
     const Eigen::Matrix3d& rot = sensor_from_frame_.linear();
     const View view =
         boxView(bounds.center(), bounds.extent() * 0.5, rot, rot.cwiseAbs(),
-                sensor_from_frame_.translation(), beams_.grid().pattern().angleMin(), !planar_);
+                sensor_from_frame_.translation(), beams_.grid().pattern().angleMin(), !planar_,
+                spread_);
     if (!(view.near <= config_.tmax) || (planar_ && !view.crosses)) return;
     beams_.grid().forEachRect(view, within, [&](const BeamRect& rect) {
       push(Entry{group_.wide.root(), rect, floatBelow(view.near), -1});
@@ -102,9 +106,11 @@ class FrameWalk {
     // The sphere first: a cheap answer for bodies out of range.
     PlacedBody a = placeBody(scene_, index, sensor_from_frame_);
     const double dist = a.center.norm();
-    const double slack = kWindowSlack * (dist + a.radius + config_.tmax);
-    if (dist - a.radius > config_.tmax + slack || dist + a.radius < config_.tmin - slack) return;
-    viewPlacedBody(scene_, beams_.grid().pattern().angleMin(), !planar_, &a);
+    const double radius = a.radius + spread_.shift;  // from every origin of a sweep's block
+    const double slack = kWindowSlack * (dist + radius + config_.tmax);
+    if (dist - radius > config_.tmax + slack || dist + radius < config_.tmin - slack) return;
+    viewPlacedBody(scene_, beams_.grid().pattern().angleMin(), !planar_, &a, spread_);
+    a.motion = motion_;
     if (!(a.view.near <= config_.tmax) || (planar_ && !a.view.crosses)) return;
     if (plane_) {
       a.plane = &*plane_;
@@ -123,6 +129,8 @@ class FrameWalk {
   const Eigen::Isometry3d sensor_from_frame_;
   const CastConfig& config_;
   std::vector<std::atomic<char>>* cast_;
+  const ColumnMotion* motion_;
+  const Spread spread_;
   const bool planar_;
   const ViewBasis basis_;
   std::optional<ScanPlane> plane_;  // planar fans: the scan plane in the frame
@@ -142,8 +150,9 @@ class FrameWalk {
 
 void walkFrame(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
-               const BeamRect& within, std::vector<std::atomic<char>>* cast) {
-  FrameWalk(beams, scene, group, sensor_from_frame, config, cast).run(within);
+               const BeamRect& within, std::vector<std::atomic<char>>* cast,
+               const ColumnMotion* motion) {
+  FrameWalk(beams, scene, group, sensor_from_frame, config, cast, motion).run(within);
 }
 
 }  // namespace core

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "beams/beam_set.h"
+#include "beams/column_motion.h"
 #include "laser_raycast/core/cast_config.h"
 #include "scene/scene_index.h"
 
@@ -15,10 +16,13 @@ namespace laser_raycast {
 namespace core {
 
 // Casts the open beams of `within` against the bodies of group, placed by sensor_from_frame. Sets
-// cast[b] for each body b it casts against (several walks may set them at once).
+// cast[b] for each body b it casts against (several walks may set them at once). With a motion
+// (a block of a rotating sweep, `within` inside its columns), sensor_from_frame is the block's
+// reference pose and each column's beams leave from the column's own pose.
 void walkFrame(BeamSet& beams, const Scene& scene, const SceneIndex::Group& group,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
-               const BeamRect& within, std::vector<std::atomic<char>>* cast);
+               const BeamRect& within, std::vector<std::atomic<char>>* cast,
+               const ColumnMotion* motion = nullptr);
 
 }  // namespace core
 }  // namespace laser_raycast

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 
+#include "beams/column_motion.h"
 #include "beams/column_raster.h"
 #include "geometry/hit_order.h"
 #include "beams/edge_filter.h"
@@ -73,13 +74,17 @@ class MeshWalk {
         rot_(active.sensor_from_body.linear()),
         abs_rot_(rot_.cwiseAbs()),
         trans_(active.sensor_from_body.translation()),
+        motion_(active.motion),
+        spread_(motion_ ? motion_->spread() : Spread()),
         planar_(beams.grid().pattern().planar()),
-        slicing_(planar_ && config.planar_fast_path),
+        // A sweep's beams leave from their columns' poses, each in its own plane: traced.
+        slicing_(planar_ && config.planar_fast_path && !motion_),
         // Without the fast paths every beam is traced from the root, as the reference.
         tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
-        basis_(active.sensor_from_body, planar_, config.tmax),
+        basis_(active.sensor_from_body, planar_, config.tmax, spread_),
         origin_(active.sensor_in_body, mesh.bvh().bounds(), config.tmin) {
-    closed_ = !slicing_ && mesh.hasClosedComponents();
+    // Which back faces are hidden depends on where the sensor is: not decided for a sweep's block.
+    closed_ = !slicing_ && !motion_ && mesh.hasClosedComponents();
     if (slicing_) {
       // Cut in the frame's plane coordinates when the walk gives them (as a kept slice is).
       if (active.plane) {
@@ -96,7 +101,7 @@ class MeshWalk {
     if (wide_.empty()) return;
     const Aabb& bounds = wide_.binary().bounds();
     const View view = boxView(bounds.center(), bounds.extent() * 0.5, rot_, abs_rot_, trans_,
-                              beams_.grid().pattern().angleMin(), !planar_);
+                              beams_.grid().pattern().angleMin(), !planar_, spread_);
     if (!(view.near <= config_.tmax)) return;
     stack_.clear();
     const Entry root{wide_.root(), BeamRect{}, floatBelow(view.near), wide_.rootTriangles()};
@@ -135,6 +140,8 @@ class MeshWalk {
         sliceLeaf(e.ref, e.rect, e.near);
       } else if (beams <= kLeafDirectBeams) {
         testLeaf(e);
+      } else if (motion_ && !beams_.grid().columnRaster()) {
+        windowLeaf(e);
       } else {
         rasterLeaf(e);
       }
@@ -209,12 +216,35 @@ class MeshWalk {
 
   void offer(int row, int col, const Best& best) {
     beams_.keepNearestHit(row, col, best.t, active_.index, static_cast<int>(best.triangle), [&] {
-      return slicing_ ? slicer_->sensorNormal(best.slot) : sensorNormal(best.triangle);
+      if (slicing_) return slicer_->sensorNormal(best.slot);
+      const Eigen::Vector3d n = sensorNormal(best.triangle);
+      return motion_ ? motion_->toColumn(col, n) : n;
     });
+  }
+
+  // A sweep's beam (row, col) as its column's ray in the reference sensor frame, for the tests.
+  PreparedRay<double, M> columnRay(int row, int col) const {
+    return PreparedRay<double, M>(
+        motion_->ray(col, beams_.grid().rebuiltDirection(row, col), config_.tmin),
+        config_.cull_backfaces);
+  }
+  // The beam as a ray in the body's frame, for box tests: from the sensor, or a sweep's column.
+  WideBoxRay::Origin columnOrigin(int col) const {
+    if (!motion_) return origin_;
+    const Eigen::Vector3d o = active_.body_from_sensor_rot * motion_->refFromColumn(col).translation() +
+                              active_.sensor_in_body;
+    return WideBoxRay::Origin(o, mesh_.bvh().bounds(), config_.tmin);
+  }
+  WideBoxRay columnBoxRay(const WideBoxRay::Origin& origin, const Ray& ray) const {
+    return WideBoxRay(origin, active_.body_from_sensor_rot * ray.dir);
   }
 
   // Each open beam of the rect through the node's subtree, one ray at a time.
   void traceRect(const Entry& e) {
+    if (motion_) {
+      traceColumns(e);
+      return;
+    }
     for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
@@ -228,15 +258,39 @@ class MeshWalk {
         } else {
           const auto ray = beams_.grid().template sensorRay<M>(row, col);
           traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
-            if (hidden(slot)) return;
-            const SensorTriangle& s = cachedTriangle(slot);
-            const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
-            if (hit && best.improves(hit->t, ids_[slot])) {
-              best = Best{hit->t, ids_[slot], slot};
-              tmax = hit->t;
-            }
+            if (!hidden(slot)) testSlot(ray, slot, &tmax, &best);
           });
         }
+        if (best.found()) offer(row, col, best);
+      }
+    }
+  }
+
+  // A traced beam against a slot's triangle: a nearer hit (or as near on a lower triangle) becomes
+  // its best so far and its far limit.
+  LASER_RAYCAST_HOT_INLINE void testSlot(const PreparedRay<double, M>& ray, std::uint32_t slot,
+                                         double* tmax, Best* best) {
+    const SensorTriangle& s = cachedTriangle(slot);
+    const auto hit = ray.intersect(s.a, s.b, s.c, *tmax);
+    if (hit && best->improves(hit->t, ids_[slot])) {
+      *best = Best{hit->t, ids_[slot], slot};
+      *tmax = hit->t;
+    }
+  }
+
+  // traceRect for a sweep's block: column by column, each column's beams from its own origin.
+  void traceColumns(const Entry& e) {
+    for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
+      const WideBoxRay::Origin origin = columnOrigin(col);
+      for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
+        const double range = beams_.range(row, col);
+        if (!(range >= e.near)) continue;
+        double tmax = std::min(config_.tmax, range);
+        const Ray r = motion_->ray(col, beams_.grid().rebuiltDirection(row, col), config_.tmin);
+        const PreparedRay<double, M> ray(r, config_.cull_backfaces);
+        Best best;
+        traceWide(wide_, e.ref, columnBoxRay(origin, r), &tmax,
+                  [&](std::uint32_t slot) { testSlot(ray, slot, &tmax, &best); });
         if (best.found()) offer(row, col, best);
       }
     }
@@ -276,7 +330,8 @@ class MeshWalk {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
         if (!(range >= e.near)) continue;
-        const auto ray = beams_.grid().template sensorRay<M>(row, col);
+        const auto ray =
+            motion_ ? columnRay(row, col) : beams_.grid().template sensorRay<M>(row, col);
         double tmax = std::min(config_.tmax, range);
         Best best;
         for (std::uint32_t i = 0; i < e.ref.count; ++i) {
@@ -299,6 +354,10 @@ class MeshWalk {
   // patterns too steep for it row by row (EdgeFilter), then the exact test for the beams let
   // through.
   void rasterLeaf(const Entry& e) {
+    if (motion_) {
+      rasterColumns(e);
+      return;
+    }
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
       if (hidden(slot)) continue;
       const SensorTriangle s = sensorTriangle(slot);
@@ -323,6 +382,57 @@ class MeshWalk {
         filter.forEachCandidate(beams_, row, e.rect.col_lo, e.rect.col_hi,
                                 [&](int col) { test(row, col); });
       }
+    }
+  }
+
+  // rasterLeaf for a sweep's block: the column raster widened by the block's spread (with the
+  // leaf's near distance, which no triangle of it is nearer than), each candidate tested from its
+  // column's pose.
+  void rasterColumns(const Entry& e) {
+    const double shift = spread_.shift, near = e.near;
+    const double widen = near > 2 * shift
+                             ? std::sin(std::min(M_PI / 2, spread_.turn + std::asin(shift / near)))
+                             : 1.0;
+    for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
+      const SensorTriangle s = sensorTriangle(slot);
+      const std::uint32_t triangle = ids_[slot];
+      const ColumnRaster raster(beams_, s.a, s.b, s.c, widen, shift, spread_.turn);
+      raster.forEachCandidate(beams_, e.rect, [&](int row, int col) {
+        const double range = beams_.range(row, col);
+        if (!(range >= e.near)) return;
+        const auto hit = columnRay(row, col).intersect(s.a, s.b, s.c, std::min(config_.tmax, range));
+        if (!hit) return;
+        beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
+                              [&] { return motion_->toColumn(col, sensorNormal(triangle)); });
+      });
+    }
+  }
+
+  // For patterns too steep for the column raster: each triangle against the open beams of its own window (the
+  // view of its sensor-frame box, widened by the block's spread), each from its column's pose.
+  void windowLeaf(const Entry& e) {
+    const double angle_min = beams_.grid().pattern().angleMin();
+    for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
+      const SensorTriangle s = sensorTriangle(slot);
+      const Eigen::Vector3d lo = s.a.cwiseMin(s.b).cwiseMin(s.c), hi = s.a.cwiseMax(s.b).cwiseMax(s.c);
+      const View view = boxView((lo + hi) * 0.5, (hi - lo) * 0.5, Eigen::Matrix3d::Identity(),
+                                Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), angle_min,
+                                !planar_, spread_);
+      if (!(view.near <= config_.tmax) || (planar_ && !view.crosses)) continue;
+      const std::uint32_t triangle = ids_[slot];
+      beams_.grid().forEachRect(view, e.rect, [&](const BeamRect& rect) {
+        for (int col = rect.col_lo; col <= rect.col_hi; ++col) {
+          for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
+            const double range = beams_.range(row, col);
+            if (!(range >= view.near)) continue;
+            const auto hit = columnRay(row, col).intersect(s.a, s.b, s.c,
+                                                           std::min(config_.tmax, range));
+            if (!hit) continue;
+            beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
+                                  [&] { return motion_->toColumn(col, sensorNormal(triangle)); });
+          }
+        }
+      });
     }
   }
 
@@ -370,6 +480,8 @@ class MeshWalk {
   const CastConfig& config_;
   const Eigen::Matrix3d rot_, abs_rot_;
   const Eigen::Vector3d trans_;
+  const ColumnMotion* motion_;  // a sweep's block, or null
+  const Spread spread_;
   const bool planar_, slicing_, tracing_only_;
   SlotCache<SensorTriangle, 64> triangles_;
   SlotCache<bool, 256> hidden_;

@@ -9,6 +9,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "beams/column_motion.h"
 #include "laser_raycast/core/primitives.h"
 #include "util/simd_math.h"
 
@@ -99,13 +100,20 @@ void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
   Ray ray;
   ray.origin = a.sensor_in_body;
   ray.dir = a.body_from_sensor_rot * beams.grid().direction(row, col);
+  if (a.motion) {  // a sweep's beam, from its column's pose
+    const Ray column = a.motion->ray(col, beams.grid().direction(row, col), config.tmin);
+    ray.origin = a.body_from_sensor_rot * column.origin + a.sensor_in_body;
+    ray.dir = a.body_from_sensor_rot * column.dir;
+  }
   ray.tmin = config.tmin;
   ray.tmax = std::min(config.tmax, current);
   // The beams are valid rays (a unit direction, a finite pose): no check needed.
   const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
   if (!hit) return;
-  beams.keepNearestHit(row, col, hit->t, a.index, -1,
-              [&] { return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal); });
+  beams.keepNearestHit(row, col, hit->t, a.index, -1, [&] {
+    const Eigen::Vector3d n = a.sensor_from_body.linear() * hit->normal;
+    return a.motion ? a.motion->toColumn(col, n) : n;
+  });
 }
 
 // The open beams of rect that the pre-test lets through against one primitive, analytically.
@@ -124,7 +132,8 @@ void castShape(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
       // skipped before the pre-test (not less than: NaN counts as open).
       int open = _mm_movemask_ps(_mm_cmpnlt_ps(r, near));
       if (!open) continue;
-      open &= ~filter.misses(_mm_loadu_ps(x + base), _mm_loadu_ps(y + base), z, r);
+      // The pre-test knows the beams from the sensor only: a sweep's are tested directly.
+      if (!a.motion) open &= ~filter.misses(_mm_loadu_ps(x + base), _mm_loadu_ps(y + base), z, r);
       while (open) {
         const int col = base + __builtin_ctz(static_cast<unsigned>(open));
         open &= open - 1;

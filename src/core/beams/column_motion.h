@@ -1,0 +1,52 @@
+// The beams of a block of a rotating sweep's columns, each from its own column's pose, written in
+// the sensor frame of one reference pose that the block is culled from (Caster::castSweep). For one
+// scene frame: column c's beams start at refFromColumn(c) * 0 and point along
+// refFromColumn(c).linear() * d, d the pattern's direction, which is the ray the sensor cast at
+// column c's time against that frame where it was then. The walks cull the block as one scan from
+// the reference pose with windows widened by spread() (beam_window.h), and test each beam exactly
+// as this ray.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "beams/beam_window.h"
+#include "laser_raycast/core/ray.h"
+
+namespace laser_raycast {
+namespace core {
+
+class ColumnMotion {
+ public:
+  // A block of columns [col_lo, col_lo + ref_from_column.size()); steepest: the largest angle of a
+  // pattern direction from the horizontal (rad).
+  ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column, double steepest);
+
+  int colLo() const { return col_lo_; }
+  int colHi() const { return col_lo_ + static_cast<int>(ref_from_column_.size()) - 1; }
+  const Eigen::Isometry3d& refFromColumn(int col) const { return ref_from_column_[col - col_lo_]; }
+  const Spread& spread() const { return spread_; }
+
+  // Beam d of column col as a ray in the reference sensor frame.
+  Ray ray(int col, const Eigen::Vector3d& d, double tmin) const {
+    const Eigen::Isometry3d& m = refFromColumn(col);
+    Ray r;
+    r.origin = m.translation();
+    r.dir = m.linear() * d;
+    r.tmin = tmin;
+    return r;
+  }
+  // A unit normal in the reference sensor frame as column col's sensor frame has it (the frame
+  // ScanResult's normals are in).
+  Eigen::Vector3d toColumn(int col, const Eigen::Vector3d& n) const {
+    return refFromColumn(col).linear().transpose() * n;
+  }
+
+ private:
+  int col_lo_;
+  std::vector<Eigen::Isometry3d> ref_from_column_;
+  Spread spread_;
+};
+
+}  // namespace core
+}  // namespace laser_raycast

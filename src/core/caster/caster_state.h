@@ -1,0 +1,110 @@
+// What a Caster keeps between casts (CasterState, behind the facade's one pointer), shared by the
+// stages of a cast (caster.cpp) and of a rotating sweep (caster_sweep.cpp).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "beams/beam_set.h"
+#include "beams/column_motion.h"
+#include "laser_raycast/core/cast_config.h"
+#include "laser_raycast/core/pose_samples.h"
+#include "laser_raycast/core/scan_pattern.h"
+#include "laser_raycast/core/scan_result.h"
+#include "laser_raycast/core/scene.h"
+#include "scene/scene_index.h"
+#include "slice/kept_slice.h"
+#include "util/thread_pool.h"
+
+namespace laser_raycast {
+namespace core {
+
+// What a result was computed from: if all of it is equal, the result is too.
+struct ReuseKey {
+  std::uint64_t scene_version = 0;
+  CastConfig config;
+  double angle_min = 0, angle_increment = 0;
+  int azimuths = 0;
+  std::vector<double> elevations;
+  std::vector<Eigen::Isometry3d> sensor_from_frame;  // meaningful where valid
+  std::vector<char> valid;
+
+  bool operator==(const ReuseKey& o) const {
+    if (scene_version != o.scene_version || !(config == o.config) || angle_min != o.angle_min ||
+        angle_increment != o.angle_increment || azimuths != o.azimuths ||
+        elevations != o.elevations || valid != o.valid) {
+      return false;
+    }
+    for (std::size_t f = 0; f < sensor_from_frame.size(); ++f) {
+      if (valid[f] && sensor_from_frame[f].matrix() != o.sensor_from_frame[f].matrix()) {
+        return false;
+      }
+    }
+    return true;
+  }
+};
+
+// A scene frame with bodies this scan, with its pose in the sensor frame.
+struct PlacedGroup {
+  const SceneIndex::Group* group;
+  const Eigen::Isometry3d* sensor_from_frame;
+  double near;
+};
+
+// The inputs of a cast from one pose: every frame relative to the sensor, in double (so that a
+// scene far from the origin loses nothing), with everything else the result depends on.
+ReuseKey relativeInputs(const Scene& scene, const FramePoses& poses,
+                        const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
+                        const CastConfig& config);
+
+// A result of `beams` beams before a cast: every range inf (NaN if !sensor_ok), nothing hit.
+void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanResult* result);
+// Each hit beam's |cos| of the angle between its direction and the hit's normal.
+void computeIncidence(const ScanPattern& pattern, ScanResult* result);
+
+// A block of a rotating sweep's columns, cast as one scan from the poses at its reference time with
+// each column's beams from the column's own poses (column_motion.h): the frames relative to the
+// reference sensor pose, the groups placed there, and each frame's column motions (null for
+// frames without bodies or without a pose).
+struct SweepBlock {
+  int col_lo = 0, col_hi = -1;
+  ReuseKey key;
+  std::vector<PlacedGroup> placed;
+  std::vector<std::shared_ptr<const ColumnMotion>> motion;  // by frame
+};
+
+// What a caster keeps between casts: the scene's body trees (rebuilt when the scene changes), the
+// walk's per-scan state (kept to reuse its memory), the threads, the kept slices and the inputs of
+// the last result.
+struct CasterState {
+  std::unique_ptr<SceneIndex> index;
+  std::vector<PlacedGroup> placed;
+  std::vector<std::atomic<char>> cast;  // per body: cast against this scan (for the stats)
+  BeamSet beams;
+  std::unique_ptr<ThreadPool> pool;     // for CastConfig::threads > 1
+  std::unique_ptr<KeptSlices> planes;   // CastConfig::keep_slices
+  std::optional<ReuseKey> previous;     // the inputs of the result, if it is complete
+
+  // The scene's index for this scene version.
+  const SceneIndex& indexOf(const Scene& scene);
+  // The valid frames' groups placed by key, nearest first, into *out; the bodies of frames without
+  // a pose are counted in *skipped.
+  void placeGroups(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,
+                   std::vector<PlacedGroup>* out, int* skipped);
+  void castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,
+                  ScanResult* result);
+  // The blocks of a sweep cast against the beams of result (caster_sweep.cpp).
+  void castBlocks(const Scene& scene, const std::vector<SweepBlock>& blocks,
+                  const ScanPattern& pattern, const CastConfig& config, ScanResult* result);
+  // Starts a cast (the beams open as result holds them, no body marked), runs
+  // castWithin(rect) over the pattern's beams on config's threads, and counts the bodies culled.
+  void castOnThreads(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,
+                     ScanResult* result, const std::function<void(const BeamRect&)>& castWithin);
+};
+
+}  // namespace core
+}  // namespace laser_raycast
