@@ -10,17 +10,18 @@ namespace core {
 ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column,
                            double steepest)
     : col_lo_(col_lo), ref_from_column_(std::move(ref_from_column)) {
-  double shift = 0, turn = 0, tilt = 0;
+  double shift2 = 0, frobenius2 = 0, z_move2 = 0;
   for (const Eigen::Isometry3d& m : ref_from_column_) {
-    shift = std::max(shift, m.translation().norm());
-    // A rotation by angle a moves the unit axes by |R - I|_F = 2 sqrt(2) sin(a / 2), and the z
-    // axis by |R e_z - e_z| = 2 sin(tilt / 2): both well conditioned for small angles.
-    const double frobenius = (m.linear() - Eigen::Matrix3d::Identity()).norm();
-    turn = std::max(turn, 2 * std::asin(std::min(1.0, frobenius / (2 * std::sqrt(2.0)))));
-    const double z_move = (m.linear().col(2) - Eigen::Vector3d::UnitZ()).norm();
-    tilt = std::max(tilt, 2 * std::asin(std::min(1.0, z_move / 2)));
+    shift2 = std::max(shift2, m.translation().squaredNorm());
+    frobenius2 = std::max(frobenius2, (m.linear() - Eigen::Matrix3d::Identity()).squaredNorm());
+    z_move2 = std::max(z_move2, (m.linear().col(2) - Eigen::Vector3d::UnitZ()).squaredNorm());
   }
-  spread_ = Spread::of(shift, turn, tilt, steepest);
+  // A rotation by angle a moves the unit axes by |R - I|_F = 2 sqrt(2) sin(a / 2), and the z axis
+  // by |R e_z - e_z| = 2 sin(tilt / 2): both well conditioned for small angles, and increasing in
+  // the angle, so the largest gives the largest angle.
+  const double turn = 2 * std::asin(std::min(1.0, std::sqrt(frobenius2) / (2 * std::sqrt(2.0))));
+  const double tilt = 2 * std::asin(std::min(1.0, std::sqrt(z_move2) / 2));
+  spread_ = Spread::of(std::sqrt(shift2), turn, tilt, steepest);
 }
 
 }  // namespace core

@@ -18,6 +18,7 @@
 #include "laser_raycast/core/scene.h"
 #include "scene/scene_index.h"
 #include "slice/kept_slice.h"
+#include "slice/slicer.h"
 #include "util/thread_pool.h"
 
 namespace laser_raycast {
@@ -70,11 +71,17 @@ void computeIncidence(const ScanPattern& pattern, ScanResult* result);
 // each column's beams from the column's own poses (column_motion.h): the frames relative to the
 // reference sensor pose, the groups placed there, and each frame's column motions (null for
 // frames without bodies or without a pose).
+//
+// Planar fans: where every column's scan plane in a frame is the reference's (n and offset bit for
+// bit, as a sensor moving in its own plane keeps it), the block is walked through that frame's kept
+// slice, each column's beams tested in its own plane's map to the sensor (column_planes).
 struct SweepBlock {
   int col_lo = 0, col_hi = -1;
   ReuseKey key;
   std::vector<PlacedGroup> placed;
   std::vector<std::shared_ptr<const ColumnMotion>> motion;  // by frame
+  std::vector<std::vector<ScanPlane>> column_planes;        // by frame; empty: not one plane
+  std::vector<const KeptSlice*> slices;                     // by placed group; null: none
 };
 
 // What a caster keeps between casts: the scene's body trees (rebuilt when the scene changes), the
@@ -91,6 +98,11 @@ struct CasterState {
 
   // The scene's index for this scene version.
   const SceneIndex& indexOf(const Scene& scene);
+  // The kept slices (CastConfig::keep_slices), made when first asked for.
+  KeptSlices& keptSlices() {
+    if (!planes) planes = std::make_unique<KeptSlices>();
+    return *planes;
+  }
   // The valid frames' groups placed by key, nearest first, into *out; the bodies of frames without
   // a pose are counted in *skipped.
   void placeGroups(const Scene& scene, const ReuseKey& key, const ScanPattern& pattern,

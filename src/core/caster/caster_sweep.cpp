@@ -8,6 +8,7 @@
 // double).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -19,6 +20,7 @@
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/pose.h"
 #include "walk/frame_walk.h"
+#include "walk/slice_walk.h"
 
 namespace laser_raycast {
 namespace core {
@@ -33,51 +35,125 @@ constexpr double kMaxBlockTurn = 0.02;   // rad
 constexpr double kMaxBlockShift = 0.05;  // m
 
 // The poses of a sweep's columns: the sensor's, and each frame with bodies (static frames, at one
-// pose in every sample, are not interpolated).
+// pose in every sample, are not interpolated). The same poses as PoseSamples::sensorAt and
+// frameAt give, bit for bit (interpolatePose from the samples' quaternions, converted once here
+// rather than at every column), with each column's bracket of samples found by one pass.
 class ColumnPoses {
  public:
   ColumnPoses(const Scene& scene, const SceneIndex& index, const PoseSamples& samples,
               int columns, double time_increment)
       : samples_(samples), dt_(time_increment) {
+    const std::size_t n = samples.times.size();
+    sample_sensor_ok_.resize(n);
+    sample_rotation_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      sample_sensor_ok_[k] = isValidPose(samples.world_from_sensor[k]);
+      sample_rotation_[k] = Eigen::Quaterniond(samples.world_from_sensor[k].linear());
+    }
+    findBrackets(columns);
     sensor_.resize(columns);
     sensor_valid_.resize(columns);
     for (int c = 0; c < columns; ++c) {
-      sensor_[c] = samples.sensorAt(c * dt_);
-      sensor_valid_[c] = isValidPose(sensor_[c]);
-    }
-    static_.assign(scene.frames().size(), 0);
-    for (const auto& group : index.groups()) {
-      const int f = group->frame;
-      frames_.push_back(f);
-      bool same = true;
-      for (const FramePoses& sample : samples.frames) {
-        same = same && sample.valid[f] && isValidPose(sample.pose[f]) &&
-               sample.pose[f].matrix() == samples.frames.front().pose[f].matrix();
+      const Bracket& b = brackets_[c];
+      sensor_valid_[c] = sample_sensor_ok_[b.i] && sample_sensor_ok_[b.j];
+      if (sensor_valid_[c]) {
+        sensor_[c] = interpolate(samples.world_from_sensor, sample_rotation_, b);
       }
-      static_[f] = same;
     }
+    prepareFrames(scene, index);
   }
 
   double time(int col) const { return col * dt_; }
   bool sensorValid(int col) const { return sensor_valid_[col]; }
   const Eigen::Isometry3d& sensor(int col) const { return sensor_[col]; }
   const std::vector<int>& framesWithBodies() const { return frames_; }
-  bool isStatic(int frame) const { return static_[frame]; }
+  bool isStatic(int frame) const { return frame_[frame].is_static; }
+  // The frame's pose at the column's time; false if it has none then.
   bool frameAt(int col, int frame, Eigen::Isometry3d* pose) const {
-    if (static_[frame]) {
+    const Frame& f = frame_[frame];
+    if (f.is_static) {
       *pose = samples_.frames.front().pose[frame];
       return true;
     }
-    return samples_.frameAt(time(col), frame, pose);
+    const Bracket& b = brackets_[col];
+    if (!(f.ok[b.i] && f.ok[b.j])) return false;
+    *pose = interpolate(f.pose, f.rotation, b);
+    return true;
   }
 
  private:
+  struct Bracket {
+    std::size_t i, j;
+    double s;
+  };
+  struct Frame {
+    bool is_static = false;
+    std::vector<char> ok;                       // by sample
+    std::vector<Eigen::Isometry3d> pose;        // by sample
+    std::vector<Eigen::Quaterniond> rotation;   // by sample
+  };
+
+  // PoseSamples::bracket for each column's time, in one pass (the times ascend).
+  void findBrackets(int columns) {
+    const std::vector<double>& times = samples_.times;
+    brackets_.resize(columns);
+    std::size_t k = 0;  // the last sample at or before t, once t reaches the first
+    for (int c = 0; c < columns; ++c) {
+      const double t = time(c);
+      while (k + 1 < times.size() && times[k + 1] <= t) ++k;
+      Bracket& b = brackets_[c];
+      if (t < times.front() || k + 1 == times.size()) {
+        b = Bracket{k, k, 0.0};
+      } else {
+        b = Bracket{k, k + 1, (t - times[k]) / (times[k + 1] - times[k])};
+        if (b.s == 0) b.j = k;
+      }
+    }
+  }
+
+  void prepareFrames(const Scene& scene, const SceneIndex& index) {
+    frame_.resize(scene.frames().size());
+    const std::size_t n = samples_.times.size();
+    for (const auto& group : index.groups()) {
+      const int f = group->frame;
+      frames_.push_back(f);
+      Frame& frame = frame_[f];
+      frame.ok.resize(n);
+      frame.pose.resize(n);
+      frame.rotation.resize(n);
+      bool same = true;
+      for (std::size_t k = 0; k < n; ++k) {
+        const FramePoses& sample = samples_.frames[k];
+        frame.ok[k] = sample.valid[f] && isValidPose(sample.pose[f]);
+        frame.pose[k] = sample.pose[f];
+        frame.rotation[k] = Eigen::Quaterniond(sample.pose[f].linear());
+        same = same && frame.ok[k] &&
+               sample.pose[f].matrix() == samples_.frames.front().pose[f].matrix();
+      }
+      frame.is_static = same;
+    }
+  }
+
+  // interpolatePose(a, b, s) of the bracket's samples, from their rotations as quaternions.
+  static Eigen::Isometry3d interpolate(const std::vector<Eigen::Isometry3d>& pose,
+                                       const std::vector<Eigen::Quaterniond>& rotation,
+                                       const Bracket& b) {
+    Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+    const Eigen::Vector3d& ta = pose[b.i].translation();
+    out.translation() = ta + b.s * (pose[b.j].translation() - ta);
+    out.linear() = rotation[b.i].slerp(b.s, rotation[b.j]).toRotationMatrix();
+    return out;
+  }
+
   const PoseSamples& samples_;
   double dt_;
+  std::vector<char> sample_sensor_ok_;
+  std::vector<Eigen::Quaterniond> sample_rotation_;
+  std::vector<Bracket> brackets_;
   std::vector<Eigen::Isometry3d> sensor_;
   std::vector<char> sensor_valid_;
   std::vector<int> frames_;
-  std::vector<char> static_;
+  std::vector<Frame> frame_;  // by scene frame (only those with bodies are filled)
 };
 
 class BlockPlanner {
@@ -86,6 +162,7 @@ class BlockPlanner {
                const ScanPattern& pattern, const CastConfig& config)
       : scene_(scene), poses_(poses), samples_(samples), pattern_(pattern), config_(config) {
     for (double e : pattern.elevations()) steepest_ = std::max(steepest_, std::abs(e));
+    slices_ = pattern.planar() && config.planar_fast_path && config.keep_slices;
   }
 
   // Blocks over [lo, hi], every column of which has a sensor pose, in column order.
@@ -115,8 +192,13 @@ class BlockPlanner {
     block->col_hi = hi;
     FramePoses frames;
     samples_.framesAt(poses_.time(ref), &frames);
+    for (int f : poses_.framesWithBodies()) {
+      if (poses_.isStatic(f)) poses_.frameAt(ref, f, &frames.pose[f]);  // as the columns have it
+    }
     block->key = relativeInputs(scene_, frames, poses_.sensor(ref), pattern_, config_);
     block->motion.assign(scene_.frames().size(), nullptr);
+    block->column_planes.assign(scene_.frames().size(), {});
+    if (slices_) findColumnPlanes(lo, hi, block);
     std::shared_ptr<const ColumnMotion> static_motion;
     for (int f : poses_.framesWithBodies()) {
       if (!block->key.valid[f]) continue;
@@ -147,6 +229,31 @@ class BlockPlanner {
     return !static_motion || small(*static_motion);
   }
 
+  // Each valid frame's scan plane at each column, kept where they are all the reference's.
+  void findColumnPlanes(int lo, int hi, SweepBlock* block) const {
+    for (int f : poses_.framesWithBodies()) {
+      if (!block->key.valid[f]) continue;
+      const ScanPlane ref(block->key.sensor_from_frame[f]);
+      std::vector<ScanPlane> planes;
+      planes.reserve(hi - lo + 1);
+      for (int c = lo; c <= hi; ++c) {
+        Eigen::Isometry3d world_from_frame;
+        if (!poses_.frameAt(c, f, &world_from_frame)) break;
+        planes.emplace_back(relativePose(poses_.sensor(c), world_from_frame));
+        if (!samePlane(planes.back(), ref)) break;
+      }
+      if (static_cast<int>(planes.size()) == hi - lo + 1 && samePlane(planes.back(), ref)) {
+        block->column_planes[f] = std::move(planes);
+      }
+    }
+  }
+
+  // The same plane bit for bit, as KeptSlices keys it.
+  static bool samePlane(const ScanPlane& a, const ScanPlane& b) {
+    return std::memcmp(a.n.data(), b.n.data(), 3 * sizeof(double)) == 0 &&
+           std::memcmp(&a.offset, &b.offset, sizeof(double)) == 0;
+  }
+
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
     std::vector<Eigen::Isometry3d> ref_from_column(hi - lo + 1);
     for (int c = lo; c <= hi; ++c) {
@@ -165,6 +272,7 @@ class BlockPlanner {
   const ScanPattern& pattern_;
   const CastConfig& config_;
   double steepest_ = 0;
+  bool slices_ = false;  // planar fans through kept slices
 };
 
 }  // namespace
@@ -197,10 +305,21 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
   }
   resetResult(pattern.size(), static_cast<int>(scene.bodies().size()), true,
               config.compute_incidence, &result_);
+  const bool slices = pattern.planar() && config.planar_fast_path && config.keep_slices;
+  if (slices) state_->keptSlices().newScan();
   for (SweepBlock& block : blocks) {
-    int skipped = 0;
+    int skipped = 0, kept = 0;
     state_->placeGroups(scene, block.key, pattern, &block.placed, &skipped);
     result_.stats.bodies_skipped = std::max(result_.stats.bodies_skipped, skipped);
+    block.slices.assign(block.placed.size(), nullptr);
+    for (std::size_t g = 0; g < block.placed.size() && slices; ++g) {
+      const SceneIndex::Group& group = *block.placed[g].group;
+      if (block.column_planes[group.frame].empty()) continue;
+      const ScanPlane ref(block.key.sensor_from_frame[group.frame]);
+      block.slices[g] = state_->keptSlices().find(scene, group, ref);
+      kept += block.slices[g] != nullptr;
+    }
+    result_.stats.kept_slices = std::max(result_.stats.kept_slices, kept);
   }
   state_->castBlocks(scene, blocks, pattern, config, &result_);
   const int rows = pattern.ringCount();
@@ -223,9 +342,17 @@ void CasterState::castBlocks(const Scene& scene, const std::vector<SweepBlock>& 
       rect.col_lo = std::max(rect.col_lo, block.col_lo);
       rect.col_hi = std::min(rect.col_hi, block.col_hi);
       if (rect.empty()) continue;
-      for (const PlacedGroup& p : block.placed) {
-        walkFrame(beams, scene, *p.group, *p.sensor_from_frame, config, rect, &cast,
-                  block.motion[p.group->frame].get());
+      for (std::size_t g = 0; g < block.placed.size(); ++g) {
+        const PlacedGroup& p = block.placed[g];
+        const int f = p.group->frame;
+        if (block.slices[g]) {
+          walkSlice(beams, scene, *block.slices[g], ScanPlane(*p.sensor_from_frame),
+                    *p.sensor_from_frame, config, rect, &cast, block.motion[f].get(),
+                    block.column_planes[f].data());
+        } else {
+          walkFrame(beams, scene, *p.group, *p.sensor_from_frame, config, rect, &cast,
+                    block.motion[f].get());
+        }
       }
     }
   });

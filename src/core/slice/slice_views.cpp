@@ -25,7 +25,12 @@ inline __m128 floorPs(__m128 x) {
 
 }  // namespace
 
-SliceViewBasis::SliceViewBasis(const ScanPlane& p, double tmax, const ScanPattern& fan) {
+SliceViewBasis::SliceViewBasis(const ScanPlane& p, double tmax, const ScanPattern& fan,
+                               const Spread& spread) {
+  spread_ = spread.any();
+  shift_ = _mm_set1_ps(floatAbove(spread.shift));
+  azimuth_all_ = !(spread.azimuth < 1.5);
+  azimuth_ = _mm_set1_ps(azimuth_all_ ? 0.0f : floatAbove(spread.azimuth));
   auto set = [](double x) { return _mm_set1_ps(static_cast<float>(x)); };
   a_ = set(p.a);
   b_ = set(p.b);
@@ -96,6 +101,10 @@ void SliceViews::compute(const WideBvh::Node& node, const SliceViewBasis& f) {
       _mm_add_ps(_mm_add_ps(f.abs_ty_, _mm_mul_ps(f.abs_c_, ax)), _mm_mul_ps(f.abs_d_, ay));
   wx = _mm_add_ps(wx, _mm_mul_ps(slack, _mm_add_ps(mx, wx)));
   wy = _mm_add_ps(wy, _mm_mul_ps(slack, _mm_add_ps(my, wy)));
+  if (f.spread_) {  // every origin of a sweep block's beams
+    wx = _mm_add_ps(wx, f.shift_);
+    wy = _mm_add_ps(wy, f.shift_);
+  }
   // Nearest distance: the norm of the gap between the sensor and the box, lowered by the slack.
   const __m128 zero = _mm_setzero_ps();
   const __m128 gx = _mm_max_ps(_mm_sub_ps(absPs(sx), wx), zero);
@@ -122,19 +131,24 @@ void SliceViews::compute(const WideBvh::Node& node, const SliceViewBasis& f) {
   __m128 half = _mm_mul_ps(_mm_div_ps(_mm_sqrt_ps(r2), denom), widen);
   __m128 center = atan2Ps(sy, sx);
   // The circle is loose (up to 1.4 times a square box's bearings, many times a long box's seen
-  // end on): the box's corners narrow it (simd::CornerTangents). Each corner in the sensor's x, y
-  // is a few roundings off, at most the slack times the magnitudes mx, my.
-  CornerTangents corners;
-  const __m128 xs[2] = {lo_x, hi_x}, ys[2] = {lo_y, hi_y};
-  for (int i = 0; i < 4; ++i) {
-    const __m128 x = xs[i & 1], y = ys[i >> 1];
-    corners.add(_mm_add_ps(_mm_add_ps(_mm_mul_ps(f.a_, x), _mm_mul_ps(f.b_, y)), f.tx_),
-                _mm_add_ps(_mm_add_ps(_mm_mul_ps(f.c_, x), _mm_mul_ps(f.d_, y)), f.ty_), sx, sy,
-                rho2);
+  // end on): the box's corners narrow it (simd::CornerTangents), but not with a spread, whose shift
+  // can move a corner too far for the narrowing's bound. Each corner in the sensor's x, y is a few
+  // roundings off, at most the slack times the magnitudes mx, my.
+  if (!f.spread_) {
+    CornerTangents corners;
+    const __m128 xs[2] = {lo_x, hi_x}, ys[2] = {lo_y, hi_y};
+    for (int i = 0; i < 4; ++i) {
+      const __m128 x = xs[i & 1], y = ys[i >> 1];
+      corners.add(_mm_add_ps(_mm_add_ps(_mm_mul_ps(f.a_, x), _mm_mul_ps(f.b_, y)), f.tx_),
+                  _mm_add_ps(_mm_add_ps(_mm_mul_ps(f.c_, x), _mm_mul_ps(f.d_, y)), f.ty_), sx, sy,
+                  rho2);
+    }
+    corners.narrow(_mm_mul_ps(slack, _mm_add_ps(mx, my)), rho2, &center, &half);
   }
-  corners.narrow(_mm_mul_ps(slack, _mm_add_ps(mx, my)), rho2, &center, &half);
   half = _mm_add_ps(half, _mm_set1_ps(static_cast<float>(2 * kBearingError)));
-  const __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
+  if (f.spread_) half = _mm_add_ps(half, f.azimuth_);
+  __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
+  if (f.azimuth_all_) narrow = _mm_setzero_ps();
   _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
   _mm_store_ps(az_center, center);
   if (!f.fast_) return;

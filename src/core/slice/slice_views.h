@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "beams/beam_window.h"
 #include "slice/slicer.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "accel/wide_bvh.h"
@@ -23,7 +24,10 @@ namespace core {
 // The plane's map and the fan's columns, prepared for SliceViews.
 class SliceViewBasis {
  public:
-  SliceViewBasis(const ScanPlane& plane, double tmax, const ScanPattern& fan);
+  // spread: a sweep block's beams leave from poses near the reference one (beam_window.h); their
+  // planes are the reference's (the caster walks a kept slice with a block only then).
+  SliceViewBasis(const ScanPlane& plane, double tmax, const ScanPattern& fan,
+                 const Spread& spread = Spread());
 
  private:
   friend struct SliceViews;
@@ -33,6 +37,9 @@ class SliceViewBasis {
   __m128 start_, inv_increment_, turn_, inv_turn_, pad_;
   int columns_;
   bool fast_;
+  // The spread's shift and azimuth widening, rounded up to float; azimuth_all_: every azimuth.
+  __m128 shift_, azimuth_;
+  bool spread_ = false, azimuth_all_ = false;
 };
 
 struct SliceViews {

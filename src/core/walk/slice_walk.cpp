@@ -31,11 +31,24 @@ Eigen::Isometry3d sensorFromPlane(const ScanPlane& f) {
   return pose;
 }
 
+// The inverse of a plane's map to the sensor's x, y (its linear part), and the sensor in plane
+// coordinates: for the traced rays' box tests.
+Eigen::Matrix2d inverseOf(const ScanPlane& plane) {
+  const double det = plane.a * plane.d - plane.b * plane.c;
+  Eigen::Matrix2d inverse;
+  inverse << plane.d / det, -plane.b / det, -plane.c / det, plane.a / det;
+  return inverse;
+}
+Eigen::Vector2d originOf(const ScanPlane& plane, const Eigen::Matrix2d& inverse) {
+  return -(inverse * Eigen::Vector2d(plane.tx, plane.ty));
+}
+
 class SliceWalk {
  public:
   SliceWalk(BeamSet& beams, const Scene& scene, const KeptSlice& slice, const ScanPlane& plane,
             const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
-            std::vector<std::atomic<char>>* cast)
+            std::vector<std::atomic<char>>* cast, const ColumnMotion* motion,
+            const ScanPlane* column_planes)
       : beams_(beams),
         scene_(scene),
         slice_(slice),
@@ -43,14 +56,13 @@ class SliceWalk {
         sensor_from_frame_(sensor_from_frame),
         config_(config),
         cast_(cast),
+        motion_(motion),
+        column_planes_(column_planes),
+        spread_(motion ? motion->spread() : Spread()),
         sensor_from_plane_(sensorFromPlane(plane)),
-        views_(plane, config.tmax, beams.grid().pattern()) {
-    // The sensor and the beams in plane coordinates, for the traced rays' box tests: the inverse
-    // of the map to the sensor frame.
-    const double det = plane.a * plane.d - plane.b * plane.c;
-    inverse_ << plane.d / det, -plane.b / det, -plane.c / det, plane.a / det;
-    origin_.emplace(-(inverse_ * Eigen::Vector2d(plane.tx, plane.ty)), slice.tree.bounds(),
-                    config.tmin);
+        views_(plane, config.tmax, beams.grid().pattern(), spread_) {
+    inverse_ = inverseOf(plane);
+    origin_.emplace(originOf(plane, inverse_), slice.tree.bounds(), config.tmin);
   }
 
   void run(const BeamRect& within) {
@@ -58,7 +70,8 @@ class SliceWalk {
     const Aabb& bounds = slice_.tree.bounds();
     const Eigen::Matrix3d& rot = sensor_from_plane_.linear();
     const View view = boxView(bounds.center(), bounds.extent() * 0.5, rot, rot.cwiseAbs(),
-                              sensor_from_plane_.translation(), beams_.grid().pattern().angleMin(), false);
+                              sensor_from_plane_.translation(), beams_.grid().pattern().angleMin(),
+                              false, spread_);
     if (!(view.near <= config_.tmax)) return;
     beams_.grid().forEachRect(view, within, [&](const BeamRect& rect) {
       stack_.push(Entry{slice_.wide.root(), rect, floatBelow(view.near)});
@@ -152,18 +165,58 @@ class SliceWalk {
   // given) or offered to the beam.
   template <class Hit, class Open>
   void testSegment(const KeptSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
+    if (motion_) {
+      testSegmentByColumn(s, first, last, hit, open);
+      return;
+    }
     Eigen::Vector2d front;
-    if (config_.cull_backfaces) front = frontOf(s);
+    if (config_.cull_backfaces) front = frontOf(s, first);
     testSegmentInFan(beams_.grid().pattern(), plane_.toSensor(s.p), plane_.toSensor(s.q), config_.tmin,
                      config_.tmax, config_.cull_backfaces ? &front : nullptr, first, last, hit,
                      open);
+  }
+
+  // testSegment for a sweep's block: the columns of the segment's window (widened by the block's
+  // spread), each tested in its own column's sensor x, y.
+  template <class Hit, class Open>
+  void testSegmentByColumn(const KeptSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
+    constexpr int kDirectColumns = 8;  // fewer are tested without a window (speed only)
+    auto testColumns = [&](int lo, int hi) {
+      for (int col = lo; col <= hi; ++col) {
+        const ScanPlane& plane = planeOf(col);
+        Eigen::Vector2d front;
+        if (config_.cull_backfaces) front = frontOf(s, col);
+        testSegmentInFan(beams_.grid().pattern(), plane.toSensor(s.p), plane.toSensor(s.q),
+                         config_.tmin, config_.tmax, config_.cull_backfaces ? &front : nullptr,
+                         col, col, hit, open);
+      }
+    };
+    if (last - first < kDirectColumns) {
+      testColumns(first, last);
+      return;
+    }
+    const Eigen::Vector2d p = plane_.toSensor(s.p), q = plane_.toSensor(s.q);
+    const Eigen::Vector3d center(0.5 * (p.x() + q.x()), 0.5 * (p.y() + q.y()), 0.0);
+    const Eigen::Vector3d half(0.5 * std::abs(p.x() - q.x()), 0.5 * std::abs(p.y() - q.y()), 0.0);
+    const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+    const View view = boxView(center, half, identity, identity, Eigen::Vector3d::Zero(),
+                              beams_.grid().pattern().angleMin(), false, spread_);
+    if (!(view.near <= config_.tmax)) return;
+    beams_.grid().forEachRect(view, BeamRect{0, 0, first, last},
+                              [&](const BeamRect& r) { testColumns(r.col_lo, r.col_hi); });
+  }
+
+  // A sweep's column's plane, or the one plane of a scan.
+  const ScanPlane& planeOf(int col) const {
+    return motion_ ? column_planes_[col - motion_->colLo()] : plane_;
   }
 
   void offerSegmentHit(int col, double t, const KeptSlice::Item& s) {
     const Mesh& mesh = meshOf(s.body);
     const std::uint32_t triangle = mesh.bvh().triangleIds()[s.slot];
     beams_.keepNearestHit(0, col, t, s.body, static_cast<int>(triangle), [&] {
-      return Eigen::Vector3d(sensorFromBody(s.body).linear() * mesh.normal(triangle));
+      const Eigen::Vector3d n = sensorFromBody(s.body).linear() * mesh.normal(triangle);
+      return motion_ ? motion_->toColumn(col, n) : n;
     });
   }
 
@@ -185,7 +238,8 @@ class SliceWalk {
   // nearest first would test it with every beam before the nearer things in front of it).
   void castPrimitiveItem(int index, const BeamRect& rect) {
     PlacedBody a = placeBody(scene_, index, sensor_from_frame_);
-    viewPlacedBody(scene_, beams_.grid().pattern().angleMin(), false, &a);
+    viewPlacedBody(scene_, beams_.grid().pattern().angleMin(), false, &a, spread_);
+    a.motion = motion_;
     if (!(a.view.near <= config_.tmax) || !a.view.crosses) return;
     beams_.grid().forEachRect(a.view, rect, [&](const BeamRect& r) {
       if (deferLargePrimitive(a)) {
@@ -213,14 +267,16 @@ class SliceWalk {
       if (item.slot == KeptSlice::kPrimitive) {
         PlacedBody a = placeBody(scene_, item.body, sensor_from_frame_);
         placeSensorInBody(&a);
+        a.motion = motion_;
         castPrimitiveBeam(beams_, scene_, a, config_, 0, b->col);
         b->tmax = std::min(b->tmax, beams_.range(0, b->col));
         return;
       }
       Eigen::Vector2d front;
-      if (config_.cull_backfaces) front = frontOf(item);
+      if (config_.cull_backfaces) front = frontOf(item, b->col);
+      const ScanPlane& plane = planeOf(b->col);
       double t;
-      if (!beamCrossesSegment(b->dx, b->dy, plane_.toSensor(item.p), plane_.toSensor(item.q),
+      if (!beamCrossesSegment(b->dx, b->dy, plane.toSensor(item.p), plane.toSensor(item.q),
                               config_.tmin, b->tmax, config_.cull_backfaces ? &front : nullptr,
                               &t)) {
         return;
@@ -249,7 +305,14 @@ class SliceWalk {
       b.tmax = std::min(config_.tmax, range);
       b.best = nullptr;
       b.best_t = std::numeric_limits<double>::infinity();
-      b.ray = PlaneRay(*origin_, inverse_ * Eigen::Vector2d(b.dx, b.dy));
+      if (motion_) {  // a sweep's beam: from its column's origin in plane coordinates
+        const ScanPlane& plane = planeOf(col);
+        const Eigen::Matrix2d inverse = inverseOf(plane);
+        const PlaneRay::Origin origin(originOf(plane, inverse), slice_.tree.bounds(), config_.tmin);
+        b.ray = PlaneRay(origin, inverse * Eigen::Vector2d(b.dx, b.dy));
+      } else {
+        b.ray = PlaneRay(*origin_, inverse_ * Eigen::Vector2d(b.dx, b.dy));
+      }
       if (n == 2) {
         traceWidePair(slice_.wide, e.ref, pair[0].ray, &pair[0].tmax, leafTest(&pair[0]),
                       pair[1].ray, &pair[1].tmax, leafTest(&pair[1]));
@@ -276,8 +339,11 @@ class SliceWalk {
     return tieBefore(a.body, ids[a.slot], b.body, ids[b.slot]);
   }
 
-  Eigen::Vector2d frontOf(const KeptSlice::Item& s) const {
-    return planarFront(sensorFromBody(s.body).linear(), meshOf(s.body).bvh().triangleVertices()[s.slot]);
+  // The item's triangle's front normal in the sensor's x, y (of column col's sensor for a sweep).
+  Eigen::Vector2d frontOf(const KeptSlice::Item& s, int col) const {
+    Eigen::Matrix3d rot = sensorFromBody(s.body).linear();
+    if (motion_) rot = motion_->refFromColumn(col).linear().transpose() * rot;
+    return planarFront(rot, meshOf(s.body).bvh().triangleVertices()[s.slot]);
   }
 
   BeamSet& beams_;
@@ -287,6 +353,9 @@ class SliceWalk {
   const Eigen::Isometry3d sensor_from_frame_;
   const CastConfig& config_;
   std::vector<std::atomic<char>>* cast_;
+  const ColumnMotion* motion_;        // a sweep's block, or null
+  const ScanPlane* column_planes_;    // its columns' planes
+  const Spread spread_;
   const Eigen::Isometry3d sensor_from_plane_;
   const SliceViewBasis views_;
   Eigen::Matrix2d inverse_;
@@ -299,8 +368,10 @@ class SliceWalk {
 
 void walkSlice(BeamSet& beams, const Scene& scene, const KeptSlice& slice, const ScanPlane& plane,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
-               const BeamRect& within, std::vector<std::atomic<char>>* cast) {
-  SliceWalk(beams, scene, slice, plane, sensor_from_frame, config, cast).run(within);
+               const BeamRect& within, std::vector<std::atomic<char>>* cast,
+               const ColumnMotion* motion, const ScanPlane* column_planes) {
+  SliceWalk(beams, scene, slice, plane, sensor_from_frame, config, cast, motion, column_planes)
+      .run(within);
 }
 
 }  // namespace core
