@@ -15,6 +15,9 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
     shift2 = std::max(shift2, m.translation().squaredNorm());
     frobenius2 = std::max(frobenius2, (m.linear() - Eigen::Matrix3d::Identity()).squaredNorm());
     z_move2 = std::max(z_move2, (m.linear().col(2) - Eigen::Vector3d::UnitZ()).squaredNorm());
+    const Eigen::Matrix3d& r = m.linear();
+    in_plane_ = in_plane_ && r(0, 2) == 0 && r(1, 2) == 0 && r(2, 0) == 0 && r(2, 1) == 0 &&
+                r(2, 2) == 1 && m.translation().z() == 0;
   }
   // A rotation by angle a moves the unit axes by |R - I|_F = 2 sqrt(2) sin(a / 2), and the z axis
   // by |R e_z - e_z| = 2 sin(tilt / 2): both well conditioned for small angles, and increasing in

@@ -26,6 +26,10 @@ class ColumnMotion {
   int colHi() const { return col_lo_ + static_cast<int>(ref_from_column_.size()) - 1; }
   const Eigen::Isometry3d& refFromColumn(int col) const { return ref_from_column_[col - col_lo_]; }
   const Spread& spread() const { return spread_; }
+  // True if every column's pose differs from the reference by a turn about the sensor's z axis and
+  // a move in its xy plane, exactly (as a level sensor driving on a floor gives): every column scans
+  // the reference's plane.
+  bool inPlane() const { return in_plane_; }
 
   // Beam d of column col as a ray in the reference sensor frame.
   Ray ray(int col, const Eigen::Vector3d& d, double tmin) const {
@@ -41,11 +45,17 @@ class ColumnMotion {
   Eigen::Vector3d toColumn(int col, const Eigen::Vector3d& n) const {
     return refFromColumn(col).linear().transpose() * n;
   }
+  // For inPlane(): a point of the scan plane, the reference sensor's x, y, in column col's.
+  Eigen::Vector2d pointToColumn(int col, const Eigen::Vector2d& p) const {
+    const Eigen::Isometry3d& m = refFromColumn(col);
+    return m.linear().topLeftCorner<2, 2>().transpose() * (p - m.translation().head<2>());
+  }
 
  private:
   int col_lo_;
   std::vector<Eigen::Isometry3d> ref_from_column_;
   Spread spread_;
+  bool in_plane_ = true;
 };
 
 }  // namespace core

@@ -72,15 +72,13 @@ void computeIncidence(const ScanPattern& pattern, ScanResult* result);
 // reference sensor pose, the groups placed there, and each frame's column motions (null for
 // frames without bodies or without a pose).
 //
-// Planar fans: where every column's scan plane in a frame is the reference's (n and offset bit for
-// bit, as a sensor moving in its own plane keeps it), the block is walked through that frame's kept
-// slice, each column's beams tested in its own plane's map to the sensor (column_planes).
+// Planar fans: where every column scans the reference's plane in a frame (ColumnMotion::inPlane, as
+// a level sensor driving on a floor does), the block is walked through that frame's kept slice.
 struct SweepBlock {
   int col_lo = 0, col_hi = -1;
   ReuseKey key;
   std::vector<PlacedGroup> placed;
   std::vector<std::shared_ptr<const ColumnMotion>> motion;  // by frame
-  std::vector<std::vector<ScanPlane>> column_planes;        // by frame; empty: not one plane
   std::vector<const KeptSlice*> slices;                     // by placed group; null: none
 };
 

@@ -8,7 +8,6 @@
 // double).
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -162,7 +161,6 @@ class BlockPlanner {
                const ScanPattern& pattern, const CastConfig& config)
       : scene_(scene), poses_(poses), samples_(samples), pattern_(pattern), config_(config) {
     for (double e : pattern.elevations()) steepest_ = std::max(steepest_, std::abs(e));
-    slices_ = pattern.planar() && config.planar_fast_path && config.keep_slices;
   }
 
   // Blocks over [lo, hi], every column of which has a sensor pose, in column order.
@@ -197,8 +195,6 @@ class BlockPlanner {
     }
     block->key = relativeInputs(scene_, frames, poses_.sensor(ref), pattern_, config_);
     block->motion.assign(scene_.frames().size(), nullptr);
-    block->column_planes.assign(scene_.frames().size(), {});
-    if (slices_) findColumnPlanes(lo, hi, block);
     std::shared_ptr<const ColumnMotion> static_motion;
     for (int f : poses_.framesWithBodies()) {
       if (!block->key.valid[f]) continue;
@@ -229,31 +225,6 @@ class BlockPlanner {
     return !static_motion || small(*static_motion);
   }
 
-  // Each valid frame's scan plane at each column, kept where they are all the reference's.
-  void findColumnPlanes(int lo, int hi, SweepBlock* block) const {
-    for (int f : poses_.framesWithBodies()) {
-      if (!block->key.valid[f]) continue;
-      const ScanPlane ref(block->key.sensor_from_frame[f]);
-      std::vector<ScanPlane> planes;
-      planes.reserve(hi - lo + 1);
-      for (int c = lo; c <= hi; ++c) {
-        Eigen::Isometry3d world_from_frame;
-        if (!poses_.frameAt(c, f, &world_from_frame)) break;
-        planes.emplace_back(relativePose(poses_.sensor(c), world_from_frame));
-        if (!samePlane(planes.back(), ref)) break;
-      }
-      if (static_cast<int>(planes.size()) == hi - lo + 1 && samePlane(planes.back(), ref)) {
-        block->column_planes[f] = std::move(planes);
-      }
-    }
-  }
-
-  // The same plane bit for bit, as KeptSlices keys it.
-  static bool samePlane(const ScanPlane& a, const ScanPlane& b) {
-    return std::memcmp(a.n.data(), b.n.data(), 3 * sizeof(double)) == 0 &&
-           std::memcmp(&a.offset, &b.offset, sizeof(double)) == 0;
-  }
-
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
     std::vector<Eigen::Isometry3d> ref_from_column(hi - lo + 1);
     for (int c = lo; c <= hi; ++c) {
@@ -272,7 +243,6 @@ class BlockPlanner {
   const ScanPattern& pattern_;
   const CastConfig& config_;
   double steepest_ = 0;
-  bool slices_ = false;  // planar fans through kept slices
 };
 
 }  // namespace
@@ -314,7 +284,8 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
     block.slices.assign(block.placed.size(), nullptr);
     for (std::size_t g = 0; g < block.placed.size() && slices; ++g) {
       const SceneIndex::Group& group = *block.placed[g].group;
-      if (block.column_planes[group.frame].empty()) continue;
+      const ColumnMotion* motion = block.motion[group.frame].get();
+      if (!motion || !motion->inPlane()) continue;
       const ScanPlane ref(block.key.sensor_from_frame[group.frame]);
       block.slices[g] = state_->keptSlices().find(scene, group, ref);
       kept += block.slices[g] != nullptr;
@@ -347,8 +318,7 @@ void CasterState::castBlocks(const Scene& scene, const std::vector<SweepBlock>& 
         const int f = p.group->frame;
         if (block.slices[g]) {
           walkSlice(beams, scene, *block.slices[g], ScanPlane(*p.sensor_from_frame),
-                    *p.sensor_from_frame, config, rect, &cast, block.motion[f].get(),
-                    block.column_planes[f].data());
+                    *p.sensor_from_frame, config, rect, &cast, block.motion[f].get());
         } else {
           walkFrame(beams, scene, *p.group, *p.sensor_from_frame, config, rect, &cast,
                     block.motion[f].get());

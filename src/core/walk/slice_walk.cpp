@@ -47,8 +47,7 @@ class SliceWalk {
  public:
   SliceWalk(BeamSet& beams, const Scene& scene, const KeptSlice& slice, const ScanPlane& plane,
             const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
-            std::vector<std::atomic<char>>* cast, const ColumnMotion* motion,
-            const ScanPlane* column_planes)
+            std::vector<std::atomic<char>>* cast, const ColumnMotion* motion)
       : beams_(beams),
         scene_(scene),
         slice_(slice),
@@ -57,7 +56,6 @@ class SliceWalk {
         config_(config),
         cast_(cast),
         motion_(motion),
-        column_planes_(column_planes),
         spread_(motion ? motion->spread() : Spread()),
         sensor_from_plane_(sensorFromPlane(plane)),
         views_(plane, config.tmax, beams.grid().pattern(), spread_) {
@@ -177,38 +175,45 @@ class SliceWalk {
   }
 
   // testSegment for a sweep's block: the columns of the segment's window (widened by the block's
-  // spread), each tested in its own column's sensor x, y.
+  // spread), each beam tested against the segment mapped to its column's sensor x, y, as
+  // testSegmentInFan tests it (beamCrossesSegment); no point of the segment is nearer to any
+  // column's origin than the window's near distance.
   template <class Hit, class Open>
   void testSegmentByColumn(const KeptSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
     constexpr int kDirectColumns = 8;  // fewer are tested without a window (speed only)
-    auto testColumns = [&](int lo, int hi) {
+    const Eigen::Vector2d p = plane_.toSensor(s.p), q = plane_.toSensor(s.q);
+    const auto& dirs = beams_.grid().pattern().directions();
+    auto testColumns = [&](int lo, int hi, double near) {
       for (int col = lo; col <= hi; ++col) {
-        const ScanPlane& plane = planeOf(col);
+        if (!open(col, near)) continue;
         Eigen::Vector2d front;
         if (config_.cull_backfaces) front = frontOf(s, col);
-        testSegmentInFan(beams_.grid().pattern(), plane.toSensor(s.p), plane.toSensor(s.q),
-                         config_.tmin, config_.tmax, config_.cull_backfaces ? &front : nullptr,
-                         col, col, hit, open);
+        double t;
+        if (beamCrossesSegment(dirs[col].x(), dirs[col].y(), motion_->pointToColumn(col, p),
+                               motion_->pointToColumn(col, q), config_.tmin, config_.tmax,
+                               config_.cull_backfaces ? &front : nullptr, &t)) {
+          hit(col, t);
+        }
       }
     };
     if (last - first < kDirectColumns) {
-      testColumns(first, last);
+      testColumns(first, last, 0.0);
       return;
     }
-    const Eigen::Vector2d p = plane_.toSensor(s.p), q = plane_.toSensor(s.q);
     const Eigen::Vector3d center(0.5 * (p.x() + q.x()), 0.5 * (p.y() + q.y()), 0.0);
     const Eigen::Vector3d half(0.5 * std::abs(p.x() - q.x()), 0.5 * std::abs(p.y() - q.y()), 0.0);
     const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
     const View view = boxView(center, half, identity, identity, Eigen::Vector3d::Zero(),
                               beams_.grid().pattern().angleMin(), false, spread_);
     if (!(view.near <= config_.tmax)) return;
-    beams_.grid().forEachRect(view, BeamRect{0, 0, first, last},
-                              [&](const BeamRect& r) { testColumns(r.col_lo, r.col_hi); });
+    beams_.grid().forEachRect(view, BeamRect{0, 0, first, last}, [&](const BeamRect& r) {
+      testColumns(r.col_lo, r.col_hi, view.near);
+    });
   }
 
-  // A sweep's column's plane, or the one plane of a scan.
-  const ScanPlane& planeOf(int col) const {
-    return motion_ ? column_planes_[col - motion_->colLo()] : plane_;
+  // A point of the plane in the sensor's x, y (column col's sensor for a sweep).
+  Eigen::Vector2d toSensor(int col, const Eigen::Vector2d& w) const {
+    return motion_ ? motion_->pointToColumn(col, plane_.toSensor(w)) : plane_.toSensor(w);
   }
 
   void offerSegmentHit(int col, double t, const KeptSlice::Item& s) {
@@ -274,9 +279,8 @@ class SliceWalk {
       }
       Eigen::Vector2d front;
       if (config_.cull_backfaces) front = frontOf(item, b->col);
-      const ScanPlane& plane = planeOf(b->col);
       double t;
-      if (!beamCrossesSegment(b->dx, b->dy, plane.toSensor(item.p), plane.toSensor(item.q),
+      if (!beamCrossesSegment(b->dx, b->dy, toSensor(b->col, item.p), toSensor(b->col, item.q),
                               config_.tmin, b->tmax, config_.cull_backfaces ? &front : nullptr,
                               &t)) {
         return;
@@ -305,11 +309,13 @@ class SliceWalk {
       b.tmax = std::min(config_.tmax, range);
       b.best = nullptr;
       b.best_t = std::numeric_limits<double>::infinity();
-      if (motion_) {  // a sweep's beam: from its column's origin in plane coordinates
-        const ScanPlane& plane = planeOf(col);
-        const Eigen::Matrix2d inverse = inverseOf(plane);
-        const PlaneRay::Origin origin(originOf(plane, inverse), slice_.tree.bounds(), config_.tmin);
-        b.ray = PlaneRay(origin, inverse * Eigen::Vector2d(b.dx, b.dy));
+      if (motion_) {  // a sweep's beam: from its column's origin, in plane coordinates
+        const Eigen::Isometry3d& m = motion_->refFromColumn(col);
+        const Eigen::Vector2d at = inverse_ * (m.translation().head<2>() -
+                                               Eigen::Vector2d(plane_.tx, plane_.ty));
+        const Eigen::Vector2d along =
+            m.linear().topLeftCorner<2, 2>() * Eigen::Vector2d(b.dx, b.dy);
+        b.ray = PlaneRay(PlaneRay::Origin(at, slice_.tree.bounds(), config_.tmin), inverse_ * along);
       } else {
         b.ray = PlaneRay(*origin_, inverse_ * Eigen::Vector2d(b.dx, b.dy));
       }
@@ -354,7 +360,6 @@ class SliceWalk {
   const CastConfig& config_;
   std::vector<std::atomic<char>>* cast_;
   const ColumnMotion* motion_;        // a sweep's block, or null
-  const ScanPlane* column_planes_;    // its columns' planes
   const Spread spread_;
   const Eigen::Isometry3d sensor_from_plane_;
   const SliceViewBasis views_;
@@ -369,9 +374,8 @@ class SliceWalk {
 void walkSlice(BeamSet& beams, const Scene& scene, const KeptSlice& slice, const ScanPlane& plane,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
                const BeamRect& within, std::vector<std::atomic<char>>* cast,
-               const ColumnMotion* motion, const ScanPlane* column_planes) {
-  SliceWalk(beams, scene, slice, plane, sensor_from_frame, config, cast, motion, column_planes)
-      .run(within);
+               const ColumnMotion* motion) {
+  SliceWalk(beams, scene, slice, plane, sensor_from_frame, config, cast, motion).run(within);
 }
 
 }  // namespace core

@@ -18,14 +18,13 @@ namespace core {
 
 // Casts the open beams of `within` against the bodies of a frame through slice, their slice by
 // plane (the plane of sensor_from_frame). Sets cast[b] for each body b it casts against. With a
-// motion (a block of a rotating sweep, `within` inside its columns), sensor_from_frame and plane
-// are the block's reference, and column_planes[c - motion->colLo()] is column c's plane, the same
-// plane (n and offset bit for bit) mapped to that column's sensor x, y: each column's beams are
-// tested there, from the column's own pose.
+// motion (a block of a rotating sweep, `within` inside its columns, every column in the reference's
+// plane: ColumnMotion::inPlane()), sensor_from_frame and plane are the block's reference, and each
+// column's beams are tested from the column's own pose, the segments mapped to its sensor x, y.
 void walkSlice(BeamSet& beams, const Scene& scene, const KeptSlice& slice, const ScanPlane& plane,
                const Eigen::Isometry3d& sensor_from_frame, const CastConfig& config,
                const BeamRect& within, std::vector<std::atomic<char>>* cast,
-               const ColumnMotion* motion = nullptr, const ScanPlane* column_planes = nullptr);
+               const ColumnMotion* motion = nullptr);
 
 }  // namespace core
 }  // namespace laser_raycast
