@@ -105,5 +105,63 @@ TEST(MeshClosed, HiddenBackFacesNeverHoldTheNearestHit) {
   EXPECT_GT(hidden, 100000);
 }
 
+// With a spread (a rotating sweep's block, every column's origin within that distance of the
+// reference eye): a face hidden from the reference eye with the spread never holds the nearest hit
+// of a ray from any eye within the spread, by brute force over every slot. Without the spread, the
+// same rays meet faces hidden from the reference eye that they do hit first.
+TEST(MeshClosed, HiddenWithASpreadFromEveryEyeWithinIt) {
+  Rng rng(79);
+  long long hidden = 0, hits = 0, wrong_without = 0;
+  for (int scene = 0; scene < 12; ++scene) {
+    const TriMesh m = solids(rng, 6, scene % 2 == 1);
+    const core::Mesh mesh(m.vertices, m.triangles);
+    const auto& slots = mesh.bvh().triangleVertices();
+    for (int i = 0; i < 300; ++i) {
+      // Eyes near the solids, where a spread of up to 0.5 m turns faces around.
+      const Eigen::Vector3d reference = uniformInCube(rng, 8);
+      const double spread = uniform(rng, 0.01, 0.5);
+      const Eigen::Vector3d eye = reference + spread * uniform(rng, 0, 1) * randomUnitVector(rng);
+      // Aimed at a face that turns around between the two eyes where there is one (the faces
+      // the spread is for), else at a random one.
+      std::size_t target = static_cast<std::size_t>(rng() % slots.size());
+      for (std::size_t k = 0; k < slots.size(); ++k) {
+        const auto& v = slots[(target + k) % slots.size()];
+        const Eigen::Vector3d n = (v[1] - v[0]).cross(v[2] - v[0]);
+        if (n.dot(v[0] - reference) * n.dot(v[0] - eye) < 0) {
+          target = (target + k) % slots.size();
+          break;
+        }
+      }
+      const auto& tri = slots[target];
+      core::Ray ray;
+      ray.origin = eye;
+      ray.dir = (tri[0] + tri[1] + tri[2]) / 3.0 - eye;
+      std::optional<double> all, visible, visible_without;
+      for (std::uint32_t slot = 0; slot < slots.size(); ++slot) {
+        const auto& v = slots[slot];
+        const auto hit =
+            core::intersectTriangle<core::TriangleMethod::kWatertight>(ray, v[0], v[1], v[2]);
+        const bool skip = core::hiddenBackFace(mesh, slot, reference, 0.0, spread);
+        const bool skip_without = core::hiddenBackFace(mesh, slot, reference, 0.0);
+        hidden += skip;
+        if (!hit) continue;
+        if (!all || hit->t < *all) all = hit->t;
+        if (!skip && (!visible || hit->t < *visible)) visible = hit->t;
+        if (!skip_without && (!visible_without || hit->t < *visible_without)) {
+          visible_without = hit->t;
+        }
+      }
+      ASSERT_EQ(all.has_value(), visible.has_value()) << "scene " << scene << " ray " << i;
+      if (!all) continue;
+      ++hits;
+      ASSERT_NEAR(*all, *visible, 1e-12 * *all) << "scene " << scene << " ray " << i;
+      wrong_without += !visible_without || std::abs(*visible_without - *all) > 1e-12 * *all;
+    }
+  }
+  EXPECT_GT(hits, 2000);
+  EXPECT_GT(hidden, 50000);
+  EXPECT_GT(wrong_without, 0);  // the spread matters for these eyes
+}
+
 }  // namespace
 }  // namespace laser_raycast_test

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -81,18 +82,27 @@ class Mesh {
 // tmin: a beam from there meets one of the component's front faces first, so it never reports this
 // triangle. Only clear cases count: the triangle's plane must pass the eye by more than rounding.
 inline bool hiddenBackFace(const Mesh& mesh, std::uint32_t slot, const Eigen::Vector3d& eye,
-                           double tmin) {
+                           double tmin, double spread = 0) {
   const int facing = mesh.slotFacing()[slot];
   if (!facing) return false;
   const Aabb& box = mesh.slotComponentBounds(slot);
   const double gap2 = (box.lo - eye).cwiseMax(eye - box.hi).cwiseMax(0.0).squaredNorm();
-  // Outside the bounds, and its front faces no nearer than tmin (written so that NaN fails).
-  if (!(gap2 > 0 && gap2 > tmin * tmin * (1 + 1e-9))) return false;
+  // Outside the bounds, and its front faces no nearer than tmin (written so that NaN fails); with
+  // a spread, from every eye within that distance of `eye` (a rotating sweep's block).
+  if (spread == 0) {
+    if (!(gap2 > 0 && gap2 > tmin * tmin * (1 + 1e-9))) return false;
+  } else {
+    const double gap = std::sqrt(gap2) - spread * (1 + 1e-9);
+    if (!(gap > 0 && gap * gap > tmin * tmin * (1 + 1e-9))) return false;
+  }
   const auto& v = mesh.bvh().triangleVertices()[slot];
   const Eigen::Vector3d ab = v[1] - v[0], ac = v[2] - v[0], from_eye = v[0] - eye;
-  // The front normal's side of the eye: positive when it points away from it.
-  const double side = ab.cross(ac).dot(from_eye);
-  return facing * side > 1e-10 * ab.lpNorm<1>() * ac.lpNorm<1>() * from_eye.lpNorm<1>();
+  // The front normal's side of the eye: positive when it points away from it (from every eye of
+  // the spread: an eye moved by d changes it by at most |n| |d|).
+  const Eigen::Vector3d n = ab.cross(ac);
+  const double side = n.dot(from_eye);
+  const double tolerance = 1e-10 * ab.lpNorm<1>() * ac.lpNorm<1>() * (from_eye.lpNorm<1>() + 3 * spread);
+  return facing * side > tolerance + (spread > 0 ? n.norm() * spread * (1 + 1e-9) : 0.0);
 }
 
 }  // namespace core

@@ -114,22 +114,25 @@ class WideSlabRay {
   // What the rays of one walk share: they start at one point (rounded once each way, after moving
   // it by frameSlack(), which widens every box by that much), and a bound on how far a box
   // coordinate of the tree is from it, in units of t of a unit direction (for the cull limit's
-  // widening). bounds: the tree's box (its first kAxes coordinates are the tree's).
+  // widening). bounds: the tree's box (its first kAxes coordinates are the tree's). widen: the rays
+  // start anywhere within that distance of origin (a rotating sweep's block, each column from its
+  // own pose): the interval the box tests take the origin in is that much wider each way.
   struct Origin {
     float up[kAxes], down[kAxes];
     double reach;
     float tnear0;  // the rays' tmin, widened as the cull limit is
-    Origin(const Vector& origin, const Aabb& bounds, double tmin) {
+    Origin(const Vector& origin, const Aabb& bounds, double tmin, double widen = 0) {
       const Vector lo = bounds.lo.template head<kAxes>(), hi = bounds.hi.template head<kAxes>();
       const double slack = frameSlack(lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).maxCoeff(),
-                                      origin.cwiseAbs().maxCoeff());
+                                      origin.cwiseAbs().maxCoeff()) +
+                           widen;
       for (int k = 0; k < kAxes; ++k) {
         up[k] = floatAbove(origin[k] + slack);
         down[k] = floatBelow(origin[k] - slack);
       }
       // A unit direction's largest component is at least 1/sqrt(kAxes) >= 1/2: twice the largest
       // coordinate distance bounds the reach of every direction.
-      reach = 2 * (lo - origin).cwiseAbs().cwiseMax((hi - origin).cwiseAbs()).maxCoeff();
+      reach = 2 * ((lo - origin).cwiseAbs().cwiseMax((hi - origin).cwiseAbs()).maxCoeff() + widen);
       tnear0 = floatBelow(tmin - (std::abs(tmin) + reach) * kWiden);
     }
   };

@@ -82,9 +82,9 @@ class MeshWalk {
         // Without the fast paths every beam is traced from the root, as the reference.
         tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
         basis_(active.sensor_from_body, planar_, config.tmax, spread_),
-        origin_(active.sensor_in_body, mesh.bvh().bounds(), config.tmin) {
-    // Which back faces are hidden depends on where the sensor is: not decided for a sweep's block.
-    closed_ = !slicing_ && !motion_ && mesh.hasClosedComponents();
+        // A sweep's block traces each column from its own origin, all within the shift.
+        origin_(active.sensor_in_body, mesh.bvh().bounds(), config.tmin, spread_.shift) {
+    closed_ = !slicing_ && mesh.hasClosedComponents();
     if (slicing_) {
       // Cut in the frame's plane coordinates when the walk gives them (as a kept slice is).
       if (active.plane) {
@@ -228,16 +228,6 @@ class MeshWalk {
         motion_->ray(col, beams_.grid().rebuiltDirection(row, col), config_.tmin),
         config_.cull_backfaces);
   }
-  // The beam as a ray in the body's frame, for box tests: from the sensor, or a sweep's column.
-  WideBoxRay::Origin columnOrigin(int col) const {
-    if (!motion_) return origin_;
-    const Eigen::Vector3d o = active_.body_from_sensor_rot * motion_->refFromColumn(col).translation() +
-                              active_.sensor_in_body;
-    return WideBoxRay::Origin(o, mesh_.bvh().bounds(), config_.tmin);
-  }
-  WideBoxRay columnBoxRay(const WideBoxRay::Origin& origin, const Ray& ray) const {
-    return WideBoxRay(origin, active_.body_from_sensor_rot * ray.dir);
-  }
 
   // Each open beam of the rect through the node's subtree, one ray at a time.
   void traceRect(const Entry& e) {
@@ -281,7 +271,6 @@ class MeshWalk {
   // traceRect for a sweep's block: column by column, each column's beams from its own origin.
   void traceColumns(const Entry& e) {
     for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
-      const WideBoxRay::Origin origin = columnOrigin(col);
       for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
         const double range = beams_.range(row, col);
         if (!(range >= e.near)) continue;
@@ -289,8 +278,11 @@ class MeshWalk {
         const Ray r = motion_->ray(col, beams_.grid().rebuiltDirection(row, col), config_.tmin);
         const PreparedRay<double, M> ray(r, config_.cull_backfaces);
         Best best;
-        traceWide(wide_, e.ref, columnBoxRay(origin, r), &tmax,
-                  [&](std::uint32_t slot) { testSlot(ray, slot, &tmax, &best); });
+        // The box tests take the origin anywhere within the block's shift (origin_).
+        const WideBoxRay box_ray(origin_, active_.body_from_sensor_rot * r.dir);
+        traceWide(wide_, e.ref, box_ray, &tmax, [&](std::uint32_t slot) {
+          if (!hidden(slot)) testSlot(ray, slot, &tmax, &best);
+        });
         if (best.found()) offer(row, col, best);
       }
     }
@@ -305,7 +297,10 @@ class MeshWalk {
   // Out of line: the tests that ask stay small inline.
   __attribute__((noinline)) bool hiddenClosed(std::uint32_t slot) {
     return hidden_.get(
-        slot, [&] { return hiddenBackFace(mesh_, slot, active_.sensor_in_body, config_.tmin); });
+        slot, [&] {
+          // A sweep's block: hidden from every column's origin, all within the shift.
+          return hiddenBackFace(mesh_, slot, active_.sensor_in_body, config_.tmin, spread_.shift);
+        });
   }
 
   // The slot's segment in the scan plane against one beam, as slicing tests it.
@@ -394,6 +389,7 @@ class MeshWalk {
                              ? std::sin(std::min(M_PI / 2, spread_.turn + std::asin(shift / near)))
                              : 1.0;
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
+      if (hidden(slot)) continue;
       const SensorTriangle s = sensorTriangle(slot);
       const std::uint32_t triangle = ids_[slot];
       const ColumnRaster raster(beams_, s.a, s.b, s.c, widen, shift, spread_.turn);
@@ -413,6 +409,7 @@ class MeshWalk {
   void windowLeaf(const Entry& e) {
     const double angle_min = beams_.grid().pattern().angleMin();
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
+      if (hidden(slot)) continue;
       const SensorTriangle s = sensorTriangle(slot);
       const Eigen::Vector3d lo = s.a.cwiseMin(s.b).cwiseMin(s.c), hi = s.a.cwiseMax(s.b).cwiseMax(s.c);
       const View view = boxView((lo + hi) * 0.5, (hi - lo) * 0.5, Eigen::Matrix3d::Identity(),
