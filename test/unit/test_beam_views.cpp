@@ -245,13 +245,15 @@ TEST(NodeViews, WithASpreadEveryColumnsBeamThatEntersAChildBoxIsInItsWindow) {
   for (const core::ScanPattern& pattern : patterns()) {
     FreshBeams fresh(pattern, core::CastConfig{});
     const core::BeamGrid& grid = fresh.beams.grid();
-    for (int scene = 0; scene < 6; ++scene) {
-      const Soup s = scene % 2 ? clusteredSoup(rng, 200) : spreadSoup(rng, 200);
+    for (int scene = 0; scene < 8; ++scene) {
+      const Soup s = scene % 4 < 2 ? clusteredSoup(rng, 200) : spreadSoup(rng, 200);
       const core::Mesh mesh(s.vertices, s.triangles);
       const Eigen::Isometry3d pose = randomPose(rng, 6);
-      const core::ColumnMotion motion =
-          randomColumns(rng, grid.cols(), uniform(rng, 0, 0.3), uniform(rng, 0, 0.1),
-                        steepest(pattern));
+      // Large spreads, and small ones without a turn (where the corners still narrow windows).
+      const bool small = scene % 2 == 0;
+      const double shift = small ? uniform(rng, 0.02, 0.05) : uniform(rng, 0, 0.3);
+      const core::ColumnMotion motion = randomColumns(
+          rng, grid.cols(), shift, small ? 0.0 : uniform(rng, 0, 0.1), steepest(pattern));
       const core::ViewBasis frame(pose, pattern.planar(), 30.0, motion.spread());
       for (const core::WideBvh::Node& node : mesh.wideBvh().nodes()) {
         core::NodeViews views;

@@ -124,9 +124,8 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewBasis& f) {
   __m128 half = _mm_mul_ps(_mm_div_ps(_mm_sqrt_ps(r2), denom), _mm_set1_ps(1 + 8 * kViewSlack));
   __m128 center = atan2Ps(c[1], c[0]);
   // The circle is loose (up to 1.4 times a square box's azimuths, many times a long box's seen end
-  // on): the corners narrow it, but not with a spread, whose shift can move a corner too far for
-  // the narrowing's bound.
-  if (!f.spread_) narrowByCorners(f, c, eb, mag, rho2, &center, &half);
+  // on): the corners narrow it.
+  narrowByCorners(f, c, eb, mag, rho2, &center, &half);
   half = _mm_add_ps(half, _mm_set1_ps(static_cast<float>(2 * kBearingError)));
   if (f.spread_) half = _mm_add_ps(half, f.azimuth_);
   __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
@@ -158,8 +157,19 @@ void NodeViews::narrowByCorners(const ViewBasis& f, const __m128 c[3], const __m
     }
     corners.add(x, y, c[0], c[1], rho2);
   }
-  corners.narrow(_mm_mul_ps(_mm_set1_ps(kViewSlack), _mm_add_ps(mag[0], mag[1])), rho2, center,
-                 half);
+  __m128 error = _mm_mul_ps(_mm_set1_ps(kViewSlack), _mm_add_ps(mag[0], mag[1]));
+  if (f.spread_) {
+    // The box grown by the shift: each corner's x, y moves by up to sqrt(2) shift more. The bound
+    // of narrow() (four times the turn of a corner within 60 degrees of the centre) holds for a
+    // corner moved a little beyond 60 degrees if the factor is 5 (sec^2 of 63.4 degrees): kept
+    // only where the move is below 5 % of the nearest corner's distance (so within 3 degrees).
+    error = _mm_add_ps(error, _mm_mul_ps(f.shift_, _mm_set1_ps(1.5f)));
+    const __m128 small = _mm_cmple_ps(
+        _mm_mul_ps(_mm_mul_ps(error, _mm_sqrt_ps(rho2)), _mm_set1_ps(20.0f)), corners.min_dot);
+    corners.ok = _mm_and_ps(corners.ok, small);
+    error = _mm_mul_ps(error, _mm_set1_ps(1.25f));
+  }
+  corners.narrow(error, rho2, center, half);
 }
 
 int planeMask(const WideBvh::Node& node, const ViewBasis& f) {
