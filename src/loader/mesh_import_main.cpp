@@ -1,6 +1,7 @@
-// laser_raycast_mesh_import: reads mesh files with assimp for the scene loader, under the bounds it
-// is given: a request (a file and a scale) on standard input, the triangles or why not on standard
-// output (import_protocol.h), until the input ends. The loader runs it as a child process
+// laser_raycast_mesh_import: reads mesh files for the scene loader (STL with the loader's own
+// streaming reader, stl_reader.h; every other format with assimp), under the bounds it is given: a
+// request (a file and a scale) on standard input, the triangles or why not on standard output
+// (import_protocol.h), until the input ends. The loader runs it as a child process
 // (import_process.cpp says why); it is not meant to be run by hand.
 //
 //   laser_raycast_mesh_import --max-memory-mb MB --max-seconds S
@@ -22,6 +23,7 @@
 
 #include "import_protocol.h"
 #include "mesh_import.h"
+#include "stl_reader.h"
 
 namespace {
 
@@ -92,13 +94,15 @@ void onOutOfMemory() {
 bool serve(const std::string& path, const Eigen::Vector3d& scale) {
   using laser_raycast::import_protocol::writeFailure;
   try {
-    const laser_raycast::mesh_file::MeshData mesh =
-        laser_raycast::mesh_file::importMeshInProcess(path, scale);
+    namespace mesh_file = laser_raycast::mesh_file;
+    const mesh_file::MeshData mesh = mesh_file::isStlPath(path)
+                                         ? mesh_file::readStl(path, scale)
+                                         : mesh_file::importMeshInProcess(path, scale);
     return laser_raycast::import_protocol::writeMesh(STDOUT_FILENO, mesh);
   } catch (const laser_raycast::SceneLoadError& e) {
     return writeFailure(STDOUT_FILENO, Status::kError, e.what());
   } catch (const std::exception& e) {
-    const std::string message = std::string("assimp failed: ") + e.what();
+    const std::string message = std::string("reading it failed: ") + e.what();
     return writeFailure(STDOUT_FILENO, Status::kError, message.c_str());
   }
 }

@@ -14,6 +14,7 @@
 #include "import_process.h"
 #include "laser_raycast/core/pose.h"
 #include "mesh_file.h"
+#include "stl_reader.h"
 #include "urdf_parse.h"
 
 namespace laser_raycast {
@@ -304,12 +305,13 @@ void commitBodies(std::vector<PendingBody> pending, const std::string& prefix,
 
 }  // namespace
 
-MeshImportBounds MeshImportBounds::forFile(std::uintmax_t bytes) const {
+MeshImportBounds MeshImportBounds::forFile(std::uintmax_t bytes, MeshReader reader) const {
   const double mb = static_cast<double>(bytes) / (1024 * 1024);
   const auto stepUp = [](double value, double step) { return std::ceil(value / step) * step; };
   MeshImportBounds out = *this;
   if (out.max_memory_mb == 0) {
-    out.max_memory_mb = std::max(kBaseMemoryMb, stepUp(kMemoryPerFileByte * mb, kMemoryStepMb));
+    const double per_byte = reader == MeshReader::kStl ? kStlMemoryPerFileByte : kMemoryPerFileByte;
+    out.max_memory_mb = std::max(kBaseMemoryMb, stepUp(per_byte * mb, kMemoryStepMb));
   }
   if (out.max_seconds == 0) {
     out.max_seconds = std::max(kBaseSeconds, stepUp(kSecondsPerFileMb * mb, kSecondsStep));
@@ -374,7 +376,9 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
     if (size == 0 && !ec) throw SceneLoadError("file is empty (0 bytes)");
 
     if (!importer_) importer_ = std::make_unique<import_process::MeshImporter>();
-    mesh_file::MeshData data = importer_->import(path, scale, bounds.forFile(ec ? 0 : size));
+    const MeshReader reader = mesh_file::isStlPath(path) ? MeshReader::kStl : MeshReader::kAssimp;
+    mesh_file::MeshData data =
+        importer_->import(path, scale, bounds.forFile(ec ? 0 : size, reader));
     const Clock::time_point start = Clock::now();
     std::shared_ptr<const core::Mesh> mesh;
     try {

@@ -34,9 +34,14 @@ const std::string kCuboid = kSourceDir + "/test/data/meshes/cuboid.obj";
 // What each regression input does to assimp, found by changing one byte of a TurtleBot3 Collada
 // file or of the test cuboid: in <p> (the triangles' indices) a character that is not a digit makes
 // assimp's Collada parser allocate without end; in a <float_array>'s count attribute, it crashes;
-// the PLY header's line break replaced by a space makes its parser loop without allocating.
-enum class Harm { kAllocates, kCrashes, kLoops };
+// the PLY header's line break replaced by a space makes its parser loop without allocating. The
+// STL reader refuses a binary STL cut short or counting more triangles than it holds, and an ASCII
+// one cut short (assimp read 7 of its 12 triangles without a word), saying what is wrong.
+enum class Harm { kAllocates, kCrashes, kLoops, kRefused };
 const std::map<std::string, Harm> kRegressions = {
+    {"regression_cuboid_ascii_truncated.stl", Harm::kRefused},
+    {"regression_cuboid_binary_count_high.stl", Harm::kRefused},
+    {"regression_cuboid_binary_truncated.stl", Harm::kRefused},
     {"regression_cuboid_ply_header_newline.ply", Harm::kLoops},
     {"regression_hexagon_float_array_count_letter.dae", Harm::kCrashes},
     {"regression_hexagon_p_quote.dae", Harm::kAllocates},
@@ -94,17 +99,19 @@ TEST(MeshImport, CorruptFilesFoundByFuzzingAreRefused) {
         EXPECT_EQ(contains(e.what(), "time bound of 1 s"), "");
       }
     } catch (const SceneLoadError& e) {
-      EXPECT_EQ(harm, Harm::kCrashes) << e.what();
+      EXPECT_TRUE(harm == Harm::kCrashes || harm == Harm::kRefused) << e.what();
       EXPECT_EQ(contains(e.what(), file), "");
-      EXPECT_EQ(contains(e.what(), "crashed on it (signal 11"), "");
+      EXPECT_EQ(
+          contains(e.what(), harm == Harm::kCrashes ? "crashed on it (signal 11" : "truncated"),
+          "");
     }
   }
   EXPECT_EQ(loader.meshesLoaded(), 0u);
 }
 
 // The case under the default bounds, through a URDF: the named error keeps its type through
-// the loader's context and names the URDF, the link, the mesh, the bound (the 4.7 KB file's: 512 MB)
-// and the parameters that raise it.
+// the loader's context and names the URDF, the link, the mesh, the bound (the 4.7 KB file's: 512
+// MB) and the parameters that raise it.
 TEST(MeshImport, CorruptColladaIsRefusedAtTheDefaultMemoryBound) {
   const std::string mesh = kCorpus + "/regression_wall_p_letter.dae";
   SceneLoader loader(nullptr);
@@ -193,41 +200,57 @@ TEST(MeshImportBounds, ValidateNamesFieldAndValue) {
 }
 
 // Bounds left 0 follow the file's size, worked out by hand from the documented rule: the larger of
-// 512 MB and 48 bytes per byte of file in steps of 256 MB, the larger of 5 s and 0.2 s per MB in
-// steps of 5 s. A bound that is set stays as set.
+// 512 MB and 48 bytes (assimp) or 6 bytes (the STL reader) per byte of file in steps of 256 MB, the
+// larger of 5 s and 0.2 s per MB in steps of 5 s. A bound that is set stays as set.
 TEST(MeshImportBounds, BoundsFollowTheFilesSizeUnlessSet) {
-  const auto expectFor = [](std::uintmax_t bytes, double memory, double seconds) {
-    const MeshImportBounds b = MeshImportBounds().forFile(bytes);
+  const auto expectFor = [](std::uintmax_t bytes, double memory, double seconds,
+                            MeshReader reader = MeshReader::kAssimp) {
+    const MeshImportBounds b = MeshImportBounds().forFile(bytes, reader);
     EXPECT_EQ(b.max_memory_mb, memory) << bytes << " bytes";
     EXPECT_EQ(b.max_seconds, seconds) << bytes << " bytes";
   };
   const std::uintmax_t mb = 1024 * 1024;
   expectFor(0, 512, 5);
-  expectFor(5000, 512, 5);             // 0.2 MB, 0.001 s
-  expectFor(16 * mb, 768, 5);          // 48 * 16 = 768 MB, 3.2 s
-  expectFor(16 * mb + 1, 1024, 5);     // just over 768 MB: the next step
-  expectFor(25 * mb, 1280, 5);         // 1200 MB -> 1280; 5 s
-  expectFor(25 * mb + 1, 1280, 10);    // just over 5 s: the next step
-  expectFor(200000084, 9216, 40);      // 4 million triangles: 9155 MB -> 9216, 38.1 s -> 40
-  expectFor(1024 * mb, 49152, 205);    // a 1 GB STL: 48 GB, 204.8 s -> 205 s
+  expectFor(5000, 512, 5);           // 0.2 MB, 0.001 s
+  expectFor(16 * mb, 768, 5);        // 48 * 16 = 768 MB, 3.2 s
+  expectFor(16 * mb + 1, 1024, 5);   // just over 768 MB: the next step
+  expectFor(25 * mb, 1280, 5);       // 1200 MB -> 1280; 5 s
+  expectFor(25 * mb + 1, 1280, 10);  // just over 5 s: the next step
+  expectFor(200000084, 9216, 40);    // 4 million triangles: 9155 MB -> 9216, 38.1 s -> 40
+  expectFor(1024 * mb, 49152, 205);  // a 1 GB file: 48 GB, 204.8 s -> 205 s
+  // The STL reader's: a 5 KB file as any; 4 and 20 million triangles far below assimp's.
+  expectFor(5000, 512, 5, MeshReader::kStl);
+  expectFor(200000084, 1280, 40, MeshReader::kStl);    // 1144 MB -> 1280
+  expectFor(1000000084, 5888, 195, MeshReader::kStl);  // 20 million: 5722 MB -> 5888, 190.7 s
+  expectFor(1024 * mb, 6144, 205, MeshReader::kStl);   // 1 GB: 6 GB
   MeshImportBounds set;
   set.max_memory_mb = 2000;
   EXPECT_EQ(set.forFile(1024 * mb).max_memory_mb, 2000);
+  EXPECT_EQ(set.forFile(1024 * mb, MeshReader::kStl).max_memory_mb, 2000);
   EXPECT_EQ(set.forFile(1024 * mb).max_seconds, 205);
   set.max_seconds = 7;
   EXPECT_EQ(set.forFile(5000).max_seconds, 7);
 }
 
-// A binary STL of 500,000 triangles (24 MB) needs more address space than a small file's 512 MB:
-// refused under that fixed bound, it loads under the one its size gives it (1280 MB).
-TEST(MeshImportBounds, ALargeMeshLoadsUnderTheBoundOfItsSize) {
+// A binary STL of 500,000 triangles (24 MB) needed more address space than a small file's 512 MB
+// while assimp read it (512-768 MB); the STL reader reads it within the smallest bound there is.
+TEST(MeshImportBounds, ALargeStlLoadsUnderTheSmallestBound) {
   const std::string path = writeBinaryStlGrid("large.stl", 500000);
   MeshImportBounds small;
-  small.max_memory_mb = MeshImportBounds::kBaseMemoryMb;
+  small.max_memory_mb = MeshImportBounds::kMinMemoryMb;
+  SceneLoader loader(nullptr);
+  EXPECT_EQ(loader.loadMesh(path, "", Vector3d::Ones(), {}, small)->triangles().size(), 500000u);
+}
+
+// The STL reader runs under the bound as assimp does: a binary STL of 2 million triangles (95 MB)
+// at the smallest bound, which its vertices and triangles (48 MB) and the importer's own 40 MB
+// exceed, is refused at that bound.
+TEST(MeshImportBounds, AnStlBeyondItsBoundIsRefused) {
+  const std::string path = writeBinaryStlGrid("larger.stl", 2000000);
+  MeshImportBounds small;
+  small.max_memory_mb = MeshImportBounds::kMinMemoryMb;
   SceneLoader loader(nullptr);
   EXPECT_THROW(loader.loadMesh(path, "", Vector3d::Ones(), {}, small), MeshImportBoundError);
-  SceneLoader by_size(nullptr);
-  EXPECT_EQ(by_size.loadMesh(path, "", Vector3d::Ones(), {}, {})->triangles().size(), 500000u);
 }
 
 // The smallest memory bound is enough for the importer itself and a small mesh.

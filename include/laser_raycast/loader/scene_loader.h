@@ -33,7 +33,11 @@ inline bool parseGeometrySource(const std::string& name, GeometrySource* source)
   return kGeometrySourceNames.parse(name, source);
 }
 
-// What one mesh file's import may use. Meshes are imported by assimp in a child process
+// Which reader a mesh file goes to: the loader's own streaming reader for STL files (*.stl), which
+// holds little more than the mesh it reads, assimp for every other format.
+enum class MeshReader { kAssimp, kStl };
+
+// What one mesh file's import may use. Meshes are imported in a child process
 // (laser_raycast_mesh_import, installed with the package) under these bounds: some corrupt files
 // make assimp allocate without limit, loop, or crash, and the child's failure is then a
 // SceneLoadError (MeshImportBoundError for a bound) instead of the caller's.
@@ -44,14 +48,17 @@ struct MeshImportBounds {
   double max_memory_mb = 0;
   double max_seconds = 0;
 
-  // The bounds for a file of `bytes` bytes: those set, and for each one left 0 the larger of a
-  // base and a multiple of the file's size, rounded up to a whole step (so that files of similar
-  // sizes share one importer process): memory kBaseMemoryMb, or kMemoryPerFileByte bytes of
-  // address space per byte of file, in steps of kMemoryStepMb; time kBaseSeconds, or
-  // kSecondsPerFileMb per MB of file, in steps of kSecondsStep. Measured: a binary STL of 500,000
-  // triangles (24 MB) needs 512-768 MB, one of 4 million (191 MB) 6-8 GB (docs/faults.md). A 5 KB
-  // file gets 512 MB and 5 s, the 191 MB one 9,216 MB and 40 s, a 1 GB one 48 GB and 205 s.
-  MeshImportBounds forFile(std::uintmax_t bytes) const;
+  // The bounds for a file of `bytes` bytes read by `reader`: those set, and for each one left 0 the
+  // larger of a base and a multiple of the file's size, rounded up to a whole step (so that files
+  // of similar sizes share one importer process): memory kBaseMemoryMb, or kMemoryPerFileByte
+  // (assimp) or kStlMemoryPerFileByte (the STL reader) bytes of address space per byte of file, in
+  // steps of kMemoryStepMb; time kBaseSeconds, or kSecondsPerFileMb per MB of file, in steps of
+  // kSecondsStep. Measured (docs/faults.md): assimp needs 512-768 MB for a binary STL of 500,000
+  // triangles (24 MB) and 6-8 GB for one of 4 million (191 MB); the STL reader 768-896 MB for 4
+  // million triangles whose 12 million corners all differ (its worst case), well under 64 MB for
+  // the 500,000. A 5 KB file gets 512 MB and 5 s; a 1 GB STL 6,144 MB and 205 s; a 1 GB file of
+  // another format 48 GB.
+  MeshImportBounds forFile(std::uintmax_t bytes, MeshReader reader = MeshReader::kAssimp) const;
 
   // Throws std::invalid_argument naming the field and its value: each must be finite,
   // max_memory_mb 0 or >= kMinMemoryMb and max_seconds >= 0. The fields are named as given (a
@@ -62,6 +69,7 @@ struct MeshImportBounds {
   static constexpr double kMinMemoryMb = 64;
   static constexpr double kBaseMemoryMb = 512;
   static constexpr double kMemoryPerFileByte = 48;
+  static constexpr double kStlMemoryPerFileByte = 6;
   static constexpr double kMemoryStepMb = 256;
   static constexpr double kBaseSeconds = 5;
   static constexpr double kSecondsPerFileMb = 0.2;
