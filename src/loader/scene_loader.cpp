@@ -1,5 +1,6 @@
 #include "laser_raycast/loader/scene_loader.h"
 
+#include <malloc.h>
 #include <urdf_model/model.h>
 
 #include <algorithm>
@@ -25,6 +26,13 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The bytes the process has allocated and not freed: glibc's count over every arena, plus the
+// blocks it maps on their own (every large vector).
+std::size_t heapBytes() {
+  const struct mallinfo2 info = mallinfo2();
+  return info.uordblks + info.hblkhd;
 }
 
 std::string inQuotes(const std::string& s) { return "'" + s + "'"; }
@@ -346,6 +354,7 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
                                                         const core::BvhConfig& bvh,
                                                         const MeshImportBounds& bounds) {
   last_bvh_seconds_ = 0;
+  last_mesh_bytes_ = 0;
   std::string where = "mesh " + inQuotes(uri);
   try {
     requirePositive("the mesh scale", scale);
@@ -379,6 +388,10 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
     const MeshReader reader = mesh_file::isStlPath(path) ? MeshReader::kStl : MeshReader::kAssimp;
     mesh_file::MeshData data =
         importer_->import(path, scale, bounds.forFile(ec ? 0 : size, reader));
+    // What the mesh holds: its input, and what the build allocated and kept.
+    const std::size_t input_bytes = data.vertices.capacity() * sizeof(data.vertices[0]) +
+                                    data.triangles.capacity() * sizeof(data.triangles[0]);
+    const std::size_t heap_before = heapBytes();
     const Clock::time_point start = Clock::now();
     std::shared_ptr<const core::Mesh> mesh;
     try {
@@ -388,6 +401,7 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
       throw SceneLoadError(e.what());
     }
     last_bvh_seconds_ = secondsSince(start);
+    last_mesh_bytes_ = input_bytes + std::max<std::size_t>(heapBytes(), heap_before) - heap_before;
     cache_.emplace(key, mesh);
     return mesh;
   } catch (const SceneLoadError& e) {
@@ -468,6 +482,10 @@ LoadedModel SceneLoader::addUrdf(const std::string& urdf_xml, const std::string&
         loadMesh(mesh.filename, base_dir, Eigen::Vector3d(mesh.scale.x, mesh.scale.y, mesh.scale.z),
                  options.bvh, options.mesh_import);
     bvh_seconds += last_bvh_seconds_;
+    if (last_mesh_bytes_ > 0) {
+      out.mesh_triangles_built += loaded->triangles().size();
+      out.mesh_bytes_built += last_mesh_bytes_;
+    }
     return loaded;
   };
   commitBodies(linkBodies(frames, dropped, options, source, load_mesh, &out.warnings), prefix,

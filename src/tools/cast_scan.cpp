@@ -173,7 +173,7 @@ po::options_description flags(Args* args) {
       "joint values (rad or m; 0 if not given): several after one --joint, or one each");
   add("repeat", count("--repeat", &args->repeat),
       "cast N more times after loading (the whole path) and print the median cast time of a "
-      "scan to stderr");
+      "scan to stderr, after the load's times and the meshes' memory per triangle");
   add("threads",
       single("N",
              [args](const std::string& v) {
@@ -294,6 +294,9 @@ struct LoadedScene {
   core::Scene scene;
   core::FramePoses poses;
   bool prefixed = false;  // each model's link names carry a private prefix (not printed)
+  // Over every model, for --repeat's statistics.
+  double load_seconds = 0, bvh_build_seconds = 0;
+  std::size_t mesh_triangles_built = 0, mesh_bytes_built = 0;
 };
 
 // Every joint value must name a movable joint of some model. Throws ArgError.
@@ -330,6 +333,10 @@ LoadedScene loadScene(const Args& args) {
     options.mesh_import = args.mesh_import;
     if (out.prefixed) options.tf_prefix = "m" + std::to_string(m) + "/";
     loaded.push_back(loader.addUrdfFile(args.models[m].path, options, &out.scene));
+    out.load_seconds += loaded.back().load_seconds;
+    out.bvh_build_seconds += loaded.back().bvh_build_seconds;
+    out.mesh_triangles_built += loaded.back().mesh_triangles_built;
+    out.mesh_bytes_built += loaded.back().mesh_bytes_built;
   }
   checkJoints(args.joints, loaded);
   std::map<std::string, Eigen::Isometry3d> link_poses;
@@ -386,6 +393,21 @@ void reportMedianCastTime(const Args& args, const LoadedScene& loaded, Casting* 
   }
   std::nth_element(ns.begin(), ns.begin() + ns.size() / 2, ns.end());
   std::cerr << "cast_ns_per_scan_median=" << ns[ns.size() / 2] << "\n";
+}
+
+// What loading cost: time reading files and building BVHs, and the meshes' memory per triangle
+// (of each mesh read, once however often it is instanced), to stderr.
+void reportLoad(const LoadedScene& loaded) {
+  std::cerr << "load_seconds=" << formatNumber(loaded.load_seconds) << "\n"
+            << "bvh_build_seconds=" << formatNumber(loaded.bvh_build_seconds) << "\n"
+            << "mesh_triangles=" << loaded.mesh_triangles_built << "\n"
+            << "mesh_bytes=" << loaded.mesh_bytes_built << "\n";
+  if (loaded.mesh_triangles_built > 0) {
+    std::cerr << "mesh_bytes_per_triangle="
+              << formatNumber(static_cast<double>(loaded.mesh_bytes_built) /
+                              loaded.mesh_triangles_built)
+              << "\n";
+  }
 }
 
 // The CSV's header: with --poses, the pose's number first; with a rotating sweep, the beam's time
@@ -461,6 +483,9 @@ int main(int argc, char** argv) {
     print(csvRows(args, loaded, casting,
                   castFrom(args, loaded, args.path.sensors[p], &casting, nullptr), p));
   }
-  if (args.repeat > 0) reportMedianCastTime(args, loaded, &casting);
+  if (args.repeat > 0) {
+    reportLoad(loaded);
+    reportMedianCastTime(args, loaded, &casting);
+  }
   return 0;
 }

@@ -245,6 +245,26 @@ TEST(CastScan, RepeatReportsTheMedianCastTime) {
   EXPECT_EQ(parse(run.out).size(), 360u);
 }
 
+// With --repeat, what loading cost too: the times, and the meshes' triangles and memory (the wall
+// plate's 12 triangles hold at least their vertex indices and the BVH's copies of their corners,
+// 12 + 72 bytes each).
+TEST(CastScan, RepeatReportsTheLoadAndTheMeshesMemory) {
+  const CliRun run =
+      runCli("--urdf " + kData + "node_scene.urdf --sensor 0.5,0,0,0,0,0 --repeat 1");
+  ASSERT_EQ(run.status, 0) << run.err;
+  for (const char* key : {"load_seconds", "bvh_build_seconds", "mesh_bytes_per_triangle"}) {
+    EXPECT_TRUE(
+        std::regex_search(run.err, std::regex(std::string("(^|\n)") + key + "=[0-9.e+-]+\n")))
+        << key << " in: " << run.err;
+  }
+  EXPECT_NE(run.err.find("\nmesh_triangles=12\n"), std::string::npos) << run.err;
+  std::smatch bytes;
+  ASSERT_TRUE(std::regex_search(run.err, bytes, std::regex("\nmesh_bytes=([0-9]+)\n")));
+#ifndef __SANITIZE_ADDRESS__  // AddressSanitizer's allocator is not glibc's, which counts them
+  EXPECT_GE(std::stoul(bytes[1]), 12u * (12 + 72));
+#endif
+}
+
 // Three rings given out of order (ring 0 is the lowest) of three azimuths against a wall at x = 2
 // and a floor at z = -1: the wall at 2 / (cos el cos az), the floor at 1 / sin(-el) where nearer.
 TEST(CastScan, RingsAtHandComputedRanges) {

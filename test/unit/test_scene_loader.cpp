@@ -378,6 +378,13 @@ TEST_F(SceneLoaderTest, MeshesAreSharedPerFileAndScale) {
   const LoadedModel first = load(urdf);
   EXPECT_EQ(first.bodies, 3u);
   EXPECT_EQ(first.triangles, 36u);  // per instance
+  // Two meshes built (one per scale), each holding at least its indices and the BVH's corner
+  // copies (12 + 72 bytes a triangle). glibc's allocator counts them; AddressSanitizer's replaces
+  // it, and then only the meshes' input is counted.
+  EXPECT_EQ(first.mesh_triangles_built, 24u);
+#ifndef __SANITIZE_ADDRESS__
+  EXPECT_GE(first.mesh_bytes_built, 24u * (12 + 72));
+#endif
   EXPECT_EQ(meshOf(scene_, 0), meshOf(scene_, 1));
   EXPECT_NE(meshOf(scene_, 0), meshOf(scene_, 2));
   EXPECT_EQ(loader_.meshesLoaded(), 2u);
@@ -390,6 +397,8 @@ TEST_F(SceneLoaderTest, MeshesAreSharedPerFileAndScale) {
   EXPECT_EQ(meshOf(scene_, 3), meshOf(scene_, 0));
   EXPECT_EQ(meshOf(scene_, 5), meshOf(scene_, 2));
   EXPECT_EQ(second.bvh_build_seconds, 0.0);
+  EXPECT_EQ(second.mesh_triangles_built, 0u);
+  EXPECT_EQ(second.mesh_bytes_built, 0u);
   EXPECT_EQ(scene_.bodies().size(), 6u);
 }
 

@@ -107,6 +107,11 @@ struct LoadedModel {
   std::size_t links = 0, bodies = 0, triangles = 0;  // triangles over all mesh bodies
   double load_seconds = 0;                           // parsing and reading meshes
   double bvh_build_seconds = 0;       // building BVHs (meshes already in the cache cost nothing)
+  // The meshes this model's load read and built (not those it found in the cache): their
+  // triangles, and the bytes they hold (vertices, triangles, BVHs and what the caster keeps per
+  // triangle), as glibc's allocator counts them: another thread allocating meanwhile would count
+  // too, and under AddressSanitizer, whose allocator replaces glibc's, only the meshes' input is.
+  std::size_t mesh_triangles_built = 0, mesh_bytes_built = 0;
   std::vector<std::string> warnings;  // elements skipped under skip_bad_geometry
 };
 
@@ -154,6 +159,7 @@ class SceneLoader {
   std::unique_ptr<import_process::MeshImporter> importer_;  // started at the first mesh file
   std::map<std::pair<std::string, std::array<double, 3>>, std::shared_ptr<const core::Mesh>> cache_;
   double last_bvh_seconds_ = 0;
+  std::size_t last_mesh_bytes_ = 0;  // of the last mesh built, 0 if it came from the cache
 };
 
 }  // namespace laser_raycast
