@@ -36,15 +36,17 @@ const char* const kSynopsis =
     "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--method NAME ...] [--list-methods]\n"
     "             [--threads N] [--list-scenes]\n";
 const char* const kNotes =
-    "Times every method on the workloads fan2d and rings3d and measures each beam's error\n"
-    "against a long double reference and its agreement with Embree's robust mode. Writes\n"
-    "DIR/results.csv, results.md, pareto.png (one point per method) and pareto_matrix.png\n"
-    "(every workload and scene) (DIR defaults to bench_results). Scenes: sphere box_room tb3\n"
-    "million vertex_rows forest warehouse (default all; tb3 needs tb3_world_data:\n"
-    "$LASER_RAYCAST_SHARED_DATA, the ROS package, or ../shared/data beside the source).\n"
-    "--method: only these rows (default all; --list-methods names them). --quick: fewer poses\n"
-    "and repetitions (under 2 minutes). --threads N: a second pipeline row cast with N threads\n"
-    "(0: every core); every other row is single-threaded.\n"
+    "Times every method on the workloads fan2d and rings3d (one pose cast again and again),\n"
+    "and the pipeline and Embree on sensors moving along a path (fan_path, fan_path_tilted,\n"
+    "rings_path, sweep_fan, sweep_rings), and measures each beam's error against a long\n"
+    "double reference and its agreement with Embree's robust mode. Writes DIR/results.csv,\n"
+    "results.md, pareto.png (one point per method) and pareto_matrix.png (every workload and\n"
+    "scene) (DIR defaults to bench_results). Scenes: sphere box_room tb3 million vertex_rows\n"
+    "forest warehouse forest_10m (default all, forest_10m not with --quick; tb3 needs\n"
+    "tb3_world_data: $LASER_RAYCAST_SHARED_DATA, the ROS package, or ../shared/data beside\n"
+    "the source). --method: only these rows (default all; --list-methods names them).\n"
+    "--quick: fewer poses, scans and repetitions (a few minutes). --threads N: a second\n"
+    "pipeline row cast with N threads (0: every core); every other row is single-threaded.\n"
     "Exit status: 0 ok, 1 the run failed, 2 bad arguments.\n";
 
 struct Options {
@@ -55,6 +57,15 @@ struct Options {
   int threads = 1;                   // the second pipeline row's; 1: no second row
   bool list_methods = false, list_scenes = false;
 };
+
+// The scenes run without --scene: all, but the large ones in a --quick run.
+std::vector<std::string> defaultScenes(bool quick) {
+  std::vector<std::string> names;
+  for (const std::string& name : bench::sceneNames()) {
+    if (!quick || !bench::isLargeScene(name)) names.push_back(name);
+  }
+  return names;
+}
 
 // The full run times more and longer batches on more rays; --quick is a smoke test.
 bench::Settings settingsFor(bool quick) {
@@ -132,7 +143,7 @@ Options parseArgs(int argc, char** argv, bool* help) {
   Options options;
   po::variables_map values;
   *help = !laser_raycast::tools::parseCommandLine(argc, argv, flags(&options), &values);
-  if (options.scenes.empty()) options.scenes = bench::sceneNames();
+  if (options.scenes.empty()) options.scenes = defaultScenes(options.quick);
   return options;
 }
 
@@ -228,7 +239,7 @@ std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settin
 std::string commandLine(const Options& options) {
   std::string command = "bench";
   if (options.quick) command += " --quick";
-  if (options.scenes != bench::sceneNames()) command += " --scene " + joined(options.scenes);
+  if (options.scenes != defaultScenes(options.quick)) command += " --scene " + joined(options.scenes);
   if (!options.methods.empty()) command += " --method " + joined(options.methods);
   if (options.threads != 1) command += " --threads " + std::to_string(options.threads);
   return command;
@@ -252,7 +263,7 @@ std::string runInfo(const Options& options, const bench::Settings& settings,
          << (options.threads == 0 ? ": every core" : "") << ")";
   }
   info << ", " << std::lround(seconds) << " s wall clock. ";
-  info << "Sensor poses per scene: ";
+  info << "Sensor poses (still workloads) or scans along a path (moving ones) per scene: ";
   for (const auto& w : bench::workloads()) {
     info << w.name << " " << (options.quick ? w.quick_poses : w.full_poses) << ", ";
   }

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <type_traits>
 #include <utility>
+
+#include "bench_paths.h"
 
 namespace laser_raycast {
 namespace bench {
@@ -13,6 +16,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kDeg = M_PI / 180;
+// Every path is driven with this seed: the level and the tilted fans follow the same path.
+constexpr std::uint64_t kPathSeed = 20261126;
 
 template <typename T>
 const std::vector<core::RayT<T>>& raysOf(const WorkloadRays& w);
@@ -67,8 +72,9 @@ Pass brutePass(const core::BvhT<T>& bvh) {
   };
 }
 
-// The pipeline as the node runs it: one Caster::cast per sensor pose over the whole pattern.
-// forget() first, so that an unchanged pose does not return the previous result. The caster keeps
+// The pipeline as the node runs it: one Caster::cast per sensor pose over the whole pattern, or
+// one Caster::castSweep per rotating scan. forget() first, so that an unchanged pose does not
+// return the previous result (a sweep is never reused). The caster keeps
 // its thread pool between casts, as the node's does, and its kept slices (kept_slice.h) unless
 // keep_slices is false: then every planar fan is cast as one in a plane never met before (a tilting
 // sensor's, or a robot's first scans).
@@ -82,10 +88,12 @@ Pass pipelinePass(const BenchScene& scene, int threads, bool keep_slices) {
     config.threads = threads;
     config.keep_slices = keep_slices;
     const std::size_t beams = static_cast<std::size_t>(w.pattern->size());
-    for (std::size_t p = 0; p < w.sensors.size(); ++p) {
+    for (std::size_t p = 0; p < w.scans(); ++p) {
       caster->forget();
       const core::ScanResult& result =
-          caster->cast(scene.scene, scene.frame_poses, w.sensors[p], *w.pattern, config);
+          w.sweeps.empty()
+              ? caster->cast(scene.scene, scene.frame_poses, w.sensors[p], *w.pattern, config)
+              : caster->castSweep(scene.scene, w.sweeps[p], *w.pattern, config, w.time_increment);
       std::copy(result.range.begin(), result.range.end(), out->begin() + p * beams);
     }
   };
@@ -116,47 +124,134 @@ void addMethodRows(const SceneGeometry& g, const MethodFilter& wanted, std::vect
   }
 }
 
+// A fan of n beams over the full turn, from -pi (the last one an increment short of +pi).
+core::FanSpec fullTurn(int n) {
+  core::FanSpec fan;
+  fan.angle_min = -M_PI;
+  fan.angle_max = M_PI - 2 * M_PI / n;
+  fan.samples = n;
+  return fan;
+}
+
+// A UTM-30LX: 1081 beams over 270 degrees.
+core::FanSpec utm30lxFan() {
+  core::FanSpec fan;
+  fan.angle_min = -135 * kDeg;
+  fan.angle_max = 135 * kDeg;
+  fan.samples = 1081;
+  return fan;
+}
+
+// A VLP-16: 16 rings, 2 degrees apart from -15 to +15.
+std::vector<double> vlp16Rings() {
+  std::vector<double> rings;
+  for (int k = 0; k < 16; ++k) rings.push_back((-15.0 + 2.0 * k) * kDeg);
+  return rings;
+}
+
+Workload moving(const std::string& name, const core::FanSpec& fan,
+                const std::vector<double>& elevations, Motion motion, double scan_rate,
+                int full_scans, int quick_scans) {
+  Workload w;
+  w.name = name;
+  w.fan = fan;
+  w.elevations = elevations;
+  w.full_poses = full_scans;
+  w.quick_poses = quick_scans;
+  w.motion = motion;
+  w.scan_rate = scan_rate;
+  return w;
+}
+
+std::vector<Workload> stillWorkloads() {
+  Workload fan2d;
+  fan2d.name = "fan2d";
+  fan2d.fan = utm30lxFan();
+  fan2d.elevations = {0.0};
+  fan2d.full_poses = 6;
+  fan2d.quick_poses = 2;
+
+  Workload rings3d;
+  rings3d.name = "rings3d";
+  rings3d.fan = fullTurn(1024);
+  for (int k = 0; k < 64; ++k) rings3d.elevations.push_back((-15.0 + 30.0 * k / 63) * kDeg);
+  rings3d.full_poses = 6;
+  rings3d.quick_poses = 1;
+  return {fan2d, rings3d};
+}
+
+// One pose per scan, every (TF rate / scan rate)-th sample of the path: a UTM-30LX at 40 Hz scans
+// from every TF sample, a VLP-16 at 10 Hz from every fourth.
+std::vector<SensorPose> pathPoses(const BenchScene& scene, const core::Bvh& soup_bvh,
+                                  const Workload& workload, int scans) {
+  const int step = std::max(1, static_cast<int>(std::lround(kTfRate / workload.scan_rate)));
+  const std::vector<SensorPose> path = drivePath(scene.sensor_poses, soup_bvh,
+                                                 (scans - 1) * step + 1, workload.tilt_sigma,
+                                                 kPathSeed);
+  std::vector<SensorPose> poses;
+  for (int k = 0; k < scans; ++k) poses.push_back(path[k * step]);
+  return poses;
+}
+
+// Rotating scans one after another along a path: each scan's pose samples into w->sweeps, and the
+// pose of every column (at c * time_increment into its scan, as castSweep interpolates it) into
+// w->poses. Column c of a full turn of n columns is taken c / n of the scan time in.
+void sweepPoses(const BenchScene& scene, const core::Bvh& soup_bvh, const Workload& workload,
+                int scans, WorkloadRays* w) {
+  const double scan_seconds = 1 / workload.scan_rate;
+  const int samples = static_cast<int>(std::ceil(scans * scan_seconds * kTfRate)) + 2;
+  const std::vector<SensorPose> path =
+      drivePath(scene.sensor_poses, soup_bvh, samples, 0, kPathSeed);
+  w->time_increment = w->pattern->angleIncrement() * scan_seconds / (2 * M_PI);
+  for (int k = 0; k < scans; ++k) {
+    w->sweeps.push_back(sweepSamples(path, k * scan_seconds, scan_seconds, scene.frame_poses));
+    for (int c = 0; c < w->pattern->azimuthCount(); ++c) {
+      SensorPose column{0, 0, 0, 0, 0, 0};
+      column.base = fromIsometry(w->sweeps.back().sensorAt(c * w->time_increment));
+      w->poses.push_back(column);
+    }
+  }
+}
+
 }  // namespace
 
 const std::vector<Workload>& workloads() {
   static const std::vector<Workload> list = [] {
-    Workload fan2d;
-    fan2d.name = "fan2d";
-    fan2d.fan.angle_min = -135 * kDeg;
-    fan2d.fan.angle_max = 135 * kDeg;
-    fan2d.fan.samples = 1081;
-    fan2d.elevations = {0.0};
-    fan2d.full_poses = 6;
-    fan2d.quick_poses = 2;
-
-    Workload rings3d;
-    rings3d.name = "rings3d";
-    rings3d.fan.angle_min = -M_PI;
-    rings3d.fan.angle_max = M_PI - 2 * M_PI / 1024;
-    rings3d.fan.samples = 1024;
-    for (int k = 0; k < 64; ++k) rings3d.elevations.push_back((-15.0 + 30.0 * k / 63) * kDeg);
-    rings3d.full_poses = 6;
-    rings3d.quick_poses = 1;
-    return std::vector<Workload>{fan2d, rings3d};
+    std::vector<Workload> all = stillWorkloads();
+    all.push_back(moving("fan_path", utm30lxFan(), {0.0}, Motion::kPath, 40, 300, 24));
+    Workload tilted = moving("fan_path_tilted", utm30lxFan(), {0.0}, Motion::kPath, 40, 300, 24);
+    tilted.tilt_sigma = 0.4 * kDeg;
+    all.push_back(tilted);
+    all.push_back(moving("rings_path", fullTurn(1800), vlp16Rings(), Motion::kPath, 10, 30, 2));
+    all.push_back(moving("sweep_fan", fullTurn(360), {0.0}, Motion::kSweep, 5, 40, 3));
+    all.push_back(moving("sweep_rings", fullTurn(1800), vlp16Rings(), Motion::kSweep, 10, 20, 1));
+    return all;
   }();
   return list;
 }
 
-WorkloadRays makeRays(const BenchScene& scene, const Workload& workload, int pose_count,
-                      double tmax) {
+WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const Workload& workload,
+                      int count, double tmax) {
   WorkloadRays w;
   w.workload = &workload;
   w.pattern = std::make_unique<core::ScanPattern>(workload.fan, workload.elevations);
   w.tmax = tmax;
-  const int count = std::min<int>(pose_count, static_cast<int>(scene.sensor_poses.size()));
-  w.poses.assign(scene.sensor_poses.begin(), scene.sensor_poses.begin() + count);
-  for (const SensorPose& p : w.poses) {
-    const Eigen::Isometry3d sensor = toIsometry(p.exact());
-    w.sensors.push_back(sensor);
-    for (const Eigen::Vector3d& d : w.pattern->directions()) {
+  if (workload.motion == Motion::kPath) {
+    w.poses = pathPoses(scene, soup_bvh, workload, count);
+  } else if (workload.motion == Motion::kSweep) {
+    sweepPoses(scene, soup_bvh, workload, count, &w);
+  } else {
+    count = std::min<int>(count, static_cast<int>(scene.sensor_poses.size()));
+    w.poses.assign(scene.sensor_poses.begin(), scene.sensor_poses.begin() + count);
+  }
+  for (const SensorPose& p : w.poses) w.sensors.push_back(toIsometry(p.exact()));
+  const auto& directions = w.pattern->directions();
+  for (std::size_t scan = 0; scan < w.scans(); ++scan) {
+    for (int b = 0; b < w.pattern->size(); ++b) {
+      const Eigen::Isometry3d& sensor = w.sensors[w.poseIndex(scan, b)];
       core::Ray ray;
       ray.origin = sensor.translation();
-      ray.dir = sensor.linear() * d;
+      ray.dir = sensor.linear() * directions[b];
       ray.tmin = 0;
       ray.tmax = tmax;
       const core::RayF ray_f = core::toFloat(ray);
@@ -182,9 +277,11 @@ std::vector<Method> coreMethods(const SceneGeometry& g, const MethodFilter& want
     const std::size_t triangles = g.scene->scene.triangleCount();
     methods.push_back(
         Method{"pipeline", false, true, triangles, pipelinePass(*g.scene, 1, true), true});
+    methods.back().moving = true;
     if (threads != 1) {
       methods.push_back(Method{"pipeline", false, true, triangles,
                                pipelinePass(*g.scene, threads, true), true, threads});
+      methods.back().moving = true;
     }
   }
   if (wanted("pipeline_new_plane")) {

@@ -10,20 +10,36 @@
 
 #include "bench_scenes.h"
 #include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/core/scan_pattern.h"
 
 namespace laser_raycast {
 namespace bench {
 
+// How the sensor moves in a workload.
+enum class Motion {
+  kStill,  // the scene's sensor poses, each cast again and again (the secondary rows)
+  kPath,   // one scan per pose along a path the robot drives (bench_paths.h)
+  kSweep,  // rotating scans along such a path, each column from the pose at its own time
+};
+
 struct Workload {
   std::string name;
   core::FanSpec fan;
   std::vector<double> elevations;  // rad; {0} for a planar fan
-  int full_poses, quick_poses;     // sensor poses used (a prefix of the scene's list)
+  // Still: sensor poses used (a prefix of the scene's list); moving: scans along the path.
+  int full_poses, quick_poses;
+  Motion motion = Motion::kStill;
+  double scan_rate = 0;   // Hz, moving workloads: scans a second (a sweep lasts 1 / scan_rate s)
+  double tilt_sigma = 0;  // rad, paths: each pose's roll and pitch ~ N(0, tilt_sigma)
 };
 
-// fan2d: 1081 beams over 270 degrees; rings3d: 64 rings from -15 to +15 degrees elevation x 1024
-// azimuths over the full turn.
+// Still, from the scene's sensor poses: fan2d, 1081 beams over 270 degrees; rings3d, 64 rings
+// from -15 to +15 degrees elevation x 1024 azimuths over the full turn. Moving, along a path from
+// the scene's first sensor pose: fan_path and fan_path_tilted, the fan once per pose at 40 Hz
+// (a UTM-30LX), level or tilted by N(0, 0.4 degrees); rings_path, a VLP-16 (16 rings from -15 to
+// +15 degrees x 1800 azimuths) at 10 Hz; sweep_fan, a rotating 360-beam fan at 5 Hz (an LDS-01);
+// sweep_rings, a rotating VLP-16 at 10 Hz.
 const std::vector<Workload>& workloads();
 
 // Every beam of a workload from each sensor pose, pose-major, as the triangle methods and peers get
@@ -38,10 +54,21 @@ struct WorkloadRays {
   std::vector<core::RayF> rays_f;
   std::vector<double> scale, scale_f;
   double tmax = 0;
+  // Sweeps: each scan's pose samples and the time from one azimuth column to the next; poses and
+  // sensors then hold one pose per column (scan-major), the one Caster::castSweep casts it from.
+  std::vector<core::PoseSamples> sweeps;
+  double time_increment = 0;
+
+  std::size_t scans() const { return sweeps.empty() ? sensors.size() : sweeps.size(); }
+  // The pose beam b (ring-major, as in the pattern) of a scan is cast from.
+  std::size_t poseIndex(std::size_t scan, int beam) const {
+    return sweeps.empty() ? scan : scan * pattern->azimuthCount() + beam % pattern->azimuthCount();
+  }
 };
 
-WorkloadRays makeRays(const BenchScene& scene, const Workload& workload, int pose_count,
-                      double tmax);
+// The rays of count poses or scans of the workload; the paths keep clear of the soup (soup_bvh).
+WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const Workload& workload,
+                      int count, double tmax);
 
 // One pass: casts the rays with the given indices, writing each one's distance (m, +inf for no
 // hit) into dist[index].
@@ -57,6 +84,7 @@ struct Method {
   bool paired = false;  // timed in alternating rounds with the other paired rows (speed ratios)
   int threads = 1;      // threads the method casts with (the pipeline's CastConfig::threads)
   bool planar_only = false;  // a row only a planar fan differs in (not run on other workloads)
+  bool moving = false;       // a row of the moving workloads too (the pipeline and Embree)
 };
 
 // Which methods to build (--method); a method not wanted costs nothing.

@@ -200,6 +200,7 @@ std::vector<Method> peerMethods([[maybe_unused]] const MeshData& soup,
                              [scene](const WorkloadRays& w, const std::vector<int>& rays,
                                      std::vector<double>* out) { scene->pass(w, rays, out); },
                              true});
+    methods.back().moving = true;
   }
 #endif
 #ifdef LASER_RAYCAST_HAVE_BULLET

@@ -195,7 +195,8 @@ std::vector<RayL> exactRays(const std::vector<core::Ray>& rays) {
 }
 
 std::vector<RayL> pipelineRays(const std::vector<SensorPose>& poses, const core::FanSpec& fan,
-                               const std::vector<double>& elevations, double tmax) {
+                               const std::vector<double>& elevations, double tmax,
+                               bool per_column) {
   // Azimuth i at angle_min + i * increment, as core::ScanPattern defines it, without rounding.
   const int n = fan.beamCount();
   const Real angle_min = fan.angle_min;
@@ -211,14 +212,17 @@ std::vector<RayL> pipelineRays(const std::vector<SensorPose>& poses, const core:
       dirs.emplace_back(ce * std::cos(a), ce * std::sin(a), se);
     }
   }
+  std::vector<PoseL> sensors;
+  for (const SensorPose& p : poses) sensors.push_back(p.exact());
+  const std::size_t scans = per_column ? poses.size() / n : poses.size();
   std::vector<RayL> out;
-  out.reserve(poses.size() * dirs.size());
-  for (const SensorPose& p : poses) {
-    const PoseL sensor = p.exact();
-    for (const Vec3L& d : dirs) {
+  out.reserve(scans * dirs.size());
+  for (std::size_t scan = 0; scan < scans; ++scan) {
+    for (std::size_t b = 0; b < dirs.size(); ++b) {
+      const PoseL& sensor = per_column ? sensors[scan * n + b % n] : sensors[scan];
       RayL ray;
       ray.origin = sensor.trans;
-      ray.dir = sensor.rot * d;
+      ray.dir = sensor.rot * dirs[b];
       ray.tmin = 0;
       ray.tmax = tmax;
       out.push_back(ray);

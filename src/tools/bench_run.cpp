@@ -57,15 +57,17 @@ void crossCheckReference(const std::string& label, const std::vector<Real>& tria
             << static_cast<double>(max_diff) << " m\n";
 }
 
-// The pipeline's beams as it holds them: the double sensor poses and the double directions of
-// core::ScanPattern, composed in long double.
+// The pipeline's beams as it holds them: the double sensor poses (a sweep's column poses) and the
+// double directions of core::ScanPattern, composed in long double.
 std::vector<RayL> pipelineInputRays(const WorkloadRays& w) {
   std::vector<RayL> out;
-  for (const Eigen::Isometry3d& sensor : w.sensors) {
-    for (const Eigen::Vector3d& d : w.pattern->directions()) {
+  const auto& directions = w.pattern->directions();
+  for (std::size_t scan = 0; scan < w.scans(); ++scan) {
+    for (int b = 0; b < w.pattern->size(); ++b) {
+      const Eigen::Isometry3d& sensor = w.sensors[w.poseIndex(scan, b)];
       RayL ray;
       ray.origin = sensor.translation().cast<Real>();
-      ray.dir = sensor.linear().cast<Real>() * d.cast<Real>();
+      ray.dir = sensor.linear().cast<Real>() * directions[b].cast<Real>();
       ray.tmin = 0;
       ray.tmax = w.tmax;
       out.push_back(ray);
@@ -85,10 +87,10 @@ References computeReferences(const BenchScene& scene, const SceneGeometry& geome
   References refs;
   const std::vector<RayL> exact = exactRays(rays.rays);
   refs.soup = referenceSoup(geometry.bvh, exact);
-  refs.pipeline = referenceBodies(
-      scene, pipelineRays(rays.poses, workload.fan, workload.elevations, rays.tmax));
-  std::cerr << "  " << workload.name << ": " << rays.rays.size() << " rays from "
-            << rays.poses.size() << " poses; the reference hits " << countHits(refs.soup)
+  refs.pipeline = referenceBodies(scene, pipelineRays(rays.poses, workload.fan, workload.elevations,
+                                                     rays.tmax, !rays.sweeps.empty()));
+  std::cerr << "  " << workload.name << ": " << rays.rays.size() << " rays from " << rays.scans()
+            << (rays.sweeps.empty() ? " poses" : " rotating scans") << "; the reference hits " << countHits(refs.soup)
             << " (soup) and " << countHits(refs.pipeline) << " (pipeline), computed in "
             << secondsSince(start) << " s\n";
   refs.pipeline_inputs = referenceBodies(scene, pipelineInputRays(rays));
@@ -179,7 +181,7 @@ Row measureRow(const Method& method, const std::vector<double>& dist, const std:
 void runWorkload(const Settings& settings, int poses, const BenchScene& scene,
                  const SceneGeometry& geometry, const SceneMethods& methods,
                  const Workload& workload, std::vector<Row>* rows) {
-  const WorkloadRays rays = makeRays(scene, workload, poses, scene.range_max);
+  const WorkloadRays rays = makeRays(scene, geometry.bvh, workload, poses, scene.range_max);
   const References refs = computeReferences(scene, geometry, workload, rays);
   std::vector<int> all(rays.rays.size());
   std::iota(all.begin(), all.end(), 0);
@@ -199,6 +201,7 @@ void runWorkload(const Settings& settings, int poses, const BenchScene& scene,
   std::vector<Measured> measured;
   for (const Method& method : methods.rows) {
     if (method.planar_only && !rays.pattern->planar()) continue;
+    if (workload.motion != Motion::kStill && !method.moving) continue;
     const std::vector<int>& used = method.brute ? subset : all;
     std::vector<double> dist = unknown();
     Measured m{&method, &used, 0, {}, {}};

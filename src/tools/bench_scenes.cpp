@@ -209,18 +209,19 @@ void buildVertexRows(BenchScene* s) {
   }
 }
 
-// One mesh of 400 slightly tapered trunks (a single body, as one STL file holding many objects
-// loads), 2,500 triangles each, scattered over a disc of 60 m radius: 354 stems per hectare, a
-// managed forest's density, so that a laser in the middle sees near and far trunks within 30 m and
-// many beams between them. Every trunk has rings of vertices at the same heights (every 0.5 m) and
-// every laser is level at a ring's height: the fan's scan plane runs exactly along the rings'
-// shared edges, the worst case for watertightness.
-void buildForest(BenchScene* s) {
-  constexpr std::size_t kTrunks = 400;
+// One mesh of slightly tapered trunks (a single body, as one STL file holding many objects loads),
+// 2,500 triangles each, scattered over a disc: 354 stems per hectare, a managed forest's density,
+// so that a laser in the middle sees near and far trunks within 30 m and many beams between them.
+// Every trunk has rings of vertices at the same heights (every 0.5 m) and every laser is level at
+// a ring's height: the fan's scan plane runs exactly along the rings' shared edges, the worst case
+// for watertightness. forest: 400 trunks on a disc of 60 m radius (1M triangles); forest_10m:
+// 4,000 on one of 190 m (10M triangles, a 1 GB STL's worth), the same density.
+void buildForest(BenchScene* s, std::size_t trunks, double disc_radius) {
   constexpr int kSegments = 50;
-  constexpr double kDiscRadius = 60, kSpacing = 1.5, kLaserZ = 1.0;
+  constexpr double kSpacing = 1.5, kLaserZ = 1.0;
   const std::vector<double> rings = steps(0.0, 12.5, 0.5);  // 25 bands x 50 segments x 2
-  s->note = "a forest: one mesh of 400 trunks of 2500 triangles on a 60 m disc, laser at a ring";
+  s->note = "a forest: one mesh of " + std::to_string(trunks) + " trunks of 2500 triangles on a " +
+            std::to_string(std::lround(disc_radius)) + " m disc, laser at a ring";
   s->range_max = 30;
   const double z = kLaserZ;  // rings[2], exactly
   s->sensor_poses = {{0.0, 0.0, z, 0, 0, 0.3},    {8.4, -5.1, z, 0, 0, 2.2},
@@ -230,10 +231,10 @@ void buildForest(BenchScene* s) {
   std::mt19937_64 rng(20250301);
   MeshData forest;
   std::vector<Eigen::Vector2d> placed;
-  for (int attempt = 0; placed.size() < kTrunks && attempt < 1000000; ++attempt) {
-    const Eigen::Vector2d p(uniform(rng, -kDiscRadius, kDiscRadius),
-                            uniform(rng, -kDiscRadius, kDiscRadius));
-    bool free = p.norm() <= kDiscRadius;
+  for (int attempt = 0; placed.size() < trunks && attempt < 1000000; ++attempt) {
+    const Eigen::Vector2d p(uniform(rng, -disc_radius, disc_radius),
+                            uniform(rng, -disc_radius, disc_radius));
+    bool free = p.norm() <= disc_radius;
     for (const auto& q : placed) free = free && (p - q).norm() >= kSpacing;
     for (const auto& v : s->sensor_poses) {
       free = free && (p - Eigen::Vector2d(v.x, v.y)).norm() >= kSpacing;
@@ -246,17 +247,19 @@ void buildForest(BenchScene* s) {
     forest.append(trunk);
     placed.push_back(p);
   }
-  if (placed.size() < kTrunks) throw std::runtime_error("forest: could not place the trunks");
+  if (placed.size() < trunks) throw std::runtime_error("forest: could not place the trunks");
   SceneBuilder(s).add(forest, PoseL{}, "forest");
 }
 
 }  // namespace
 
 const std::vector<std::string>& sceneNames() {
-  static const std::vector<std::string> names = {"sphere",      "box_room", "tb3",      "million",
-                                                 "vertex_rows", "forest",   "warehouse"};
+  static const std::vector<std::string> names = {"sphere", "box_room",  "tb3",       "million",
+                                                 "vertex_rows", "forest", "warehouse", "forest_10m"};
   return names;
 }
+
+bool isLargeScene(const std::string& name) { return name == "forest_10m"; }
 
 std::string findSharedData() {
   const char* env = std::getenv("LASER_RAYCAST_SHARED_DATA");
@@ -284,7 +287,9 @@ std::optional<BenchScene> makeScene(const std::string& name, const std::string& 
   } else if (name == "vertex_rows") {
     buildVertexRows(&s);
   } else if (name == "forest") {
-    buildForest(&s);
+    buildForest(&s, 400, 60);
+  } else if (name == "forest_10m") {
+    buildForest(&s, 4000, 190);
   } else if (name == "warehouse") {
     buildWarehouse(&s);
   } else {

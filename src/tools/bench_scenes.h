@@ -41,6 +41,9 @@ struct BenchScene {
 
 // The scene names, in output order.
 const std::vector<std::string>& sceneNames();
+// Whether a scene is left out of a --quick run unless named (forest_10m: its build alone takes
+// about a minute).
+bool isLargeScene(const std::string& name);
 
 // Builds the named scene. tb3 needs the directory holding tb3_world_data (shared_data_dir) and
 // returns nullopt without it; every other scene is generated. Throws std::runtime_error if

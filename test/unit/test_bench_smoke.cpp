@@ -1,5 +1,6 @@
 // The benchmark tool run as a user would: `bench --quick --out DIR`. Checks the outputs' format
-// (a stable interface), that every method has a row for every workload and scene that ran, that
+// (a stable interface), that every method has a row for every still workload and scene that ran
+// and the pipeline and Embree for every moving one (with a finite speed ratio), that
 // the production rows (watertight_bvh, pipeline) neither leak nor hit what is not there, that the
 // agreement columns compare beam for beam (embree_robust agrees with itself on every beam), and
 // that --method keeps only the rows asked for. Never timings: the machine may be busy. The quick
@@ -77,6 +78,52 @@ std::string tempDir(const std::string& name) {
   return dir;
 }
 
+// The beams of one scan of each workload: still (fan2d, rings3d) and moving.
+const std::map<std::string, long> kWorkloadBeams = {
+    {"fan2d", 1081},    {"rings3d", 64 * 1024},    {"fan_path", 1081}, {"fan_path_tilted", 1081},
+    {"rings_path", 16 * 1800}, {"sweep_fan", 360}, {"sweep_rings", 16 * 1800}};
+
+bool isBruteForce(const std::string& method) {
+  return method.size() > 6 && method.compare(method.size() - 6, 6, "_brute") == 0;
+}
+
+bool isMovingRow(const std::string& method) {
+  return method == "pipeline" || method == "embree_default" || method == "embree_robust";
+}
+
+// The rows a workload has in a run of every method (those of --list-methods).
+std::set<std::string> expectedRows(const std::string& workload,
+                                   const std::vector<std::string>& methods) {
+  const bool still = workload == "fan2d" || workload == "rings3d";
+  std::set<std::string> rows;
+  for (const std::string& m : methods) {
+    if (still ? m != "pipeline_new_plane" || workload == "fan2d" : isMovingRow(m)) rows.insert(m);
+  }
+  return rows;
+}
+
+// Every moving row of the pipeline has Embree's time beside it (when Embree is built in): both
+// positive, so the ratio the README reports is finite and positive.
+void expectMovingRatios(const std::vector<std::string>& lines, bool has_embree) {
+  std::map<std::pair<std::string, std::string>, std::map<std::string, double>> ns;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const auto f = splitFields(lines[i]);
+    double value = 0;
+    if (f.size() == kFields && parseDouble(f[6], &value)) ns[{f[0], f[1]}][f[2]] = value;
+  }
+  int moving = 0;
+  for (const auto& [key, rows] : ns) {
+    if (key.first == "fan2d" || key.first == "rings3d") continue;
+    ++moving;
+    ASSERT_EQ(rows.count("pipeline"), 1u) << key.first << ", " << key.second;
+    if (!has_embree) continue;
+    ASSERT_EQ(rows.count("embree_default"), 1u) << key.first << ", " << key.second;
+    const double ratio = rows.at("embree_default") / rows.at("pipeline");
+    EXPECT_TRUE(std::isfinite(ratio) && ratio > 0) << key.first << ", " << key.second;
+  }
+  EXPECT_GT(moving, 0);
+}
+
 TEST(BenchSmoke, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runCommand(kBench + " --no-such-flag 2>/dev/null").status, 2);
   EXPECT_EQ(runCommand(kBench + " --scene nowhere 2>/dev/null").status, 2);
@@ -91,7 +138,7 @@ TEST(BenchSmoke, ListsTheScenes) {
   ASSERT_EQ(result.status, 0);
   EXPECT_EQ(splitLines(result.output),
             (std::vector<std::string>{"sphere", "box_room", "tb3", "million", "vertex_rows",
-                                      "forest", "warehouse"}));
+                                      "forest", "warehouse", "forest_10m"}));
 }
 
 TEST(BenchSmoke, HelpListsEveryFlag) {
@@ -164,6 +211,10 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
     double ns = 0, mrays = 0, max_err = 0, p99_err = 0, max_ulp = 0;
     EXPECT_TRUE(parseCount(f[4], &triangles)) << lines[i];
     EXPECT_TRUE(parseCount(f[5], &rays) && rays > 0) << lines[i];
+    ASSERT_EQ(kWorkloadBeams.count(f[0]), 1u) << lines[i];
+    if (!isBruteForce(method)) {  // whole scans: the beams of every pose
+      EXPECT_EQ(rays % kWorkloadBeams.at(f[0]), 0) << lines[i];
+    }
     EXPECT_TRUE(parseDouble(f[6], &ns) && ns > 0) << lines[i];
     EXPECT_TRUE(parseDouble(f[7], &mrays) && mrays > 0) << lines[i];
     EXPECT_TRUE(parseDouble(f[8], &max_err) && max_err >= 0) << lines[i];
@@ -178,23 +229,21 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
     expectAgreementFields(f[13], f[14], has_robust, rays, method == "embree_robust", lines[i]);
   }
 
-  // Every method for every workload and scene that ran, but pipeline_new_plane on planar fans only
-  // (elsewhere it is the pipeline); every generated scene in both workloads (tb3 runs only where
-  // its data is).
+  // Every method for every still workload and scene that ran, but pipeline_new_plane on planar
+  // fans only (elsewhere it is the pipeline); the pipeline and Embree's rows for the moving ones.
+  // Every generated scene in every workload (tb3 runs only where its data is), but forest_10m,
+  // which --quick leaves out.
   for (const auto& [key, present] : ran) {
-    const bool planar = key.first == "fan2d";
-    for (const std::string& m : methods) {
-      EXPECT_EQ(present.count(m), m == "pipeline_new_plane" && !planar ? 0u : 1u)
-          << m << " for " << key.first << ", " << key.second;
-    }
-    EXPECT_EQ(present.size(), methods.size() - (planar ? 0 : 1)) << key.first << ", " << key.second;
+    EXPECT_EQ(present, expectedRows(key.first, methods)) << key.first << ", " << key.second;
   }
   for (const std::string scene :
        {"sphere", "box_room", "million", "vertex_rows", "forest", "warehouse"}) {
-    for (const std::string workload : {"fan2d", "rings3d"}) {
+    for (const auto& [workload, beams] : kWorkloadBeams) {
       EXPECT_EQ(ran.count({workload, scene}), 1u) << workload << ", " << scene;
     }
   }
+  for (const auto& [key, present] : ran) EXPECT_NE(key.second, "forest_10m");
+  expectMovingRatios(lines, has_robust);
 
   EXPECT_FALSE(readFile(dir + "/results.md").empty());
   for (const std::string name : {"pareto.png", "pareto_matrix.png"}) {
@@ -215,7 +264,8 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  ASSERT_EQ(lines.size(), 5u) << readFile(dir + "/results.csv");  // header, 2 workloads x 2 rows
+  // header, 2 still workloads x 2 rows, 5 moving ones x the pipeline's row
+  ASSERT_EQ(lines.size(), 10u) << readFile(dir + "/results.csv");
   std::multiset<std::string> rows;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const auto f = splitFields(lines[i]);
@@ -223,8 +273,10 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
     EXPECT_EQ(f[1], "box_room") << lines[i];
     rows.insert(f[0] + " " + f[2]);
   }
-  EXPECT_EQ(rows, (std::multiset<std::string>{"fan2d watertight_bvh", "fan2d pipeline",
-                                              "rings3d watertight_bvh", "rings3d pipeline"}));
+  EXPECT_EQ(rows, (std::multiset<std::string>{
+                      "fan2d watertight_bvh", "fan2d pipeline", "rings3d watertight_bvh",
+                      "rings3d pipeline", "fan_path pipeline", "fan_path_tilted pipeline",
+                      "rings_path pipeline", "sweep_fan pipeline", "sweep_rings pipeline"}));
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
 }
@@ -239,8 +291,8 @@ TEST(BenchSmoke, NewPlaneRowHasThePipelinesRanges) {
       " --quick --scene forest --method pipeline pipeline_new_plane --out " + dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  // header, fan2d x 2 rows, rings3d x 1 row
-  ASSERT_EQ(lines.size(), 4u) << readFile(dir + "/results.csv");
+  // header, fan2d x 2 rows, rings3d x 1 row, then the pipeline's 5 moving rows
+  ASSERT_EQ(lines.size(), 9u) << readFile(dir + "/results.csv");
   const auto kept = splitFields(lines[1]), fresh = splitFields(lines[2]);
   ASSERT_EQ(kept.size(), kFields);
   ASSERT_EQ(fresh.size(), kFields);
@@ -264,7 +316,7 @@ TEST(BenchSmoke, ThreadsAddsAPipelineRowWithTheSameRanges) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  ASSERT_EQ(lines.size(), 5u) << readFile(dir + "/results.csv");  // header, 2 workloads x 2 rows
+  ASSERT_EQ(lines.size(), 15u) << readFile(dir + "/results.csv");  // header, 7 workloads x 2
   for (std::size_t i = 1; i + 1 < lines.size(); i += 2) {
     const auto one = splitFields(lines[i]), two = splitFields(lines[i + 1]);
     ASSERT_EQ(one.size(), kFields) << lines[i];
@@ -282,6 +334,36 @@ TEST(BenchSmoke, ThreadsAddsAPipelineRowWithTheSameRanges) {
   EXPECT_EQ(runCommand(kBench + " --threads two 2>/dev/null").status, 2);
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
+}
+
+// The paths are generated from a fixed seed: two runs cast the same beams from the same poses,
+// so every moving row's rays, errors and agreement are the same, field for field.
+TEST(BenchSmoke, MovingRowsAreTheSameInEveryRun) {
+  std::vector<std::vector<std::string>> runs;
+  for (int run = 0; run < 2; ++run) {
+    const std::string dir = tempDir("bench_paths" + std::to_string(run));
+    const std::string log = dir + ".log";
+    const auto result = runCommand("timeout 300 " + kBench +
+                                   " --quick --scene sphere --method pipeline --out " + dir +
+                                   " 2>" + log);
+    ASSERT_EQ(result.status, 0) << readFile(log);
+    runs.push_back(splitLines(readFile(dir + "/results.csv")));
+    std::filesystem::remove_all(dir);
+    std::filesystem::remove(log);
+  }
+  ASSERT_EQ(runs[0].size(), runs[1].size());
+  int moving = 0;
+  for (std::size_t i = 1; i < runs[0].size(); ++i) {
+    const auto a = splitFields(runs[0][i]), b = splitFields(runs[1][i]);
+    ASSERT_EQ(a.size(), kFields) << runs[0][i];
+    ASSERT_EQ(b.size(), kFields) << runs[1][i];
+    if (a[0] == "fan2d" || a[0] == "rings3d") continue;
+    ++moving;
+    for (const std::size_t k : {0, 1, 2, 5, 8, 9, 10, 11, 12, 13, 14}) {
+      EXPECT_EQ(a[k], b[k]) << "field " << k << ": " << runs[0][i] << " / " << runs[1][i];
+    }
+  }
+  EXPECT_EQ(moving, 5);
 }
 
 }  // namespace
