@@ -239,7 +239,8 @@ std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settin
 std::string commandLine(const Options& options) {
   std::string command = "bench";
   if (options.quick) command += " --quick";
-  if (options.scenes != defaultScenes(options.quick)) command += " --scene " + joined(options.scenes);
+  if (options.scenes != defaultScenes(options.quick))
+    command += " --scene " + joined(options.scenes);
   if (!options.methods.empty()) command += " --method " + joined(options.methods);
   if (options.threads != 1) command += " --threads " + std::to_string(options.threads);
   return command;

@@ -185,9 +185,8 @@ std::vector<Workload> stillWorkloads() {
 std::vector<SensorPose> pathPoses(const BenchScene& scene, const core::Bvh& soup_bvh,
                                   const Workload& workload, int scans) {
   const int step = std::max(1, static_cast<int>(std::lround(kTfRate / workload.scan_rate)));
-  const std::vector<SensorPose> path = drivePath(scene.sensor_poses, soup_bvh,
-                                                 (scans - 1) * step + 1, workload.tilt_sigma,
-                                                 kPathSeed);
+  const std::vector<SensorPose> path = drivePath(
+      scene.sensor_poses, soup_bvh, (scans - 1) * step + 1, workload.tilt_sigma, kPathSeed);
   std::vector<SensorPose> poses;
   for (int k = 0; k < scans; ++k) poses.push_back(path[k * step]);
   return poses;

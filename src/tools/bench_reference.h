@@ -73,11 +73,10 @@ std::vector<RayL> exactRays(const std::vector<core::Ray>& rays);
 
 // The pipeline's beams: every beam of the pattern (directions from the fan's angles and the
 // elevations, in long double) from every sensor pose (from its parameters, in long double). With
-// per_column, poses holds one pose per azimuth column of each scan (a rotating sweep's), scan-major,
-// and each beam leaves from its column's.
+// per_column, poses holds one pose per azimuth column of each scan (a rotating sweep's),
+// scan-major, and each beam leaves from its column's.
 std::vector<RayL> pipelineRays(const std::vector<SensorPose>& poses, const core::FanSpec& fan,
-                               const std::vector<double>& elevations, double tmax,
-                               bool per_column);
+                               const std::vector<double>& elevations, double tmax, bool per_column);
 
 // Distances (m) on the soup (soup_bvh is built over it): t times |dir|, as each method's distance
 // is its t times the length of the direction it was given.

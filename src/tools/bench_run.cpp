@@ -88,11 +88,11 @@ References computeReferences(const BenchScene& scene, const SceneGeometry& geome
   const std::vector<RayL> exact = exactRays(rays.rays);
   refs.soup = referenceSoup(geometry.bvh, exact);
   refs.pipeline = referenceBodies(scene, pipelineRays(rays.poses, workload.fan, workload.elevations,
-                                                     rays.tmax, !rays.sweeps.empty()));
+                                                      rays.tmax, !rays.sweeps.empty()));
   std::cerr << "  " << workload.name << ": " << rays.rays.size() << " rays from " << rays.scans()
-            << (rays.sweeps.empty() ? " poses" : " rotating scans") << "; the reference hits " << countHits(refs.soup)
-            << " (soup) and " << countHits(refs.pipeline) << " (pipeline), computed in "
-            << secondsSince(start) << " s\n";
+            << (rays.sweeps.empty() ? " poses" : " rotating scans") << "; the reference hits "
+            << countHits(refs.soup) << " (soup) and " << countHits(refs.pipeline)
+            << " (pipeline), computed in " << secondsSince(start) << " s\n";
   refs.pipeline_inputs = referenceBodies(scene, pipelineInputRays(rays));
   refs.same_hit.resize(rays.rays.size());
   for (std::size_t i = 0; i < refs.same_hit.size(); ++i) {

@@ -254,8 +254,8 @@ void buildForest(BenchScene* s, std::size_t trunks, double disc_radius) {
 }  // namespace
 
 const std::vector<std::string>& sceneNames() {
-  static const std::vector<std::string> names = {"sphere", "box_room",  "tb3",       "million",
-                                                 "vertex_rows", "forest", "warehouse", "forest_10m"};
+  static const std::vector<std::string> names = {
+      "sphere", "box_room", "tb3", "million", "vertex_rows", "forest", "warehouse", "forest_10m"};
   return names;
 }
 

@@ -80,8 +80,9 @@ std::string tempDir(const std::string& name) {
 
 // The beams of one scan of each workload: still (fan2d, rings3d) and moving.
 const std::map<std::string, long> kWorkloadBeams = {
-    {"fan2d", 1081},    {"rings3d", 64 * 1024},    {"fan_path", 1081}, {"fan_path_tilted", 1081},
-    {"rings_path", 16 * 1800}, {"sweep_fan", 360}, {"sweep_rings", 16 * 1800}};
+    {"fan2d", 1081},           {"rings3d", 64 * 1024},    {"fan_path", 1081},
+    {"fan_path_tilted", 1081}, {"rings_path", 16 * 1800}, {"sweep_fan", 360},
+    {"sweep_rings", 16 * 1800}};
 
 bool isBruteForce(const std::string& method) {
   return method.size() > 6 && method.compare(method.size() - 6, 6, "_brute") == 0;
@@ -343,9 +344,9 @@ TEST(BenchSmoke, MovingRowsAreTheSameInEveryRun) {
   for (int run = 0; run < 2; ++run) {
     const std::string dir = tempDir("bench_paths" + std::to_string(run));
     const std::string log = dir + ".log";
-    const auto result = runCommand("timeout 300 " + kBench +
-                                   " --quick --scene sphere --method pipeline --out " + dir +
-                                   " 2>" + log);
+    const auto result =
+        runCommand("timeout 300 " + kBench + " --quick --scene sphere --method pipeline --out " +
+                   dir + " 2>" + log);
     ASSERT_EQ(result.status, 0) << readFile(log);
     runs.push_back(splitLines(readFile(dir + "/results.csv")));
     std::filesystem::remove_all(dir);
