@@ -152,6 +152,10 @@ WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) :
   const Builder::Summary root = builder.collapse(bvh.root());
   root_ = root.ref;
   root_triangles_ = root.triangles;
+  // Grown one node at a time, the arrays hold up to twice what they use (38 bytes a triangle of a
+  // 20M-triangle terrain): given back once the tree is whole.
+  nodes_.shrink_to_fit();
+  child_triangles_.shrink_to_fit();
 }
 
 WideBoxRay::WideBoxRay(const Ray& ray, const Aabb& bounds) {

@@ -27,11 +27,14 @@ namespace {
 
 // How the columns are cut into blocks. These change only the speed, never a range: a wider block
 // pays for its columns' spread with wider windows, a narrower one walks the scene's trees more
-// often. A block is halved while its poses turn by more than kMaxBlockTurn or move by more than
-// kMaxBlockShift, or a frame's pose or the sensor's is valid at some of its columns only.
+// often. A block is halved while its poses turn by more than kMaxBlockTurn (or a fraction
+// kTurnPerIncrement of the pattern's azimuth increment, if less: a turn of a column or more widens
+// every triangle's raster by that many beams) or move by more than kMaxBlockShift, or a frame's
+// pose or the sensor's is valid at some of its columns only.
 constexpr int kBlockColumns = 32;
-constexpr double kMaxBlockTurn = 0.02;   // rad
-constexpr double kMaxBlockShift = 0.05;  // m
+constexpr double kMaxBlockTurn = 0.02;    // rad
+constexpr double kTurnPerIncrement = 0.5;
+constexpr double kMaxBlockShift = 0.01;   // m
 
 // The poses of a sweep's columns: the sensor's, and each frame with bodies (static frames, at one
 // pose in every sample, are not interpolated). The same poses as PoseSamples::sensorAt and
@@ -161,6 +164,7 @@ class BlockPlanner {
                const ScanPattern& pattern, const CastConfig& config)
       : scene_(scene), poses_(poses), samples_(samples), pattern_(pattern), config_(config) {
     for (double e : pattern.elevations()) steepest_ = std::max(steepest_, std::abs(e));
+    max_turn_ = std::min(kMaxBlockTurn, kTurnPerIncrement * std::abs(pattern.angleIncrement()));
   }
 
   // Blocks over [lo, hi], every column of which has a sensor pose, in column order.
@@ -233,8 +237,8 @@ class BlockPlanner {
     return std::make_shared<ColumnMotion>(lo, std::move(ref_from_column), steepest_);
   }
 
-  static bool small(const ColumnMotion& m) {
-    return m.spread().turn <= kMaxBlockTurn && m.spread().shift <= kMaxBlockShift;
+  bool small(const ColumnMotion& m) const {
+    return m.spread().turn <= max_turn_ && m.spread().shift <= kMaxBlockShift;
   }
 
   const Scene& scene_;
@@ -243,7 +247,28 @@ class BlockPlanner {
   const ScanPattern& pattern_;
   const CastConfig& config_;
   double steepest_ = 0;
+  double max_turn_ = kMaxBlockTurn;  // rad, for this pattern
 };
+
+// Whether any beam of the block's columns can meet the group's tree (its box's view from the
+// reference pose, widened by the block's spread): a cheap test before any walk.
+bool reachesBlock(const PlacedGroup& p, const SweepBlock& block, const ScanPattern& pattern,
+                  const CastConfig& config) {
+  const ColumnMotion* motion = block.motion[p.group->frame].get();
+  const Aabb& bounds = p.group->tree.bounds();
+  const Eigen::Matrix3d& rot = p.sensor_from_frame->linear();
+  const View view =
+      boxView(bounds.center(), bounds.extent() * 0.5, rot, rot.cwiseAbs(),
+              p.sensor_from_frame->translation(), pattern.angleMin(), !pattern.planar(),
+              motion ? motion->spread() : Spread());
+  if (!(view.near <= config.tmax) || (pattern.planar() && !view.crosses)) return false;
+  if (!view.azimuth_limited) return true;
+  bool reaches = false;
+  forEachBeamRange(pattern, view.azimuth_start, view.azimuth_width, [&](int first, int last) {
+    reaches = reaches || (first <= block.col_hi && last >= block.col_lo);
+  });
+  return reaches;
+}
 
 }  // namespace
 
@@ -281,6 +306,13 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
     int skipped = 0, kept = 0;
     state_->placeGroups(scene, block.key, pattern, &block.placed, &skipped);
     result_.stats.bodies_skipped = std::max(result_.stats.bodies_skipped, skipped);
+    // Only the frames a block can see: a scene of many frames (a warehouse of racks, each its own)
+    // would otherwise be walked from every frame's root in every block.
+    block.placed.erase(std::remove_if(block.placed.begin(), block.placed.end(),
+                                      [&](const PlacedGroup& p) {
+                                        return !reachesBlock(p, block, pattern, config);
+                                      }),
+                       block.placed.end());
     block.slices.assign(block.placed.size(), nullptr);
     for (std::size_t g = 0; g < block.placed.size() && slices; ++g) {
       const SceneIndex::Group& group = *block.placed[g].group;

@@ -384,14 +384,19 @@ class MeshWalk {
   // leaf's near distance, which no triangle of it is nearer than), each candidate tested from its
   // column's pose.
   void rasterColumns(const Entry& e) {
-    const double shift = spread_.shift, near = e.near;
-    const double widen = near > 2 * shift
-                             ? std::sin(std::min(M_PI / 2, spread_.turn + std::asin(shift / near)))
-                             : 1.0;
+    const double shift = spread_.shift;
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
       if (hidden(slot)) continue;
       const SensorTriangle s = sensorTriangle(slot);
       const std::uint32_t triangle = ids_[slot];
+      // No point of the triangle is nearer than its plane (lowered for the rounding), nor than the
+      // leaf: the larger, so that a leaf around the sensor (a room's walls) still rasterises.
+      const Eigen::Vector3d n = (s.b - s.a).cross(s.c - s.a);
+      const double plane = std::abs(n.dot(s.a)) / n.norm() * (1 - 1e-9);
+      const double near = std::max(double(e.near), std::isfinite(plane) ? plane : 0.0);
+      const double widen = near > 2 * shift ? std::sin(std::min(
+                                                  M_PI / 2, spread_.turn + std::asin(shift / near)))
+                                            : 1.0;
       const ColumnRaster raster(beams_, s.a, s.b, s.c, widen, shift, spread_.turn);
       raster.forEachCandidate(beams_, e.rect, [&](int row, int col) {
         const double range = beams_.range(row, col);
@@ -403,6 +408,7 @@ class MeshWalk {
       });
     }
   }
+
 
   // For patterns too steep for the column raster: each triangle against the open beams of its own window (the
   // view of its sensor-frame box, widened by the block's spread), each from its column's pose.
