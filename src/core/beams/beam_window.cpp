@@ -28,11 +28,13 @@ View sphereView(const Eigen::Vector3d& center, double radius, double angle_min) 
 
 Spread Spread::of(double shift, double turn, double tilt, double steepest) {
   Spread s;
-  // The offsets and angles were computed in double from poses a few roundings off: a relative
-  // widening of 1e-9 and an absolute one far above double's rounding at these magnitudes.
-  s.shift = shift > 0 ? shift * (1 + 1e-9) + 1e-12 : 0;
-  s.turn = turn > 0 ? turn * (1 + 1e-9) + 1e-12 : 0;
-  s.tilt = tilt > 0 ? tilt * (1 + 1e-9) + 1e-12 : 0;
+  // The beams start exactly at the offsets the shift was taken from (widened for the rounding of
+  // the norm); the angles come from differences R - I of entries of order 1, each a few ulps off,
+  // and the beams' directions are rounded once more when turned: a relative widening and 16 ulps
+  // of 1.
+  s.shift = shift > 0 ? shift * (1 + 1e-9) : 0;
+  s.turn = turn > 0 ? turn * (1 + 1e-9) + 16 * kEps : 0;
+  s.tilt = tilt > 0 ? tilt * (1 + 1e-9) + 16 * kEps : 0;
   // Two unit vectors at most `turn` apart, both within E of the horizontal, have horizontal
   // parts of length >= cos E whose angle b satisfies cos E sin b <= 2 sin(turn / 2) (the chord).
   const double e = std::min(M_PI / 2, steepest + s.turn);

@@ -41,15 +41,17 @@ void storeElevations(const __m128 c[3], const __m128 e[3], __m128 rho2, __m128 r
 
 }  // namespace
 
+SpreadPs::SpreadPs(const Spread& spread)
+    : any(spread.any()),
+      every_azimuth(!(spread.azimuth < 1.5)),
+      shift(_mm_set1_ps(floatAbove(spread.shift))),
+      sin_tilt(_mm_set1_ps(floatAbove(std::sin(spread.tilt) * (1 + 1e-9)))),
+      turn(_mm_set1_ps(floatAbove(spread.turn))),
+      azimuth(_mm_set1_ps(every_azimuth ? 0.0f : floatAbove(spread.azimuth))) {}
+
 ViewBasis::ViewBasis(const Eigen::Isometry3d& sensor_from_body, bool planar, double tmax,
                      const Spread& spread)
-    : planar_(planar) {
-  spread_ = spread.any();
-  shift_ = _mm_set1_ps(floatAbove(spread.shift));
-  sin_tilt_ = _mm_set1_ps(floatAbove(std::sin(spread.tilt) * (1 + 1e-9)));
-  turn_ = _mm_set1_ps(floatAbove(spread.turn));
-  azimuth_all_ = !(spread.azimuth < 1.5);
-  azimuth_ = _mm_set1_ps(azimuth_all_ ? 0.0f : floatAbove(spread.azimuth));
+    : spread_(spread), planar_(planar) {
   const Eigen::Matrix3d& r = sensor_from_body.linear();
   const Eigen::Vector3d& t = sensor_from_body.translation();
   for (int i = 0; i < 3; ++i) {
@@ -84,7 +86,7 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewBasis& f) {
     c[i] = ci;
     mag[i] = m;
     e[i] = _mm_add_ps(ei, _mm_mul_ps(slack, _mm_add_ps(m, ei)));
-    if (f.spread_) e[i] = _mm_add_ps(e[i], f.shift_);  // every origin of the block's beams
+    if (f.spread_.any) e[i] = _mm_add_ps(e[i], f.spread_.shift);  // every origin of the block's beams
   }
   // Nearest distance: the norm of the gap between the sensor and the box, lowered by the slack.
   // If the squares overflow, the largest gap is still a lower bound.
@@ -103,11 +105,11 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewBasis& f) {
 
   // Present, within tmax, and (planar) meeting the plane.
   __m128 ok = _mm_cmple_ps(near, f.tmax_);
-  if (f.planar_ && !f.spread_) ok = _mm_and_ps(ok, _mm_cmple_ps(absPs(c[2]), e[2]));
-  if (f.planar_ && f.spread_) {
+  if (f.planar_ && !f.spread_.any) ok = _mm_and_ps(ok, _mm_cmple_ps(absPs(c[2]), e[2]));
+  if (f.planar_ && f.spread_.any) {
     // A tilted column's plane rises at most (distance + shift) sin(tilt) above the reference one;
     // magnitude bounds the distance, and the factor the rounding of the product.
-    const __m128 rise = _mm_mul_ps(_mm_add_ps(magnitude, f.shift_), f.sin_tilt_);
+    const __m128 rise = _mm_mul_ps(_mm_add_ps(magnitude, f.spread_.shift), f.spread_.sin_tilt);
     const __m128 reach = _mm_mul_ps(_mm_add_ps(e[2], rise), _mm_set1_ps(1 + 8 * kViewSlack));
     ok = _mm_and_ps(ok, _mm_cmple_ps(absPs(c[2]), reach));
   }
@@ -127,16 +129,16 @@ void NodeViews::compute(const WideBvh::Node& node, const ViewBasis& f) {
   // on): the corners narrow it.
   narrowByCorners(f, c, eb, mag, rho2, &center, &half);
   half = _mm_add_ps(half, _mm_set1_ps(static_cast<float>(2 * kBearingError)));
-  if (f.spread_) half = _mm_add_ps(half, f.azimuth_);
-  __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
-  if (f.azimuth_all_) narrow = _mm_setzero_ps();
+  half = f.spread_.widenHalf(half);
+  const __m128 narrow =
+      f.spread_.keepLimited(_mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f))));
   _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
   _mm_store_ps(az_center, center);
   if (f.planar_) return;
   storeElevations(c, e, rho2, r2, el_lo, el_hi);
-  if (!f.spread_) return;
-  _mm_store_ps(el_lo, _mm_sub_ps(_mm_load_ps(el_lo), f.turn_));
-  _mm_store_ps(el_hi, _mm_add_ps(_mm_load_ps(el_hi), f.turn_));
+  if (!f.spread_.any) return;
+  _mm_store_ps(el_lo, _mm_sub_ps(_mm_load_ps(el_lo), f.spread_.turn));
+  _mm_store_ps(el_hi, _mm_add_ps(_mm_load_ps(el_hi), f.spread_.turn));
 }
 
 void NodeViews::narrowByCorners(const ViewBasis& f, const __m128 c[3], const __m128 eb[3],
@@ -158,12 +160,12 @@ void NodeViews::narrowByCorners(const ViewBasis& f, const __m128 c[3], const __m
     corners.add(x, y, c[0], c[1], rho2);
   }
   __m128 error = _mm_mul_ps(_mm_set1_ps(kViewSlack), _mm_add_ps(mag[0], mag[1]));
-  if (f.spread_) {
+  if (f.spread_.any) {
     // The box grown by the shift: each corner's x, y moves by up to sqrt(2) shift more. The bound
     // of narrow() (four times the turn of a corner within 60 degrees of the centre) holds for a
     // corner moved a little beyond 60 degrees if the factor is 5 (sec^2 of 63.4 degrees): kept
     // only where the move is below 5 % of the nearest corner's distance (so within 3 degrees).
-    error = _mm_add_ps(error, _mm_mul_ps(f.shift_, _mm_set1_ps(1.5f)));
+    error = _mm_add_ps(error, _mm_mul_ps(f.spread_.shift, _mm_set1_ps(1.5f)));
     const __m128 small = _mm_cmple_ps(
         _mm_mul_ps(_mm_mul_ps(error, _mm_sqrt_ps(rho2)), _mm_set1_ps(20.0f)), corners.min_dot);
     corners.ok = _mm_and_ps(corners.ok, small);

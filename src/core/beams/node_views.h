@@ -17,6 +17,21 @@
 namespace laser_raycast {
 namespace core {
 
+// A sweep block's Spread (beam_window.h) for the views of four boxes at once: rounded outwards to
+// float, and how a box's azimuth window is widened by it (NodeViews, SliceViews).
+struct SpreadPs {
+  explicit SpreadPs(const Spread& spread);
+
+  // A window's half width widened by the spread's azimuths.
+  __m128 widenHalf(__m128 half) const { return any ? _mm_add_ps(half, azimuth) : half; }
+  // Which windows stay limited in azimuth (none when the spread may turn to every azimuth).
+  __m128 keepLimited(__m128 limited) const { return every_azimuth ? _mm_setzero_ps() : limited; }
+
+  bool any = false;            // Spread::any()
+  bool every_azimuth = false;  // its azimuth widening reaches every azimuth
+  __m128 shift, sin_tilt, turn, azimuth;
+};
+
 // A body's pose relative to the sensor, prepared for node views.
 class ViewBasis {
  public:
@@ -30,10 +45,7 @@ class ViewBasis {
   friend int planeMask(const WideBvh::Node& node, const ViewBasis& basis);
   __m128 rot_[3][3], abs_rot_[3][3], trans_[3], abs_trans_[3];
   __m128 tmax_;
-  // The spread, rounded outwards to float: the shift, sin(tilt), the elevations' and the
-  // azimuths' widening (azimuth_all_: every azimuth).
-  __m128 shift_, sin_tilt_, turn_, azimuth_;
-  bool spread_ = false, azimuth_all_ = false;
+  SpreadPs spread_;
   bool planar_;
 };
 

@@ -197,9 +197,8 @@ void CasterState::castBodies(const Scene& scene, const ScanPattern& pattern,
                                const CastConfig& config, ScanResult* result) {
   KeptSlices* kept = nullptr;
   if (pattern.planar() && config.planar_fast_path && config.keep_slices) {
-    if (!planes) planes = std::make_unique<KeptSlices>();
-    planes->newScan();
-    kept = planes.get();
+    kept = &keptSlices();
+    kept->newScan();
   }
   // Planar fans: each frame's kept slice by this plane, where there is one.
   std::vector<std::pair<ScanPlane, const KeptSlice*>> slices;

@@ -26,11 +26,8 @@ inline __m128 floorPs(__m128 x) {
 }  // namespace
 
 SliceViewBasis::SliceViewBasis(const ScanPlane& p, double tmax, const ScanPattern& fan,
-                               const Spread& spread) {
-  spread_ = spread.any();
-  shift_ = _mm_set1_ps(floatAbove(spread.shift));
-  azimuth_all_ = !(spread.azimuth < 1.5);
-  azimuth_ = _mm_set1_ps(azimuth_all_ ? 0.0f : floatAbove(spread.azimuth));
+                               const Spread& spread)
+    : spread_(spread) {
   auto set = [](double x) { return _mm_set1_ps(static_cast<float>(x)); };
   a_ = set(p.a);
   b_ = set(p.b);
@@ -101,9 +98,9 @@ void SliceViews::compute(const WideBvh::Node& node, const SliceViewBasis& f) {
       _mm_add_ps(_mm_add_ps(f.abs_ty_, _mm_mul_ps(f.abs_c_, ax)), _mm_mul_ps(f.abs_d_, ay));
   wx = _mm_add_ps(wx, _mm_mul_ps(slack, _mm_add_ps(mx, wx)));
   wy = _mm_add_ps(wy, _mm_mul_ps(slack, _mm_add_ps(my, wy)));
-  if (f.spread_) {  // every origin of a sweep block's beams
-    wx = _mm_add_ps(wx, f.shift_);
-    wy = _mm_add_ps(wy, f.shift_);
+  if (f.spread_.any) {  // every origin of a sweep block's beams
+    wx = _mm_add_ps(wx, f.spread_.shift);
+    wy = _mm_add_ps(wy, f.spread_.shift);
   }
   // Nearest distance: the norm of the gap between the sensor and the box, lowered by the slack.
   const __m128 zero = _mm_setzero_ps();
@@ -134,7 +131,7 @@ void SliceViews::compute(const WideBvh::Node& node, const SliceViewBasis& f) {
   // end on): the box's corners narrow it (simd::CornerTangents), but not with a spread, whose shift
   // can move a corner too far for the narrowing's bound. Each corner in the sensor's x, y is a few
   // roundings off, at most the slack times the magnitudes mx, my.
-  if (!f.spread_) {
+  if (!f.spread_.any) {
     CornerTangents corners;
     const __m128 xs[2] = {lo_x, hi_x}, ys[2] = {lo_y, hi_y};
     for (int i = 0; i < 4; ++i) {
@@ -146,9 +143,9 @@ void SliceViews::compute(const WideBvh::Node& node, const SliceViewBasis& f) {
     corners.narrow(_mm_mul_ps(slack, _mm_add_ps(mx, my)), rho2, &center, &half);
   }
   half = _mm_add_ps(half, _mm_set1_ps(static_cast<float>(2 * kBearingError)));
-  if (f.spread_) half = _mm_add_ps(half, f.azimuth_);
-  __m128 narrow = _mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f)));
-  if (f.azimuth_all_) narrow = _mm_setzero_ps();
+  half = f.spread_.widenHalf(half);
+  const __m128 narrow =
+      f.spread_.keepLimited(_mm_and_ps(limited, _mm_cmplt_ps(half, _mm_set1_ps(1.5f))));
   _mm_store_ps(az_half, selectPs(narrow, half, _mm_set1_ps(-1)));
   _mm_store_ps(az_center, center);
   if (!f.fast_) return;

@@ -14,6 +14,7 @@
 #include <limits>
 
 #include "beams/beam_window.h"
+#include "beams/node_views.h"
 #include "slice/slicer.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "accel/wide_bvh.h"
@@ -37,9 +38,7 @@ class SliceViewBasis {
   __m128 start_, inv_increment_, turn_, inv_turn_, pad_;
   int columns_;
   bool fast_;
-  // The spread's shift and azimuth widening, rounded up to float; azimuth_all_: every azimuth.
-  __m128 shift_, azimuth_;
-  bool spread_ = false, azimuth_all_ = false;
+  SpreadPs spread_;
 };
 
 struct SliceViews {

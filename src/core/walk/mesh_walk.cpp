@@ -140,8 +140,6 @@ class MeshWalk {
         sliceLeaf(e.ref, e.rect, e.near);
       } else if (beams <= kLeafDirectBeams) {
         testLeaf(e);
-      } else if (motion_ && !beams_.grid().columnRaster()) {
-        windowLeaf(e);
       } else {
         rasterLeaf(e);
       }
@@ -179,8 +177,12 @@ class MeshWalk {
   // The beam as a ray in the body's frame, for box tests: the same one for every box test of this
   // walk.
   WideBoxRay boxRay(int row, int col) const {
-    return WideBoxRay(origin_, active_.body_from_sensor_rot * beams_.grid().rebuiltDirection(row, col));
+    Eigen::Vector3d d = beams_.grid().rebuiltDirection(row, col);
+    // A sweep's beam turns with its column; origin_ holds every column's origin (the block's shift).
+    if (motion_) d = motion_->refFromColumn(col).linear() * d;
+    return WideBoxRay(origin_, active_.body_from_sensor_rot * d);
   }
+
 
   // A triangle slot moved into the sensor frame. Every 3D test of this body's triangles is the
   // beam's sensor-frame ray against these vertices, however the pair was found (traced,
@@ -214,16 +216,23 @@ class MeshWalk {
     }
   };
 
+  // A triangle's unit normal in the frame of the beams of column col: the sensor's, or for a
+  // sweep's block the column's own.
+  Eigen::Vector3d columnNormal(int col, std::uint32_t triangle) const {
+    const Eigen::Vector3d n = sensorNormal(triangle);
+    return motion_ ? motion_->toColumn(col, n) : n;
+  }
+
   void offer(int row, int col, const Best& best) {
     beams_.keepNearestHit(row, col, best.t, active_.index, static_cast<int>(best.triangle), [&] {
-      if (slicing_) return slicer_->sensorNormal(best.slot);
-      const Eigen::Vector3d n = sensorNormal(best.triangle);
-      return motion_ ? motion_->toColumn(col, n) : n;
+      return slicing_ ? slicer_->sensorNormal(best.slot) : columnNormal(col, best.triangle);
     });
   }
 
-  // A sweep's beam (row, col) as its column's ray in the reference sensor frame, for the tests.
-  PreparedRay<double, M> columnRay(int row, int col) const {
+  // A beam as a ray for the triangle tests: from the sensor, or for a sweep's block from its
+  // column's pose, in the reference sensor frame.
+  PreparedRay<double, M> beamRay(int row, int col) const {
+    if (!motion_) return beams_.grid().template sensorRay<M>(row, col);
     return PreparedRay<double, M>(
         motion_->ray(col, beams_.grid().rebuiltDirection(row, col), config_.tmin),
         config_.cull_backfaces);
@@ -231,10 +240,6 @@ class MeshWalk {
 
   // Each open beam of the rect through the node's subtree, one ray at a time.
   void traceRect(const Entry& e) {
-    if (motion_) {
-      traceColumns(e);
-      return;
-    }
     for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
@@ -246,7 +251,7 @@ class MeshWalk {
             if (!hidden(slot)) sliceOne(slot, col, &tmax, &best);
           });
         } else {
-          const auto ray = beams_.grid().template sensorRay<M>(row, col);
+          const auto ray = beamRay(row, col);
           traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
             if (!hidden(slot)) testSlot(ray, slot, &tmax, &best);
           });
@@ -265,26 +270,6 @@ class MeshWalk {
     if (hit && best->improves(hit->t, ids_[slot])) {
       *best = Best{hit->t, ids_[slot], slot};
       *tmax = hit->t;
-    }
-  }
-
-  // traceRect for a sweep's block: column by column, each column's beams from its own origin.
-  void traceColumns(const Entry& e) {
-    for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
-      for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
-        const double range = beams_.range(row, col);
-        if (!(range >= e.near)) continue;
-        double tmax = std::min(config_.tmax, range);
-        const Ray r = motion_->ray(col, beams_.grid().rebuiltDirection(row, col), config_.tmin);
-        const PreparedRay<double, M> ray(r, config_.cull_backfaces);
-        Best best;
-        // The box tests take the origin anywhere within the block's shift (origin_).
-        const WideBoxRay box_ray(origin_, active_.body_from_sensor_rot * r.dir);
-        traceWide(wide_, e.ref, box_ray, &tmax, [&](std::uint32_t slot) {
-          if (!hidden(slot)) testSlot(ray, slot, &tmax, &best);
-        });
-        if (best.found()) offer(row, col, best);
-      }
     }
   }
 
@@ -325,8 +310,7 @@ class MeshWalk {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
         if (!(range >= e.near)) continue;
-        const auto ray =
-            motion_ ? columnRay(row, col) : beams_.grid().template sensorRay<M>(row, col);
+        const auto ray = beamRay(row, col);
         double tmax = std::min(config_.tmax, range);
         Best best;
         for (std::uint32_t i = 0; i < e.ref.count; ++i) {
@@ -345,14 +329,10 @@ class MeshWalk {
   }
 
   // Each triangle of the leaf against the open beams of the leaf's window: column by column
-  // through a conservative float test of its edge planes and its plane (ColumnRaster), or for
-  // patterns too steep for it row by row (EdgeFilter), then the exact test for the beams let
-  // through.
+  // through a conservative float test of its edge planes and its plane (ColumnRaster, widened by a
+  // sweep block's spread), or for patterns too steep for it row by row (EdgeFilter; for a sweep's
+  // block, the triangle's own window instead), then the exact test for the beams let through.
   void rasterLeaf(const Entry& e) {
-    if (motion_) {
-      rasterColumns(e);
-      return;
-    }
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
       if (hidden(slot)) continue;
       const SensorTriangle s = sensorTriangle(slot);
@@ -362,81 +342,55 @@ class MeshWalk {
         // hit it lets through beyond the exact range is turned down by keepNearestHit().
         const double range = beams_.rangeAbove(row)[col];
         if (!(range >= e.near)) return;
-        const auto hit = beams_.grid().template sensorRay<M>(row, col).intersect(
-            s.a, s.b, s.c, std::min(config_.tmax, range));
+        const auto hit = beamRay(row, col).intersect(s.a, s.b, s.c, std::min(config_.tmax, range));
         if (!hit) return;
         beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
-                     [&] { return sensorNormal(triangle); });
+                              [&] { return columnNormal(col, triangle); });
       };
       if (beams_.grid().columnRaster()) {
-        ColumnRaster(beams_, s.a, s.b, s.c).forEachCandidate(beams_, e.rect, test);
-        continue;
-      }
-      const EdgeFilter filter(s.a, s.b, s.c);
-      for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
-        filter.forEachCandidate(beams_, row, e.rect.col_lo, e.rect.col_hi,
-                                [&](int col) { test(row, col); });
-      }
-    }
-  }
-
-  // rasterLeaf for a sweep's block: the column raster widened by the block's spread (with the
-  // leaf's near distance, which no triangle of it is nearer than), each candidate tested from its
-  // column's pose.
-  void rasterColumns(const Entry& e) {
-    const double shift = spread_.shift;
-    for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
-      if (hidden(slot)) continue;
-      const SensorTriangle s = sensorTriangle(slot);
-      const std::uint32_t triangle = ids_[slot];
-      // No point of the triangle is nearer than its plane (lowered for the rounding), nor than the
-      // leaf: the larger, so that a leaf around the sensor (a room's walls) still rasterises.
-      const Eigen::Vector3d n = (s.b - s.a).cross(s.c - s.a);
-      const double plane = std::abs(n.dot(s.a)) / n.norm() * (1 - 1e-9);
-      const double near = std::max(double(e.near), std::isfinite(plane) ? plane : 0.0);
-      const double widen = near > 2 * shift ? std::sin(std::min(
-                                                  M_PI / 2, spread_.turn + std::asin(shift / near)))
-                                            : 1.0;
-      const ColumnRaster raster(beams_, s.a, s.b, s.c, widen, shift, spread_.turn);
-      raster.forEachCandidate(beams_, e.rect, [&](int row, int col) {
-        const double range = beams_.range(row, col);
-        if (!(range >= e.near)) return;
-        const auto hit = columnRay(row, col).intersect(s.a, s.b, s.c, std::min(config_.tmax, range));
-        if (!hit) return;
-        beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
-                              [&] { return motion_->toColumn(col, sensorNormal(triangle)); });
-      });
-    }
-  }
-
-
-  // For patterns too steep for the column raster: each triangle against the open beams of its own window (the
-  // view of its sensor-frame box, widened by the block's spread), each from its column's pose.
-  void windowLeaf(const Entry& e) {
-    const double angle_min = beams_.grid().pattern().angleMin();
-    for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
-      if (hidden(slot)) continue;
-      const SensorTriangle s = sensorTriangle(slot);
-      const Eigen::Vector3d lo = s.a.cwiseMin(s.b).cwiseMin(s.c), hi = s.a.cwiseMax(s.b).cwiseMax(s.c);
-      const View view = boxView((lo + hi) * 0.5, (hi - lo) * 0.5, Eigen::Matrix3d::Identity(),
-                                Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), angle_min,
-                                !planar_, spread_);
-      if (!(view.near <= config_.tmax) || (planar_ && !view.crosses)) continue;
-      const std::uint32_t triangle = ids_[slot];
-      beams_.grid().forEachRect(view, e.rect, [&](const BeamRect& rect) {
-        for (int col = rect.col_lo; col <= rect.col_hi; ++col) {
-          for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-            const double range = beams_.range(row, col);
-            if (!(range >= view.near)) continue;
-            const auto hit = columnRay(row, col).intersect(s.a, s.b, s.c,
-                                                           std::min(config_.tmax, range));
-            if (!hit) continue;
-            beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
-                                  [&] { return motion_->toColumn(col, sensorNormal(triangle)); });
-          }
+        ColumnRaster(beams_, s.a, s.b, s.c, rasterWidening(s, e.near), spread_.shift, spread_.turn)
+            .forEachCandidate(beams_, e.rect, test);
+      } else if (motion_) {
+        forEachInWindow(s, e.rect, test);
+      } else {
+        const EdgeFilter filter(s.a, s.b, s.c);
+        for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
+          filter.forEachCandidate(beams_, row, e.rect.col_lo, e.rect.col_hi,
+                                  [&](int col) { test(row, col); });
         }
-      });
+      }
     }
+  }
+
+  // How far the column raster widens a triangle's edge tests for a sweep's block (ColumnRaster):
+  // sin(turn + asin(shift / near)), near the larger of the leaf's and the triangle's plane's
+  // distance (lowered for the rounding), so that a leaf around the sensor (a room's walls) still
+  // rasterises. 0 for a scan from one pose.
+  double rasterWidening(const SensorTriangle& s, double leaf_near) const {
+    if (!motion_) return 0;
+    const Eigen::Vector3d n = (s.b - s.a).cross(s.c - s.a);
+    const double plane = std::abs(n.dot(s.a)) / n.norm() * (1 - 1e-9);
+    const double near = std::max(leaf_near, std::isfinite(plane) ? plane : 0.0);
+    const double shift = spread_.shift;
+    if (!(near > 2 * shift)) return 1;  // every beam of the rect
+    return std::sin(std::min(M_PI / 2, spread_.turn + std::asin(shift / near)));
+  }
+
+  // The beams of rect in the triangle's own window (the view of its sensor-frame box, widened by
+  // the sweep block's spread): f(row, col) for each.
+  template <class F>
+  void forEachInWindow(const SensorTriangle& s, const BeamRect& rect, F&& f) const {
+    const Eigen::Vector3d lo = s.a.cwiseMin(s.b).cwiseMin(s.c), hi = s.a.cwiseMax(s.b).cwiseMax(s.c);
+    const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+    const View view = boxView((lo + hi) * 0.5, (hi - lo) * 0.5, identity, identity,
+                              Eigen::Vector3d::Zero(), beams_.grid().pattern().angleMin(),
+                              !planar_, spread_);
+    if (!(view.near <= config_.tmax) || (planar_ && !view.crosses)) return;
+    beams_.grid().forEachRect(view, rect, [&](const BeamRect& r) {
+      for (int row = r.row_lo; row <= r.row_hi; ++row) {
+        for (int col = r.col_lo; col <= r.col_hi; ++col) f(row, col);
+      }
+    });
   }
 
   // Every leaf below the entry that meets the scan plane, sliced into the entry's beams, with no

@@ -31,18 +31,6 @@ Eigen::Isometry3d sensorFromPlane(const ScanPlane& f) {
   return pose;
 }
 
-// The inverse of a plane's map to the sensor's x, y (its linear part), and the sensor in plane
-// coordinates: for the traced rays' box tests.
-Eigen::Matrix2d inverseOf(const ScanPlane& plane) {
-  const double det = plane.a * plane.d - plane.b * plane.c;
-  Eigen::Matrix2d inverse;
-  inverse << plane.d / det, -plane.b / det, -plane.c / det, plane.a / det;
-  return inverse;
-}
-Eigen::Vector2d originOf(const ScanPlane& plane, const Eigen::Matrix2d& inverse) {
-  return -(inverse * Eigen::Vector2d(plane.tx, plane.ty));
-}
-
 class SliceWalk {
  public:
   SliceWalk(BeamSet& beams, const Scene& scene, const KeptSlice& slice, const ScanPlane& plane,
@@ -59,8 +47,12 @@ class SliceWalk {
         spread_(motion ? motion->spread() : Spread()),
         sensor_from_plane_(sensorFromPlane(plane)),
         views_(plane, config.tmax, beams.grid().pattern(), spread_) {
-    inverse_ = inverseOf(plane);
-    origin_.emplace(originOf(plane, inverse_), slice.tree.bounds(), config.tmin);
+    // The sensor and the beams in plane coordinates, for the traced rays' box tests: the inverse
+    // of the map to the sensor frame.
+    const double det = plane.a * plane.d - plane.b * plane.c;
+    inverse_ << plane.d / det, -plane.b / det, -plane.c / det, plane.a / det;
+    origin_.emplace(-(inverse_ * Eigen::Vector2d(plane.tx, plane.ty)), slice.tree.bounds(),
+                    config.tmin);
   }
 
   void run(const BeamRect& within) {
