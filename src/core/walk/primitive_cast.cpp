@@ -11,6 +11,7 @@
 
 #include "beams/column_motion.h"
 #include "laser_raycast/core/primitives.h"
+#include "util/float_rounding.h"
 #include "util/simd_math.h"
 
 namespace laser_raycast {
@@ -28,14 +29,23 @@ constexpr float kDirectionError = 1e-6f;
 // from the slab never enters it, and one moving towards it enters no sooner than the gap over its
 // speed there, which a larger speed bounds from below. Never says "miss" for a beam whose exact ray
 // enters the box before its range.
+//
+// A sweep's beam leaves from within spread.shift of o along a direction within spread.turn of d
+// (ColumnMotion): where it meets the box, the same direction from o meets the box grown by the
+// shift on every side, and each component of its direction is within the turn of d's. So the test
+// of d from o against the grown box, with the turn added to the directions' error, never says
+// "miss" for it either.
 class BoxPrefilter {
  public:
-  BoxPrefilter(const PlacedBody& a, const Eigen::Vector3d& half) {
+  BoxPrefilter(const PlacedBody& a, const Eigen::Vector3d& half, const Spread& spread)
+      : shift_(spread.shift),
+        error_(_mm_set1_ps(floatAbove(double(kDirectionError) + spread.turn))),
+        error_value_(double(kDirectionError) + spread.turn) {
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) r_[i][j] = _mm_set1_ps(float(a.body_from_sensor_rot(i, j)));
       const double o = a.sensor_in_body[i];
       // The gap to the slab, rounded down by the margin (negative: inside the slab).
-      const double h = half[i] * (1 + kMargin) + kMargin * std::abs(o);
+      const double h = (half[i] + shift_) * (1 + kMargin) + kMargin * std::abs(o);
       gap_[i] = _mm_set1_ps(static_cast<float>(std::abs(o) - h));
       // The sign of the side the sensor is on (0 inside): a beam moving that way moves away.
       side_[i] = _mm_set1_ps(std::abs(o) > h ? (o > 0 ? 1.0f : -1.0f) : 0.0f);
@@ -52,15 +62,15 @@ class BoxPrefilter {
     const double ox = a.sensor_in_body.x(), oy = a.sensor_in_body.y();
     ox_ = _mm_set1_ps(static_cast<float>(ox));
     oy_ = _mm_set1_ps(static_cast<float>(oy));
-    const double r = radius * (1 + kMargin), o = std::hypot(ox, oy);
+    const double r = (radius + shift_) * (1 + kMargin), o = std::hypot(ox, oy);
     tube_r_ = _mm_set1_ps(static_cast<float>(r));
     tube_pad_ =
-        _mm_set1_ps(static_cast<float>((2 * r + 3 * o) * kDirectionError + kMargin * (r + o)));
+        _mm_set1_ps(static_cast<float>((2 * r + 3 * o) * error_value_ + kMargin * (r + o)));
   }
 
   // Bit j: beam j of the four (directions x, y, z; ranges rounded up) cannot hit.
   int misses(__m128 dx, __m128 dy, __m128 dz, __m128 range) const {
-    const __m128 error = _mm_set1_ps(kDirectionError);
+    const __m128 error = error_;
     const __m128 zero = _mm_setzero_ps();
     __m128 miss = zero;
     __m128 body[3];  // the directions in the body's frame
@@ -87,6 +97,9 @@ class BoxPrefilter {
   }
 
  private:
+  double shift_;
+  __m128 error_;
+  double error_value_;
   __m128 r_[3][3], gap_[3], side_[3];
   bool tube_ = false;
   __m128 ox_, oy_, tube_r_, tube_pad_;
@@ -132,8 +145,7 @@ void castShape(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
       // skipped before the pre-test (not less than: NaN counts as open).
       int open = _mm_movemask_ps(_mm_cmpnlt_ps(r, near));
       if (!open) continue;
-      // The pre-test knows the beams from the sensor only: a sweep's are tested directly.
-      if (!a.motion) open &= ~filter.misses(_mm_loadu_ps(x + base), _mm_loadu_ps(y + base), z, r);
+      open &= ~filter.misses(_mm_loadu_ps(x + base), _mm_loadu_ps(y + base), z, r);
       while (open) {
         const int col = base + __builtin_ctz(static_cast<unsigned>(open));
         open &= open - 1;
@@ -160,7 +172,7 @@ void DeferredPrimitives::cast(BeamSet& beams, const Scene& scene, const CastConf
 void castPrimitive(BeamSet& beams, const Scene& scene, const PlacedBody& a,
                    const CastConfig& config, const BeamRect& rect) {
   const Shape& shape = scene.bodies()[a.index].shape;
-  BoxPrefilter filter(a, scene.boxHalf(a.index));
+  BoxPrefilter filter(a, scene.boxHalf(a.index), a.motion ? a.motion->spread() : Spread());
   if (const auto* box = std::get_if<Box>(&shape)) {
     castShape(beams, *box, a, filter, config, rect);
   } else if (const auto* cylinder = std::get_if<Cylinder>(&shape)) {
