@@ -1,0 +1,254 @@
+"""The Python module laser_raycast, against distances worked out by hand and against cast_scan.
+
+Run by the README's test command (catkin's run_tests, through pytest: CMakeLists.txt), in the
+devel space's environment: package:// URIs resolve and `import laser_raycast` finds the module.
+"""
+
+import math
+import os
+import pydoc
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import laser_raycast as lr
+
+DEMO_ROOM = "package://laser_raycast/worlds/demo_room.urdf"
+
+# A wall x in [5, 5.2], |y| <= 10, |z| <= 2.5 on the link "world", and a box 0.4 m wide on a
+# prismatic joint along y: at joint value q its centre is at (3, 2 + q, 0).
+WALL_URDF = """<robot name="walls">
+  <link name="world">
+    <visual><origin xyz="5.1 0 0"/><geometry><box size="0.2 20 5"/></geometry></visual>
+  </link>
+  <link name="slider">
+    <visual><geometry><box size="0.4 0.4 0.4"/></geometry></visual>
+  </link>
+  <joint name="slide" type="prismatic">
+    <parent link="world"/><child link="slider"/>
+    <origin xyz="3 2 0"/><axis xyz="0 1 0"/><limit lower="-5" upper="5" effort="1" velocity="1"/>
+  </joint>
+</robot>"""
+
+
+def pose(x=0.0, y=0.0, z=0.0, yaw=0.0):
+    m = np.eye(4)
+    m[0, 0] = m[1, 1] = math.cos(yaw)
+    m[0, 1], m[1, 0] = -math.sin(yaw), math.sin(yaw)
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+def cast_scan_binary():
+    """cast_scan of the same build as the module (the devel space's lib directory)."""
+    module_dir = os.path.dirname(lr._laser_raycast.__file__)
+    devel = os.path.abspath(os.path.join(module_dir, "..", "..", "..", ".."))
+    path = os.path.join(devel, "lib", "laser_raycast", "cast_scan")
+    if not os.path.exists(path):
+        pytest.skip("no cast_scan beside the module (an installed package)")
+    return path
+
+
+@pytest.fixture(scope="module")
+def walls():
+    return lr.Scene.from_urdf(WALL_URDF)
+
+
+def test_a_fan_sees_the_wall_at_the_range_worked_out_by_hand(walls):
+    pattern = lr.Pattern.fan(-0.3, 0.3, samples=61)
+    xs = np.linspace(-2.0, 1.0, 7)
+    poses = np.stack([pose(x, -4.0) for x in xs])  # beside the slider, which stays out of view
+    scans = lr.Caster(threads=1).cast(walls, poses, pattern, range_max=50)
+    assert scans.ranges.shape == (7, 61) and scans.ranges.dtype == np.float64
+    assert scans.links.dtype == np.int32
+    azimuths = np.array(pattern.azimuths)
+    expected = (5.0 - xs)[:, None] / np.cos(azimuths)[None, :]
+    np.testing.assert_allclose(scans.ranges, expected, rtol=0, atol=1e-9)
+    assert set(scans.links.ravel()) == {walls.link_names.index("world")}
+
+
+def test_points_are_the_ranges_along_the_beams(walls):
+    pattern = lr.Pattern.rings(-0.5, 0.5, [-0.2, 0.0, 0.3], samples=11)
+    scans = lr.Caster().cast(walls, pose(0, -4)[None], pattern, points=True, range_max=50)
+    assert scans.points.shape == (1, 33, 3)
+    np.testing.assert_allclose(scans.points[0], scans.ranges[0][:, None] * pattern.directions,
+                               atol=1e-12)
+    np.testing.assert_allclose(scans.points[0][:, 0], 5.0, atol=1e-9)  # all on the wall's face
+
+
+def test_joints_and_link_poses_move_the_links(walls):
+    pattern = lr.Pattern.fan(-0.01, 0.01, samples=3)
+    at_slider = pose(0, 0, 0, math.atan2(2.0, 3.0))  # looking at the slider's centre
+    caster = lr.Caster(threads=1)
+    # At joint 0 the beam meets the slider's face x = 2.8, in front of the wall.
+    r0 = caster.cast(walls, at_slider[None], pattern).ranges[0, 1]
+    assert r0 == pytest.approx(2.8 * math.hypot(3, 2) / 3, abs=1e-9)
+    # Slid 1 m away along y, the beam passes beside it onto the wall.
+    r1 = caster.cast(walls, at_slider[None], pattern, joints={"slide": 1.0}).ranges[0, 1]
+    assert r1 == pytest.approx(5.0 * math.hypot(3, 2) / 3, abs=1e-9)
+    # The same by placing the link, once for all scans and per scan.
+    moved = pose(3, 3)
+    r2 = caster.cast(walls, at_slider[None], pattern, link_poses={"slider": moved}).ranges[0, 1]
+    assert r2 == r1
+    two = np.stack([pose(3, 2), pose(3, 3)])
+    both = caster.cast(walls, np.stack([at_slider] * 2), pattern, link_poses={"slider": two})
+    assert both.ranges[0, 1] == r0 and both.ranges[1, 1] == r1
+
+
+def test_the_ranges_are_those_cast_scan_prints():
+    scene = lr.Scene.from_urdf(DEMO_ROOM)
+    pattern = lr.Pattern.fan(-2.0, 2.0, samples=201)
+    sensors = [(0.0, 0.0, 0.3, 0.0), (1.0, -0.5, 0.25, 0.7), (-1.5, 1.0, 0.5, -2.0)]
+    poses = np.stack([pose(x, y, z, yaw) for x, y, z, yaw in sensors])
+    scans = lr.Caster().cast(scene, poses, pattern, range_min=0.1, range_max=12)
+    binary = cast_scan_binary()
+    for k, (x, y, z, yaw) in enumerate(sensors):
+        out = subprocess.run(
+            [binary, "--urdf", DEMO_ROOM, "--sensor", f"{x!r},{y!r},{z!r},0,0,{yaw!r}",
+             "--angle-min", "-2", "--angle-max", "2", "--samples", "201", "--range-min", "0.1",
+             "--range-max", "12"],
+            check=True, capture_output=True, text=True).stdout.splitlines()
+        assert out[0] == "index,angle,range,link"
+        rows = [line.split(",") for line in out[1:]]
+        assert len(rows) == 201
+        for i, (_, _, text, link) in enumerate(rows):
+            assert "%.9g" % scans.ranges[k, i] == text.replace("inf", "inf"), (k, i)
+            name = scene.link_names[scans.links[k, i]] if scans.links[k, i] >= 0 else ""
+            assert name == link, (k, i)
+
+
+def test_any_thread_count_gives_the_same_scans():
+    scene = lr.Scene.from_urdf(DEMO_ROOM)
+    pattern = lr.Pattern.preset("VLP-16")
+    poses = np.stack([pose(0.1 * k, 0.05 * k, 0.4, 0.3 * k) for k in range(6)])
+    one = lr.Caster(threads=1).cast(scene, poses, pattern)
+    two = lr.Caster(threads=2).cast(scene, poses, pattern)
+    np.testing.assert_array_equal(one.ranges, two.ranges)
+    np.testing.assert_array_equal(one.links, two.links)
+    assert np.isfinite(one.ranges).sum() > 0.5 * one.ranges.size  # a closed room: most beams hit
+
+
+def test_presets_bring_their_range_limits():
+    pattern = lr.Pattern.preset("UTM-30LX")
+    assert pattern.size == 1081 and pattern.elevations == [0.0]
+    assert (pattern.range_min, pattern.range_max, pattern.rate) == (0.1, 30.0, 40.0)
+    scene = lr.Scene.from_urdf(DEMO_ROOM)
+    scans = lr.Caster().cast(scene, pose(0, 0, 0.3)[None], pattern)
+    finite = scans.ranges[np.isfinite(scans.ranges)]
+    assert finite.min() >= 0.1 and finite.max() <= 30.0
+    assert lr.Pattern.fan(-1, 1, samples=3).range_max is None
+
+
+def test_rep117_and_the_min_range_policy(walls):
+    pattern = lr.Pattern.fan(-0.1, 0.1, samples=3)
+    at = pose(4.0, -4.0)[None]  # 1 m from the wall
+    assert np.all(lr.Caster().cast(walls, at, pattern, range_min=2).ranges == -np.inf)
+    assert np.all(np.isnan(lr.Caster().cast(walls, at, pattern, range_min=2,
+                                            min_range_policy="nan").ranges))
+    far = lr.Caster().cast(walls, pose(0, 0, 0, math.pi)[None], pattern, range_max=5)
+    assert np.all(far.ranges == np.inf) and np.all(far.links == -1)
+    bad = np.zeros((1, 4, 4))  # not a rigid transform: nothing can be cast from it
+    assert np.all(np.isnan(lr.Caster().cast(walls, bad, pattern).ranges))
+
+
+def test_the_measurement_model_is_an_option(walls):
+    pattern = lr.Pattern.fan(-0.3, 0.3, samples=301)
+    poses = np.stack([pose(0, -4)] * 4)
+    exact = lr.Caster().cast(walls, poses, pattern, range_max=50).ranges
+    noisy = lr.Measurement(noise_stddev=0.05, noise_seed=7)
+    a = lr.Caster().cast(walls, poses, pattern, range_max=50, measurement=noisy).ranges
+    b = lr.Caster().cast(walls, poses, pattern, range_max=50, measurement=noisy).ranges
+    np.testing.assert_array_equal(a, b)  # the same seed, the same draws
+    assert 0.03 < np.std(a - exact) < 0.07
+    assert not np.array_equal(a[0], a[1])  # the draws continue from scan to scan
+    lost = lr.Caster().cast(walls, poses, pattern, range_max=50,
+                            measurement=lr.Measurement(dropout_probability=0.5)).ranges
+    assert 0.3 < np.mean(lost == np.inf) < 0.7
+    lit = lr.Caster().cast(walls, poses[:1], pattern, range_max=50,
+                           measurement=lr.Measurement(intensity=True, reflectivity={"world": 0.5}))
+    expected = 0.5 * np.cos(np.array(pattern.azimuths))  # reflectivity x cos(incidence)
+    np.testing.assert_allclose(lit.intensity[0], expected, atol=1e-6)
+    assert exact is not None and lr.Caster().cast(walls, poses, pattern).intensity is None
+
+
+def test_bad_arguments_raise_errors_that_name_them(walls):
+    pattern = lr.Pattern.fan(-1, 1, samples=5)
+    caster = lr.Caster()
+    cases = [
+        (lambda: caster.cast(walls, np.eye(3), pattern), ValueError, "sensor_poses"),
+        (lambda: caster.cast(walls, "here", pattern), TypeError, "sensor_poses"),
+        (lambda: caster.cast(walls, np.eye(4)[None], pattern, link_poses={"nowhere": np.eye(4)}),
+         ValueError, "nowhere"),
+        (lambda: caster.cast(walls, np.eye(4)[None], pattern, link_poses={"slider": "x"}),
+         TypeError, "link_poses['slider']"),
+        (lambda: caster.cast(walls, np.stack([np.eye(4)] * 2), pattern,
+                             link_poses={"slider": np.stack([np.eye(4)] * 3)}),
+         ValueError, "3 poses for 2"),
+        (lambda: caster.cast(walls, np.eye(4)[None], pattern, joints={"no_joint": 1.0}),
+         ValueError, "no_joint"),
+        (lambda: caster.cast(walls, np.eye(4)[None], pattern, range_max=-1), ValueError,
+         "range_max"),
+        (lambda: caster.cast(walls, np.eye(4)[None], pattern, min_range_policy="zero"),
+         ValueError, "zero"),
+        (lambda: lr.Pattern.fan(-1, 1), ValueError, "samples"),
+        (lambda: lr.Pattern.fan(1, -1, samples=3), ValueError, "angle_max"),
+        (lambda: lr.Pattern.rings(-1, 1, [0.1, 0.1], samples=3), ValueError, "elevations"),
+        (lambda: lr.Pattern.preset("VLP-17"), ValueError, "VLP-17"),
+        (lambda: lr.Measurement(noise_stddev=-1), ValueError, "noise_stddev"),
+        (lambda: lr.Caster(threads=-2), ValueError, "threads"),
+        (lambda: lr.Scene.from_urdf(WALL_URDF, geometry="both"), ValueError, "both"),
+        (lambda: lr.Scene.from_urdf("/no/such/file.urdf"), lr.SceneLoadError, "/no/such/file.urdf"),
+        (lambda: lr.Scene.from_urdf("<robot name='x'><link>"), lr.SceneLoadError, "URDF"),
+    ]
+    for call, error, words in cases:
+        with pytest.raises(error) as raised:
+            call()
+        assert words in str(raised.value), (words, str(raised.value))
+
+
+def test_a_model_that_fails_to_load_leaves_the_scene_as_it_was(walls):
+    scene = lr.Scene.from_urdf(WALL_URDF)
+    before = scene.bodies
+    with pytest.raises(lr.SceneLoadError):
+        scene.add_urdf("<robot name='broken'><link name='a'><visual><geometry>"
+                       "<mesh filename='/no/such/mesh.stl'/></geometry></visual></link></robot>")
+    assert scene.bodies == before
+    scene.add_urdf(WALL_URDF, tf_prefix="second/")
+    assert scene.bodies == 2 * before and "second/slider" in scene.link_names
+
+
+def test_the_gil_is_released_while_casting():
+    scene = lr.Scene.from_urdf(DEMO_ROOM)
+    pattern = lr.Pattern.preset("OS1-64")
+    poses = np.stack([pose(0, 0, 0.5, 0.01 * k) for k in range(40)])
+    started, done = threading.Event(), threading.Event()
+    took = []
+
+    def work():
+        started.set()
+        t0 = time.perf_counter()
+        lr.Caster(threads=1).cast(scene, poses, pattern)
+        took.append(time.perf_counter() - t0)
+        done.set()
+
+    worker = threading.Thread(target=work)
+    worker.start()
+    started.wait()
+    # This thread runs during the cast only if the cast lets go of the GIL: then it sees the clock
+    # advance through most of the cast; holding it, the cast would freeze this loop until it ends.
+    first = last = time.perf_counter()
+    while not done.is_set():
+        last = time.perf_counter()
+    worker.join()
+    assert took[0] > 0.05
+    assert last - first > 0.5 * took[0]
+
+
+def test_help_describes_the_module():
+    text = pydoc.render_doc(lr, renderer=pydoc.plaintext)
+    for words in ["class Scene", "from_urdf", "class Pattern", "preset", "class Caster",
+                  "sensor_poses", "REP 117", "class Measurement", "noise_stddev"]:
+        assert words in text, words
