@@ -114,7 +114,7 @@ class Scene {
 
   // Every link's pose: each model's root at the identity and its joints at `joints` (0 if not
   // given), then the poses given in `links` instead, for each of `count` scans (a pose given once
-  // holds for every scan).
+  // holds for every scan); one set only if it is the same for every scan.
   std::vector<core::FramePoses> framePoses(
       std::size_t count, const std::map<std::string, double>& joints,
       const std::map<std::string, std::vector<Eigen::Isometry3d>>& links) const {
@@ -142,9 +142,12 @@ class Scene {
         throw py::value_error(msg.str());
       }
     }
+    // One set for every scan unless some link has a pose per scan.
+    bool per_scan = false;
+    for (const auto& entry : links) per_scan = per_scan || entry.second.size() > 1;
     std::vector<core::FramePoses> out;
-    out.reserve(count);
-    for (std::size_t k = 0; k < count; ++k) {
+    out.reserve(per_scan ? count : 1);
+    for (std::size_t k = 0; k < (per_scan ? count : 1); ++k) {
       std::map<std::string, Eigen::Isometry3d> at = fixed;
       for (const auto& [name, poses] : links) at[name] = poses[poses.size() == 1 ? 0 : k];
       out.push_back(framePosesFromLinks(scene_, at));
@@ -316,7 +319,8 @@ class Caster {
       for (py::ssize_t k = 0; k < n; ++k) {
         caster_.forget();  // every pose cast anew, as cast_scan casts a path
         const core::ScanResult& result =
-            caster_.cast(scene.scene(), frames[k], sensors[k], pattern.pattern, config);
+            caster_.cast(scene.scene(), frames[frames.size() == 1 ? 0 : k], sensors[k],
+                         pattern.pattern, config);
         for (py::ssize_t b = 0; b < beams; ++b) {
           const int body = result.body[b];
           link_out[k * beams + b] = body >= 0 ? scene.scene().bodies()[body].label : -1;

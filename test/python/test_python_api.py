@@ -98,26 +98,26 @@ def test_joints_and_link_poses_move_the_links(walls):
     assert both.ranges[0, 1] == r0 and both.ranges[1, 1] == r1
 
 
-def test_the_ranges_are_those_cast_scan_prints():
+def test_the_ranges_are_those_cast_scan_prints(tmp_path):
     scene = lr.Scene.from_urdf(DEMO_ROOM)
     pattern = lr.Pattern.fan(-2.0, 2.0, samples=201)
     sensors = [(0.0, 0.0, 0.3, 0.0), (1.0, -0.5, 0.25, 0.7), (-1.5, 1.0, 0.5, -2.0)]
     poses = np.stack([pose(x, y, z, yaw) for x, y, z, yaw in sensors])
     scans = lr.Caster().cast(scene, poses, pattern, range_min=0.1, range_max=12)
-    binary = cast_scan_binary()
-    for k, (x, y, z, yaw) in enumerate(sensors):
-        out = subprocess.run(
-            [binary, "--urdf", DEMO_ROOM, "--sensor", f"{x!r},{y!r},{z!r},0,0,{yaw!r}",
-             "--angle-min", "-2", "--angle-max", "2", "--samples", "201", "--range-min", "0.1",
-             "--range-max", "12"],
-            check=True, capture_output=True, text=True).stdout.splitlines()
-        assert out[0] == "index,angle,range,link"
-        rows = [line.split(",") for line in out[1:]]
-        assert len(rows) == 201
-        for i, (_, _, text, link) in enumerate(rows):
-            assert "%.9g" % scans.ranges[k, i] == text.replace("inf", "inf"), (k, i)
-            name = scene.link_names[scans.links[k, i]] if scans.links[k, i] >= 0 else ""
-            assert name == link, (k, i)
+    path = tmp_path / "poses.txt"
+    path.write_text("".join(f"{x!r},{y!r},{z!r},0,0,{yaw!r}\n" for x, y, z, yaw in sensors))
+    out = subprocess.run(
+        [cast_scan_binary(), "--urdf", DEMO_ROOM, "--poses", str(path), "--angle-min", "-2",
+         "--angle-max", "2", "--samples", "201", "--range-min", "0.1", "--range-max", "12"],
+        check=True, capture_output=True, text=True).stdout.splitlines()
+    assert out[0] == "pose,index,angle,range,link"
+    rows = [line.split(",") for line in out[1:]]
+    assert len(rows) == 3 * 201
+    for k, i, _, text, link in rows:
+        k, i = int(k), int(i)
+        assert "%.9g" % scans.ranges[k, i] == text, (k, i)
+        name = scene.link_names[scans.links[k, i]] if scans.links[k, i] >= 0 else ""
+        assert name == link, (k, i)
 
 
 def test_any_thread_count_gives_the_same_scans():
