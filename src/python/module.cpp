@@ -123,7 +123,8 @@ class Scene {
         throw py::value_error("joints['" + name + "'] must be finite");
       }
       if (!hasMovableJoint(name)) {
-        throw py::value_error("joints: '" + name + "' is not a movable joint of the scene's models");
+        throw py::value_error("joints: '" + name +
+                              "' is not a movable joint of the scene's models");
       }
     }
     std::map<std::string, Eigen::Isometry3d> fixed;
@@ -245,8 +246,8 @@ struct Scans {
 class Caster {
  public:
   explicit Caster(int threads) : threads_(threads) {
-    if (threads < 0) throw py::value_error("threads must be >= 0 (0: every core), got " +
-                                           std::to_string(threads));
+    if (threads < 0)
+      throw py::value_error("threads must be >= 0 (0: every core), got " + std::to_string(threads));
   }
 
   Scans cast(const Scene& scene, const py::object& sensor_poses, const Pattern& pattern,
@@ -262,8 +263,7 @@ class Caster {
         links[name] = posesFrom(poses, "link_poses['" + name + "']", &single);
       }
     }
-    const std::vector<core::FramePoses> frames =
-        scene.framePoses(sensors.size(), joints, links);
+    const std::vector<core::FramePoses> frames = scene.framePoses(sensors.size(), joints, links);
 
     core::ScanSpec spec;
     spec.fan = pattern.fan;
@@ -318,9 +318,8 @@ class Caster {
       core::MeasuredScan measured;
       for (py::ssize_t k = 0; k < n; ++k) {
         caster_.forget();  // every pose cast anew, as cast_scan casts a path
-        const core::ScanResult& result =
-            caster_.cast(scene.scene(), frames[frames.size() == 1 ? 0 : k], sensors[k],
-                         pattern.pattern, config);
+        const core::ScanResult& result = caster_.cast(
+            scene.scene(), frames[frames.size() == 1 ? 0 : k], sensors[k], pattern.pattern, config);
         for (py::ssize_t b = 0; b < beams; ++b) {
           const int body = result.body[b];
           link_out[k * beams + b] = body >= 0 ? scene.scene().bodies()[body].label : -1;
@@ -373,15 +372,16 @@ py::array_t<double> matrixArray(const Eigen::MatrixXd& m) {
 PYBIND11_MODULE(_laser_raycast, m) {
   using laser_raycast::SceneLoadError;
   using laser_raycast::python::Caster;
+  using laser_raycast::python::matrixArray;
   using laser_raycast::python::Measurement;
   using laser_raycast::python::Pattern;
   using laser_raycast::python::Scans;
   using laser_raycast::python::Scene;
-  using laser_raycast::python::matrixArray;
   namespace core = laser_raycast::core;
 
   m.doc() =
-      "Simulated laser scanners and lidars: load URDF models, describe a scan pattern, and cast it\n"
+      "Simulated laser scanners and lidars: load URDF models, describe a scan pattern, and cast "
+      "it\n"
       "from many sensor poses at once. The same scene, casts and REP 117 ranges as the node and\n"
       "cast_scan (docs/python.md).";
 
@@ -391,12 +391,13 @@ PYBIND11_MODULE(_laser_raycast, m) {
       m, "Scene",
       "The geometry of one or more URDF models: meshes (through assimp, or the STL reader) and\n"
       "primitives, each on the frame of its link. package:// URIs are found on ROS_PACKAGE_PATH.")
-      .def_static("from_urdf", &Scene::fromUrdf, py::arg("path_or_xml"),
-                  py::arg("geometry") = "visual", py::arg("tf_prefix") = "",
-                  "A scene of one URDF model: path_or_xml is a file path, a package:// URI, or the\n"
-                  "URDF's XML itself (text starting with '<'). geometry: 'visual' (a link without\n"
-                  "visual elements uses its collision ones) or 'collision'. tf_prefix is prepended\n"
-                  "to every link name. Raises SceneLoadError naming the file and the problem.")
+      .def_static(
+          "from_urdf", &Scene::fromUrdf, py::arg("path_or_xml"), py::arg("geometry") = "visual",
+          py::arg("tf_prefix") = "",
+          "A scene of one URDF model: path_or_xml is a file path, a package:// URI, or the\n"
+          "URDF's XML itself (text starting with '<'). geometry: 'visual' (a link without\n"
+          "visual elements uses its collision ones) or 'collision'. tf_prefix is prepended\n"
+          "to every link name. Raises SceneLoadError naming the file and the problem.")
       .def("add_urdf", &Scene::addUrdf, py::arg("path_or_xml"), py::arg("geometry") = "visual",
            py::arg("tf_prefix") = "",
            "Adds another model (as from_urdf); a model that fails to load leaves the scene as it "
@@ -417,42 +418,46 @@ PYBIND11_MODULE(_laser_raycast, m) {
   py::class_<Pattern>(m, "Pattern",
                       "The beams of a scan in the sensor frame: a fan of azimuths (counter-"
                       "clockwise from x about z) at one or more elevations (up from the xy plane).")
-      .def_static("fan", [](double angle_min, double angle_max, std::optional<int> samples,
-                            std::optional<double> angle_increment) {
-                    return Pattern::make(angle_min, angle_max, samples, angle_increment, {0.0});
-                  },
-                  py::arg("angle_min"), py::arg("angle_max"), py::arg("samples") = py::none(),
-                  py::arg("angle_increment") = py::none(),
-                  "A planar fan (a LaserScan) from angle_min to angle_max (rad): samples beams\n"
-                  "spread evenly over it, both ends included, or one every angle_increment rad from\n"
-                  "angle_min (exactly one of the two). Raises ValueError naming a bad value.")
-      .def_static("rings",
-                  [](double angle_min, double angle_max, std::vector<double> elevations,
-                     std::optional<int> samples, std::optional<double> angle_increment) {
-                    return Pattern::make(angle_min, angle_max, samples, angle_increment,
-                                         std::move(elevations));
-                  },
-                  py::arg("angle_min"), py::arg("angle_max"), py::arg("elevations"),
-                  py::arg("samples") = py::none(), py::arg("angle_increment") = py::none(),
-                  "One fan per elevation (rad, in [-pi/2, pi/2], distinct): ring r is the r-th\n"
-                  "lowest, and beam r * azimuths + i is azimuth i of ring r.")
+      .def_static(
+          "fan",
+          [](double angle_min, double angle_max, std::optional<int> samples,
+             std::optional<double> angle_increment) {
+            return Pattern::make(angle_min, angle_max, samples, angle_increment, {0.0});
+          },
+          py::arg("angle_min"), py::arg("angle_max"), py::arg("samples") = py::none(),
+          py::arg("angle_increment") = py::none(),
+          "A planar fan (a LaserScan) from angle_min to angle_max (rad): samples beams\n"
+          "spread evenly over it, both ends included, or one every angle_increment rad from\n"
+          "angle_min (exactly one of the two). Raises ValueError naming a bad value.")
+      .def_static(
+          "rings",
+          [](double angle_min, double angle_max, std::vector<double> elevations,
+             std::optional<int> samples, std::optional<double> angle_increment) {
+            return Pattern::make(angle_min, angle_max, samples, angle_increment,
+                                 std::move(elevations));
+          },
+          py::arg("angle_min"), py::arg("angle_max"), py::arg("elevations"),
+          py::arg("samples") = py::none(), py::arg("angle_increment") = py::none(),
+          "One fan per elevation (rad, in [-pi/2, pi/2], distinct): ring r is the r-th\n"
+          "lowest, and beam r * azimuths + i is azimuth i of ring r.")
       .def_static("preset", &Pattern::fromPreset, py::arg("name"),
                   "The pattern and range limits of a real sensor ('VLP-16', 'HDL-32E', 'OS1-64',\n"
                   "'UTM-30LX', 'TiM571', 'LDS-01'), from its datasheet (docs/sensors.md).")
-      .def_property_readonly("size", [](const Pattern& p) { return p.pattern.size(); },
-                             "Beams in one scan.")
+      .def_property_readonly(
+          "size", [](const Pattern& p) { return p.pattern.size(); }, "Beams in one scan.")
       .def_property_readonly("azimuth_count",
                              [](const Pattern& p) { return p.pattern.azimuthCount(); })
-      .def_property_readonly("azimuths",
-                             [](const Pattern& p) {
-                               std::vector<double> a(p.pattern.azimuthCount());
-                               for (int i = 0; i < p.pattern.azimuthCount(); ++i)
-                                 a[i] = p.pattern.azimuth(i);
-                               return a;
-                             },
-                             "The azimuths (rad), the same in every ring.")
-      .def_property_readonly("elevations", [](const Pattern& p) { return p.elevations; },
-                             "The rings' elevations (rad), ascending.")
+      .def_property_readonly(
+          "azimuths",
+          [](const Pattern& p) {
+            std::vector<double> a(p.pattern.azimuthCount());
+            for (int i = 0; i < p.pattern.azimuthCount(); ++i) a[i] = p.pattern.azimuth(i);
+            return a;
+          },
+          "The azimuths (rad), the same in every ring.")
+      .def_property_readonly(
+          "elevations", [](const Pattern& p) { return p.elevations; },
+          "The rings' elevations (rad), ascending.")
       .def_property_readonly(
           "directions",
           [](const Pattern& p) {
@@ -535,17 +540,18 @@ PYBIND11_MODULE(_laser_raycast, m) {
                      "Casts patterns against scenes. Results are the same for any thread count.")
       .def(py::init<int>(), py::arg("threads") = 0,
            "threads: the threads each scan is cast with (0: every core).")
-      .def("cast", &Caster::cast, py::arg("scene"), py::arg("sensor_poses"), py::arg("pattern"),
-           py::arg("link_poses") = py::none(),
-           py::arg("joints") = std::map<std::string, double>{}, py::arg("range_min") = py::none(),
-           py::arg("range_max") = py::none(), py::arg("min_range_policy") = "-inf",
-           py::arg("measurement") = py::none(), py::arg("points") = false,
-           "Casts pattern from each of sensor_poses, a float64 array (N, 4, 4) of homogeneous\n"
-           "transforms (the sensor in the common frame), one scan each, with the GIL released.\n"
-           "Links: each model's root link at the identity of the common frame and its joints at\n"
-           "`joints` (name -> rad or m, 0 if absent); link_poses (link name -> (4, 4) or\n"
-           "(N, 4, 4)) places those links instead. range_min, range_max (m): a preset's, or 0 and\n"
-           "30. min_range_policy: '-inf', 'pass_through' or 'nan'. Without measurement, ranges are\n"
-           "the exact ones as cast_scan prints them; with a Measurement, as the node publishes\n"
-           "them. points: also the points. Returns Scans. Raises ValueError naming a bad argument.");
+      .def(
+          "cast", &Caster::cast, py::arg("scene"), py::arg("sensor_poses"), py::arg("pattern"),
+          py::arg("link_poses") = py::none(), py::arg("joints") = std::map<std::string, double>{},
+          py::arg("range_min") = py::none(), py::arg("range_max") = py::none(),
+          py::arg("min_range_policy") = "-inf", py::arg("measurement") = py::none(),
+          py::arg("points") = false,
+          "Casts pattern from each of sensor_poses, a float64 array (N, 4, 4) of homogeneous\n"
+          "transforms (the sensor in the common frame), one scan each, with the GIL released.\n"
+          "Links: each model's root link at the identity of the common frame and its joints at\n"
+          "`joints` (name -> rad or m, 0 if absent); link_poses (link name -> (4, 4) or\n"
+          "(N, 4, 4)) places those links instead. range_min, range_max (m): a preset's, or 0 and\n"
+          "30. min_range_policy: '-inf', 'pass_through' or 'nan'. Without measurement, ranges are\n"
+          "the exact ones as cast_scan prints them; with a Measurement, as the node publishes\n"
+          "them. points: also the points. Returns Scans. Raises ValueError naming a bad argument.");
 }

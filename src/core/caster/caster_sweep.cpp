@@ -234,7 +234,6 @@ class BlockPlanner {
       : scene_(scene), poses_(poses), pattern_(pattern), config_(config) {
     for (double e : pattern.elevations()) steepest_ = std::max(steepest_, std::abs(e));
     limits_ = pattern.planar() ? kLimitsPlanar : kLimits3d;
-    max_turn_ = std::min(limits_.turn, limits_.turn_per_increment * std::abs(pattern.angleIncrement()));
   }
 
   // Blocks over [lo, hi], every column of which has a sensor pose, in column order.
@@ -268,7 +267,9 @@ class BlockPlanner {
     FramePoses frames;
     frames.pose.assign(frame_count, Eigen::Isometry3d::Identity());
     frames.valid.assign(frame_count, 0);
-    for (int f : poses_.framesWithBodies()) frames.valid[f] = poses_.frameAt(ref, f, &frames.pose[f]);
+    for (int f : poses_.framesWithBodies()) {
+      frames.valid[f] = poses_.frameAt(ref, f, &frames.pose[f]);
+    }
     block->key = relativeInputs(scene_, frames, poses_.sensor(ref), pattern_, config_);
     block->motion.assign(scene_.frames().size(), nullptr);
     std::shared_ptr<const ColumnMotion> static_motion;
@@ -284,11 +285,12 @@ class BlockPlanner {
       for (int c = lo; c <= hi; ++c) {
         Eigen::Isometry3d world_from_frame;
         if (!poses_.frameAt(c, f, &world_from_frame)) return false;  // not valid throughout
-        const Eigen::Isometry3d column_from_frame = relativePose(poses_.sensor(c), world_from_frame);
+        const Eigen::Isometry3d column_from_frame =
+            relativePose(poses_.sensor(c), world_from_frame);
         ref_from_column[c - lo] = block->key.sensor_from_frame[f] * column_from_frame.inverse();
       }
       block->motion[f] = std::make_shared<ColumnMotion>(lo, std::move(ref_from_column), steepest_);
-      if (!small(*block->motion[f])) return false;
+      if (!small(*block->motion[f], limits_)) return false;
     }
     // A frame valid at some column but not at the reference: halved until it is one or the other.
     for (int f : poses_.framesWithBodies()) {
@@ -298,7 +300,21 @@ class BlockPlanner {
         if (poses_.frameAt(c, f, &unused)) return false;
       }
     }
-    return !static_motion || small(*static_motion);
+    if (static_motion && !small(*static_motion, limits_)) return false;
+    // A planar fan's longer blocks are for the 2D walk of its kept slices: a block whose columns
+    // leave the reference's plane (a tilted or climbing sensor) is walked in 3D, so it keeps within
+    // the 3D limits.
+    if (pattern_.planar()) {
+      bool in_plane = true;
+      for (const auto& m : block->motion) in_plane = in_plane && (!m || m->inPlane());
+      if (!in_plane) {
+        if (hi - lo + 1 > kLimits3d.columns) return false;
+        for (const auto& m : block->motion) {
+          if (m && !small(*m, kLimits3d)) return false;
+        }
+      }
+    }
+    return true;
   }
 
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
@@ -309,8 +325,10 @@ class BlockPlanner {
     return std::make_shared<ColumnMotion>(lo, std::move(ref_from_column), steepest_);
   }
 
-  bool small(const ColumnMotion& m) const {
-    return m.spread().turn <= max_turn_ && m.spread().shift <= limits_.shift;
+  bool small(const ColumnMotion& m, const BlockLimits& limits) const {
+    const double max_turn =
+        std::min(limits.turn, limits.turn_per_increment * std::abs(pattern_.angleIncrement()));
+    return m.spread().turn <= max_turn && m.spread().shift <= limits.shift;
   }
 
   const Scene& scene_;
@@ -319,7 +337,6 @@ class BlockPlanner {
   const CastConfig& config_;
   double steepest_ = 0;
   BlockLimits limits_;
-  double max_turn_ = 0;  // rad, for this pattern
 };
 
 // Whether any beam of the block's columns can meet the group's tree (its box's view from the
