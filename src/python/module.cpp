@@ -332,8 +332,13 @@ class Caster {
             if (intensity_out) intensity_out[k * beams + b] = measured.intensities[b];
           }
         } else {
+          // A hit within the limits is itself (classifyRange's first rule, checked here so that
+          // most beams skip the call); classifyRange decides every other.
+          const double lo = spec.output.range_min, hi = spec.output.range_max;
           for (py::ssize_t b = 0; b < beams; ++b) {
-            range_out[k * beams + b] = core::classifyRange(result.range[b], spec.output);
+            const double r = result.range[b];
+            range_out[k * beams + b] =
+                r >= lo && r <= hi ? r : core::classifyRange(r, spec.output);
           }
         }
         if (xyz_out) {
