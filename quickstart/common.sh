@@ -8,8 +8,8 @@ REPO_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 WS_DIR=${LASER_RAYCAST_WS:-$REPO_DIR/.ws}
 JOBS=${LASER_RAYCAST_JOBS:-$(nproc)}
 
-# Everything the package needs to build, test (clang: the fuzz harnesses), run the demo and
-# benchmark, from Debian 12's archive.
+# Everything the package needs to build, test (clang: the fuzz harnesses; PCL: reading the point
+# layouts as SLAM packages do), run the demo and benchmark, from Debian 12's archive.
 APT_PACKAGES=(
   build-essential cmake catkin python3-catkin-pkg
   libeigen3-dev libassimp-dev liburdfdom-dev liburdfdom-headers-dev liborocos-kdl-dev
@@ -22,7 +22,7 @@ APT_PACKAGES=(
   librostest-dev libgtest-dev python3-rostest python3-roslaunch python3-rosmaster python3-rostopic
   python3-rospy python3-tf2-ros python3-sensor-msgs python3-geometry-msgs python3-std-msgs
   rosbash ros-robot-state-publisher
-  libembree-dev libbullet-dev python3-matplotlib catkin-lint
+  libembree-dev libbullet-dev python3-matplotlib catkin-lint libpcl-dev
   clang libclang-rt-dev
 )
 

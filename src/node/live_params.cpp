@@ -22,6 +22,17 @@ std::string applyLiveParams(const LiveParams& live, SensorParams* params) {
            formatNumber(params->scan_time) +
            " s (a head turns once a scan; scan_time needs a restart)";
   }
+  // scan_time 0 follows the rate: a slower rate lengthens a rotating sweep, whose point times the
+  // layout's fields must still hold.
+  SensorParams next = *params;
+  next.rate = live.rate;
+  if (!next.planar()) {
+    const std::string limit = pointLayoutLimit(
+        next.point_layout, static_cast<int>(next.scan.elevations.size()), next.sweepDuration());
+    if (!limit.empty()) {
+      return "rate " + formatNumber(live.rate) + " Hz is too slow for point_layout " + limit;
+    }
+  }
   try {
     live.output.validate();
   } catch (const std::invalid_argument& e) {

@@ -12,7 +12,7 @@ namespace laser_raycast {
 
 struct LiveParams {
   core::MeasurementConfig output;  // range limits, min-range policy, noise, intensity, realism
-  double rate = 10.0;          // Hz
+  double rate = 10.0;              // Hz
 };
 
 // The live part of `params`.
@@ -20,8 +20,9 @@ LiveParams liveParams(const SensorParams& params);
 
 // Applies `live` to *params and returns "", or returns the problem (naming the parameter and the
 // value) and leaves *params as it was: a rate outside (0, kMaxRate], a rate too fast for a
-// rotating sensor's scan_time (one turn per scan; scan_time itself needs a restart), or output
-// settings core::MeasurementConfig::validate refuses (e.g. range_min >= range_max).
+// rotating sensor's scan_time (one turn per scan; scan_time itself needs a restart), one so slow
+// that a sweep following it outlasts the times point_layout can hold, or output settings
+// core::MeasurementConfig::validate refuses (e.g. range_min >= range_max).
 std::string applyLiveParams(const LiveParams& live, SensorParams* params);
 
 }  // namespace laser_raycast

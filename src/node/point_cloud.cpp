@@ -2,25 +2,18 @@
 
 #include <sensor_msgs/PointField.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace laser_raycast {
 namespace {
 
-using Layout = CloudPointLayout;
-
-sensor_msgs::PointField field(const char* name, std::uint32_t offset, std::uint8_t datatype) {
-  sensor_msgs::PointField f;
-  f.name = name;
-  f.offset = offset;
-  f.datatype = datatype;
-  f.count = 1;
-  return f;
-}
+using sensor_msgs::PointField;
 
 bool hostIsBigEndian() {
   const std::uint16_t one = 1;
@@ -29,27 +22,90 @@ bool hostIsBigEndian() {
   return first == 0;
 }
 
-struct Point {
-  float x, y, z, intensity;
-  std::uint16_t ring;
-  float time;
+// What one beam gives its point's fields.
+struct Beam {
+  Eigen::Vector3f xyz;  // NaN without a return
+  float intensity;      // NaN without a return
+  int ring;
+  double time;   // s after the stamp
+  double range;  // m; 0 without a return
 };
 
 // memcpy: the data buffer gives no alignment guarantee.
-void writePoint(const Point& p, std::uint8_t* out) {
-  std::memset(out, 0, Layout::kPointStep);  // the padding too, so equal clouds are equal bytes
-  std::memcpy(out + Layout::kX, &p.x, 4);
-  std::memcpy(out + Layout::kY, &p.y, 4);
-  std::memcpy(out + Layout::kZ, &p.z, 4);
-  std::memcpy(out + Layout::kIntensity, &p.intensity, 4);
-  std::memcpy(out + Layout::kRing, &p.ring, 2);
-  std::memcpy(out + Layout::kTime, &p.time, 4);
+template <typename T>
+void put(T value, std::uint8_t* out) {
+  std::memcpy(out, &value, sizeof value);
+}
+
+// An integer field: rounded to nearest and clamped to its type; NaN (no return) is 0.
+template <typename T>
+void putInteger(double value, std::uint8_t* out) {
+  const double max = std::numeric_limits<T>::max();
+  put(static_cast<T>(value > 0 ? std::min(std::round(value), max) : 0.0), out);
+}
+
+// The stamp plus `time` s, in whole ns: the absolute fields are computed from it, each with one
+// rounding at the end.
+std::int64_t stampNanoseconds(std::int64_t stamp_ns, double time) {
+  return stamp_ns + std::llround(time * 1e9);
+}
+
+// Value V of `beam` as a double, for writeField to convert to the field's type.
+template <PointValue V>
+double valueOf(const Beam& beam, std::int64_t stamp_ns) {
+  if constexpr (V == PointValue::kX) return beam.xyz.x();
+  if constexpr (V == PointValue::kY) return beam.xyz.y();
+  if constexpr (V == PointValue::kZ) return beam.xyz.z();
+  if constexpr (V == PointValue::kIntensity || V == PointValue::kReflectivity) {
+    return beam.intensity;
+  }
+  if constexpr (V == PointValue::kRing) return beam.ring;
+  if constexpr (V == PointValue::kTimeSeconds) return beam.time;
+  if constexpr (V == PointValue::kTimeNanoseconds) return beam.time * 1e9;
+  if constexpr (V == PointValue::kStampSeconds) {
+    // Whole seconds and the rest apart, so that the rest is not rounded with the seconds.
+    const std::int64_t ns = stampNanoseconds(stamp_ns, beam.time);
+    return static_cast<double>(ns / 1000000000) + static_cast<double>(ns % 1000000000) * 1e-9;
+  }
+  if constexpr (V == PointValue::kStampNanoseconds) {
+    return static_cast<double>(stampNanoseconds(stamp_ns, beam.time));
+  }
+  if constexpr (V == PointValue::kRangeMillimetres) return beam.range * 1000;
+  return 0;  // kZero
+}
+
+template <PointValue V, std::uint8_t D>
+void writeField(const Beam& beam, std::int64_t stamp_ns, std::uint8_t* out) {
+  const double value = valueOf<V>(beam, stamp_ns);
+  if constexpr (D == PointField::FLOAT32) {
+    put(static_cast<float>(value), out);
+  } else if constexpr (D == PointField::FLOAT64) {
+    put(value, out);
+  } else if constexpr (D == PointField::UINT8) {
+    putInteger<std::uint8_t>(value, out);
+  } else if constexpr (D == PointField::UINT16) {
+    putInteger<std::uint16_t>(value, out);
+  } else {
+    static_assert(D == PointField::UINT32, "a field type the layouts do not use");
+    putInteger<std::uint32_t>(value, out);
+  }
+}
+
+// Every field of a point of the layout `Ref` refers to: one call per field, each resolved when
+// this is compiled.
+template <class Ref, std::size_t... I>
+void writePoint(const Beam& beam, std::int64_t stamp_ns, std::uint8_t* out,
+                std::index_sequence<I...>) {
+  constexpr const auto& fields = Ref::table.fields;
+  (writeField<fields[I].value, fields[I].datatype>(beam, stamp_ns, out + fields[I].offset), ...);
 }
 
 void checkSizes(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
-                const std::vector<double>& column_times) {
+                const std::vector<double>& column_times, PointLayout layout) {
   const std::size_t beams = pattern.size();
   std::string problem;
+  const double last_time =
+      column_times.empty() ? 0.0 : *std::max_element(column_times.begin(), column_times.end());
   if (scan.ranges.size() != beams) {
     problem = "the scan has " + std::to_string(scan.ranges.size()) + " ranges";
   } else if (!scan.intensities.empty() && scan.intensities.size() != beams) {
@@ -57,10 +113,9 @@ void checkSizes(const core::ScanPattern& pattern, const core::MeasuredScan& scan
   } else if (!column_times.empty() &&
              column_times.size() != static_cast<std::size_t>(pattern.azimuthCount())) {
     problem = std::to_string(column_times.size()) + " column times are given";
-  } else if (pattern.ringCount() > std::numeric_limits<std::uint16_t>::max() + 1) {
-    problem = "ring numbers are uint16";
   } else {
-    return;
+    problem = pointLayoutLimit(layout, pattern.ringCount(), last_time);
+    if (problem.empty()) return;
   }
   throw std::invalid_argument("buildPointCloud: " + problem + " for a pattern of " +
                               std::to_string(pattern.ringCount()) + " rings x " +
@@ -72,7 +127,7 @@ void checkSizes(const core::ScanPattern& pattern, const core::MeasuredScan& scan
 void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
                      const std::vector<double>& column_times, const std_msgs::Header& header,
                      const CloudOptions& options, sensor_msgs::PointCloud2* cloud) {
-  checkSizes(pattern, scan, column_times);
+  checkSizes(pattern, scan, column_times, options.layout);
   const int beams = pattern.size(), azimuths = pattern.azimuthCount();
   int points = beams;
   if (!options.organized) {
@@ -83,41 +138,52 @@ void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan&
   cloud->header = header;
   cloud->height = options.organized ? pattern.ringCount() : 1;
   cloud->width = options.organized ? azimuths : points;
-  cloud->fields = {field("x", Layout::kX, sensor_msgs::PointField::FLOAT32),
-                   field("y", Layout::kY, sensor_msgs::PointField::FLOAT32),
-                   field("z", Layout::kZ, sensor_msgs::PointField::FLOAT32),
-                   field("intensity", Layout::kIntensity, sensor_msgs::PointField::FLOAT32),
-                   field("ring", Layout::kRing, sensor_msgs::PointField::UINT16),
-                   field("time", Layout::kTime, sensor_msgs::PointField::FLOAT32)};
   cloud->is_bigendian = hostIsBigEndian();
-  cloud->point_step = Layout::kPointStep;
-  cloud->row_step = cloud->width * Layout::kPointStep;
-  cloud->data.resize(static_cast<std::size_t>(points) * Layout::kPointStep);
+  cloud->fields.clear();
+  withPointLayout(options.layout, [&](auto ref) {
+    for (const PointLayoutField& f : ref.table.fields) {
+      PointField field;
+      field.name = f.name;
+      field.offset = f.offset;
+      field.datatype = f.datatype;
+      field.count = 1;
+      cloud->fields.push_back(field);
+    }
+    cloud->point_step = ref.table.point_step;
+  });
+  cloud->row_step = cloud->width * cloud->point_step;
+  // Zeroed, the padding too, so that equal clouds are equal bytes.
+  cloud->data.assign(static_cast<std::size_t>(points) * cloud->point_step, 0);
 
   constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+  const auto stamp_ns = static_cast<std::int64_t>(header.stamp.toNSec());
   bool all_valid = true;
   std::uint8_t* out = cloud->data.data();
-  for (int b = 0; b < beams; ++b) {
-    const float range = scan.ranges[b];
-    const bool valid = std::isfinite(range);
-    all_valid = all_valid && valid;
-    if (!valid && !options.organized) continue;
-    const int column = b % azimuths;
-    Point p;
-    p.ring = static_cast<std::uint16_t>(b / azimuths);
-    p.time = column_times.empty() ? 0.0f : static_cast<float>(column_times[column]);
-    if (valid) {
-      const Eigen::Vector3d xyz = pattern.directions()[b] * static_cast<double>(range);
-      p.x = static_cast<float>(xyz.x());
-      p.y = static_cast<float>(xyz.y());
-      p.z = static_cast<float>(xyz.z());
-      p.intensity = scan.intensities.empty() ? 0.0f : scan.intensities[b];
-    } else {
-      p.x = p.y = p.z = p.intensity = kNan;
+  // One loop per layout, its fields written as constants.
+  withPointLayout(options.layout, [&](auto ref) {
+    using Ref = decltype(ref);
+    const auto each_field = std::make_index_sequence<Ref::table.fields.size()>();
+    for (int b = 0; b < beams; ++b) {
+      const float range = scan.ranges[b];
+      const bool valid = std::isfinite(range);
+      all_valid = all_valid && valid;
+      if (!valid && !options.organized) continue;
+      Beam beam;
+      beam.ring = b / azimuths;
+      beam.time = column_times.empty() ? 0.0 : column_times[b % azimuths];
+      if (valid) {
+        beam.xyz = (pattern.directions()[b] * static_cast<double>(range)).cast<float>();
+        beam.intensity = scan.intensities.empty() ? 0.0f : scan.intensities[b];
+        beam.range = range;
+      } else {
+        beam.xyz.setConstant(kNan);
+        beam.intensity = kNan;
+        beam.range = 0;
+      }
+      writePoint<Ref>(beam, stamp_ns, out, each_field);
+      out += Ref::table.point_step;
     }
-    writePoint(p, out);
-    out += Layout::kPointStep;
-  }
+  });
   cloud->is_dense = !options.organized || all_valid;
 }
 

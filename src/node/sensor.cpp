@@ -173,6 +173,7 @@ void Sensor::publishCloud(const ros::Time& stamp) {
   header.frame_id = cast_params_.frame_id;
   CloudOptions options;
   options.organized = cast_params_.organized;
+  options.layout = cast_params_.point_layout;
   sensor_msgs::PointCloud2 cloud;
   buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud);
   cloud_pub_.publish(cloud);

@@ -124,6 +124,7 @@ void readSweep(ParamReader* r, SensorParams* s, std::vector<std::string>* warnin
     r->note(r->prefix() + "scan_time unset (1 / " + r->prefix() + "rate)");
   }
   s->organized = r->boolean("organized", s->organized);
+  s->point_layout = r->choice("point_layout", s->point_layout, kPointLayoutNames);
 }
 
 // Where the sensor pose comes from: TF, or a topic giving the pose of pose_frame.
@@ -194,10 +195,18 @@ void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::st
       failWithCoreMessage(r, e.what(), beams_from);
     }
   }
-  if (s->organized && s->planar()) {
-    warnings->push_back(r->prefix() + "organized has no effect for a planar pattern (published " +
-                        "as a LaserScan)");
+  // The layout's integer fields must hold every ring number and point time of the scan.
+  if (r->error().empty() && !s->planar()) {
+    const std::string limit = pointLayoutLimit(
+        s->point_layout, static_cast<int>(s->scan.elevations.size()), s->sweepDuration());
+    if (!limit.empty()) r->fail("point_layout", limit);
   }
+  const auto no_effect = [&](const char* name) {
+    warnings->push_back(r->prefix() + name + " has no effect for a planar pattern (published as " +
+                        "a LaserScan)");
+  };
+  if (s->planar() && s->organized) no_effect("organized");
+  if (s->planar() && s->point_layout != PointLayout::kVelodyne) no_effect("point_layout");
 }
 
 double SensorParams::timeIncrement() const {

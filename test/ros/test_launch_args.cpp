@@ -101,6 +101,7 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
   EXPECT_EQ(p.sensors.at(0).sweep, laser_raycast::Sweep::kRotating);
   EXPECT_EQ(p.sensors.at(0).scan_time, 0.1);
   EXPECT_TRUE(p.sensors.at(0).organized);
+  EXPECT_EQ(p.sensors.at(0).point_layout, laser_raycast::PointLayout::kOusterLegacy);
   EXPECT_EQ(p.sensors.at(0).scan.output.range_bias, 0.01);
   EXPECT_EQ(p.sensors.at(0).scan.output.range_resolution, 0.002);
   EXPECT_EQ(p.sensors.at(0).scan.output.dropout_probability, 0.05);

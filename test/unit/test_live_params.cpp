@@ -76,6 +76,24 @@ TEST(LiveParams, ScanTimeFollowingTheRateOrNoSweepAllowsAnyRate) {
   EXPECT_DOUBLE_EQ(p.scanTime(), 1.0 / 50);
 }
 
+// A rate so slow that a sweep following it (scan_time unset) outlasts what ouster's uint32 ns
+// hold (4.29 s) is refused; the velodyne layout's float seconds hold it.
+TEST(LiveParams, ASweepTooLongForThePointLayoutIsRefused) {
+  SensorParams p = rotating(0.0);
+  p.scan.fan.samples = 360;
+  p.scan.elevations = {-0.1, 0.1};
+  p.point_layout = laser_raycast::PointLayout::kOuster;
+  LiveParams live = liveParams(p);
+  live.rate = 0.2;  // a 5 s turn
+  expectRefused(live, p, {"rate 0.2 Hz", "too slow for point_layout 'ouster'", "uint32 ns"});
+  live.rate = 0.25;  // 4 s
+  SensorParams q = p;
+  EXPECT_EQ(applyLiveParams(live, &q), "");
+  p.point_layout = laser_raycast::PointLayout::kVelodyne;
+  live.rate = 0.2;
+  EXPECT_EQ(applyLiveParams(live, &p), "");
+}
+
 TEST(LiveParams, RatesOutsideTheRangeAreRefused) {
   for (const double rate : {0.0, -1.0, 1000.5, std::numeric_limits<double>::quiet_NaN(),
                             std::numeric_limits<double>::infinity()}) {

@@ -71,6 +71,7 @@ const std::vector<std::string> kReadmeParameters = {"frame_id",
                                                     "sweep",
                                                     "scan_time",
                                                     "organized",
+                                                    "point_layout",
                                                     "range_bias",
                                                     "range_resolution",
                                                     "dropout_probability",
@@ -121,6 +122,7 @@ TEST(NodeParams, EveryDefault) {
     EXPECT_EQ(s.scanTime(), 0.1);
     EXPECT_EQ(s.timeIncrement(), 0.0);
     EXPECT_FALSE(s.organized);
+    EXPECT_EQ(s.point_layout, laser_raycast::PointLayout::kVelodyne);
     EXPECT_EQ(s.scan.output.range_bias, 0.0);
     EXPECT_EQ(s.scan.output.range_resolution, 0.0);
     EXPECT_EQ(s.scan.output.dropout_probability, 0.0);
@@ -309,8 +311,9 @@ TEST(NodeParams, TheLimitsThemselvesAreAccepted) {
   expectAccepted(values({{"threads", laser_raycast::core::CastConfig::kMaxThreads}}));
   expectAccepted(values({{"pose_timeout", kInf}}));  // never stale
   expectAccepted(values({{"samples", 2}}));
-  expectAccepted(values({{"mesh_import_max_memory_mb", laser_raycast::MeshImportBounds::kMinMemoryMb},
-                         {"mesh_import_timeout", 1e-3}}));
+  expectAccepted(
+      values({{"mesh_import_max_memory_mb", laser_raycast::MeshImportBounds::kMinMemoryMb},
+              {"mesh_import_timeout", 1e-3}}));
   expectAccepted(values({{"noise_seed", 0}, {"default_reflectivity", 0}}));
   expectAccepted(values({{"reflectivity", values({{"black", 0}})}, {"intensity", "reflectivity"}}));
 }

@@ -1,6 +1,7 @@
-// buildPointCloud: the field layout, both layouts against hand-computed points (read back with
-// sensor_msgs' PointCloud2ConstIterator, as consumers read them), times, intensities, and a cloud
-// from a real cast whose points lie on the wall that was cast against.
+// buildPointCloud in its default layout (velodyne_pointcloud's): the fields, dense and organized
+// clouds against hand-computed points (read back with sensor_msgs' PointCloud2ConstIterator),
+// times, intensities, and a cloud from a real cast whose points lie on the wall that was cast
+// against. The other layouts, read by PCL as SLAM packages read them: test_point_layouts.cpp.
 #include <gtest/gtest.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cloud_scan.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/node/point_cloud.h"
@@ -23,27 +25,7 @@ using laser_raycast::rotatingColumnTimes;
 using namespace laser_raycast::core;
 using sensor_msgs::PointField;
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
-
-// Two rings (given high first: ring 0 is the lower, -0.3 rad) of three azimuths -pi/2, 0, pi/2.
-ScanPattern twoRings() {
-  ScanSpec spec;
-  spec.fan.angle_min = -M_PI / 2;
-  spec.fan.angle_max = M_PI / 2;
-  spec.fan.samples = 3;
-  spec.elevations = {0.2, -0.3};
-  return spec.pattern();
-}
-
-// Ring-major: ring 0 = {2, no return, 1.5}, ring 1 = {too close, 3, NaN}.
-MeasuredScan sixBeams() {
-  MeasuredScan scan;
-  scan.ranges = {2.0f, kInf, 1.5f, -kInf, 3.0f, kNan};
-  scan.intensities = {0.5f, 0.0f, 0.25f, 0.0f, 0.75f, 0.0f};
-  scan.labels = {0, -1, 0, 0, 0, -1};
-  return scan;
-}
 
 std_msgs::Header header() {
   std_msgs::Header h;
@@ -83,7 +65,8 @@ TEST(PointCloud, FieldsAsVelodynePointcloudNamesThem) {
   buildPointCloud(twoRings(), sixBeams(), {}, header(), CloudOptions{}, &cloud);
   ASSERT_EQ(cloud.fields.size(), 6u);
   const std::vector<std::string> names = {"x", "y", "z", "intensity", "ring", "time"};
-  const std::vector<std::uint32_t> offsets = {0, 4, 8, 12, 16, 20};
+  // Packed, as velodyne_pointcloud >= 1.6 lays them out: 22 bytes a point.
+  const std::vector<std::uint32_t> offsets = {0, 4, 8, 12, 16, 18};
   for (int f = 0; f < 6; ++f) {
     EXPECT_EQ(cloud.fields[f].name, names[f]);
     EXPECT_EQ(cloud.fields[f].offset, offsets[f]) << names[f];
@@ -92,7 +75,7 @@ TEST(PointCloud, FieldsAsVelodynePointcloudNamesThem) {
         << names[f];
     EXPECT_EQ(cloud.fields[f].count, 1u) << names[f];
   }
-  EXPECT_EQ(cloud.point_step, 24u);
+  EXPECT_EQ(cloud.point_step, 22u);
   EXPECT_FALSE(cloud.is_bigendian);  // the test machines are little-endian
   EXPECT_EQ(cloud.header.frame_id, "velodyne");
   EXPECT_EQ(cloud.header.stamp, ros::Time(12, 345));
@@ -105,8 +88,8 @@ TEST(PointCloud, DenseHoldsTheValidReturns) {
   buildPointCloud(twoRings(), sixBeams(), {0.0, 0.01, 0.02}, header(), CloudOptions{}, &cloud);
   EXPECT_EQ(cloud.height, 1u);
   EXPECT_EQ(cloud.width, 3u);
-  EXPECT_EQ(cloud.row_step, 72u);
-  EXPECT_EQ(cloud.data.size(), 72u);
+  EXPECT_EQ(cloud.row_step, 66u);
+  EXPECT_EQ(cloud.data.size(), 66u);
   EXPECT_TRUE(cloud.is_dense);
   const auto p = readAll(cloud);
   ASSERT_EQ(p.size(), 3u);
@@ -138,8 +121,8 @@ TEST(PointCloud, OrganizedHoldsEveryBeam) {
                   &cloud);
   EXPECT_EQ(cloud.height, 2u);
   EXPECT_EQ(cloud.width, 3u);
-  EXPECT_EQ(cloud.row_step, 72u);
-  EXPECT_EQ(cloud.data.size(), 144u);
+  EXPECT_EQ(cloud.row_step, 66u);
+  EXPECT_EQ(cloud.data.size(), 132u);
   EXPECT_FALSE(cloud.is_dense);
   const auto p = readAll(cloud);
   ASSERT_EQ(p.size(), 6u);

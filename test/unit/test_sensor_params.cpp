@@ -120,6 +120,55 @@ XmlRpcValue sensor(const std::vector<std::pair<std::string, XmlRpcValue>>& entri
 
 // The private namespace's sensor parameters are every entry's defaults; an entry's own preset and
 // keys override them.
+// ~point_layout: velodyne by default, per entry of ~sensors with the private namespace's as the
+// default; a value not in the table names the choices; a layout whose integer fields cannot hold
+// the scan's rings or point times is refused at start-up.
+TEST(SensorParams, PointLayoutPerSensor) {
+  using laser_raycast::PointLayout;
+  const Parsed parsed = parse(
+      values({{"point_layout", "ouster"},
+              {"elevations", list({-0.1, 0.1})},
+              {"sensors", list({sensor({{"frame_id", "a"}}),
+                                sensor({{"frame_id", "b"}, {"point_layout", "ouster_legacy"}}),
+                                sensor({{"frame_id", "c"}, {"point_layout", "livox"}}),
+                                sensor({{"frame_id", "d"}, {"point_layout", "hesai"}}),
+                                sensor({{"frame_id", "e"}, {"point_layout", "velodyne"}})})}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_TRUE(parsed.report.warnings.empty()) << parsed.report.warnings.front();
+  const std::vector<PointLayout> expected = {PointLayout::kOuster, PointLayout::kOusterLegacy,
+                                             PointLayout::kLivox, PointLayout::kHesai,
+                                             PointLayout::kVelodyne};
+  ASSERT_EQ(parsed.params.sensors.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(parsed.params.sensors[i].point_layout, expected[i]) << i;
+  }
+  const auto& log = parsed.report.values;
+  EXPECT_NE(std::find(log.begin(), log.end(), "~sensors[2]/point_layout = 'livox'"), log.end());
+  EXPECT_EQ(parse(values({})).params.sensors.at(0).point_layout, PointLayout::kVelodyne);
+
+  expectRefused(values({{"point_layout", "xyzirt"}}),
+                {"~point_layout",
+                 "'xyzirt' is not one of velodyne, ouster, ouster_legacy, livox, "
+                 "hesai"});
+  expectRefused(values({{"sensors", list({sensor({{"frame_id", "a"}, {"point_layout", 3}})})}}),
+                {"~sensors[0]/point_layout", "is a int (3)", "a string"});
+  // 300 rings do not fit a uint8 ring; a 5 s sweep does not fit ouster's uint32 ns.
+  std::vector<XmlRpcValue> many;
+  for (int i = 0; i < 300; ++i) many.push_back(-1.5 + i * 0.01);
+  expectRefused(values({{"elevations", list(many)}, {"point_layout", "ouster_legacy"}}),
+                {"~point_layout", "'ouster_legacy'", "at most 256", "300 rings"});
+  expectAccepted(values({{"elevations", list(many)}, {"point_layout", "ouster"}}));
+  expectRefused(values({{"elevations", list({0.1})},
+                        {"point_layout", "ouster"},
+                        {"sweep", "rotating"},
+                        {"rate", 0.2}}),
+                {"~point_layout", "'ouster'", "uint32 ns", "the sweep lasts 4.99"});
+  // A planar sensor publishes a LaserScan: the layout has no effect.
+  const Parsed planar = parse(values({{"point_layout", "ouster"}}));
+  ASSERT_EQ(planar.report.warnings.size(), 1u);
+  expectMentions(planar.report.warnings[0], {"~point_layout", "planar"});
+}
+
 TEST(SensorParams, SeveralSensors) {
   const Parsed parsed =
       parse(values({{"noise_stddev", 0.01},

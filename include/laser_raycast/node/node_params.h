@@ -12,6 +12,7 @@
 #include "laser_raycast/core/enum_names.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/scene_loader.h"
+#include "laser_raycast/node/point_layout.h"
 
 namespace ros {
 class NodeHandle;
@@ -69,7 +70,8 @@ struct SensorParams {
   Sweep sweep = Sweep::kInstant;
   double scan_time = 0;    // s, in (0, 1 / rate]: one turn of a rotating head; 0: 1 / rate
   bool organized = false;  // PointCloud2: every beam, height = rings (else valid returns only)
-  std::string pose_topic;  // empty: the sensor pose comes from TF
+  PointLayout point_layout = PointLayout::kVelodyne;  // PointCloud2: whose driver's fields
+  std::string pose_topic;                             // empty: the sensor pose comes from TF
   std::string pose_frame;  // frame whose pose pose_topic gives; empty: frame_id
   // s, > 0: a topic pose older than this at a scan's time is stale (the scan is skipped). Pose
   // sources run at 10 to 100 Hz: this is five periods of the slowest.

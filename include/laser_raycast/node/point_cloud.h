@@ -1,41 +1,37 @@
-// sensor_msgs/PointCloud2 from one encoded scan, as a pure function: the fields x y z intensity
-// (float32), ring (uint16) and time (float32, s after header.stamp) that velodyne_pointcloud
-// publishes and lidar SLAM packages read by name.
+// sensor_msgs/PointCloud2 from one encoded scan, as a pure function, in the point layout of a real
+// driver (point_layout.h) that lidar SLAM packages read by field name: by default
+// velodyne_pointcloud's x y z intensity (float32), ring (uint16) and time (float32, s after
+// header.stamp).
 #pragma once
 
 #include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/Header.h>
 
-#include <cstdint>
 #include <vector>
 
 #include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/scan_pattern.h"
+#include "laser_raycast/node/point_layout.h"
 
 namespace laser_raycast {
-
-// Where each field lies in a point: every field aligned to its size, 24 bytes a point.
-struct CloudPointLayout {
-  static constexpr std::uint32_t kX = 0, kY = 4, kZ = 8, kIntensity = 12;  // float32
-  static constexpr std::uint32_t kRing = 16;                               // uint16 (+2 padding)
-  static constexpr std::uint32_t kTime = 20;                               // float32
-  static constexpr std::uint32_t kPointStep = 24;
-};
 
 struct CloudOptions {
   // false: only valid returns (finite ranges, i.e. REP 117's range_min <= r <= range_max) in one
   // row (height 1, is_dense true). true: every beam, height = rings, width = azimuths, row r =
   // ring r (ring 0 lowest, as the pattern orders beams), a beam without a valid return as NaN x, y,
-  // z and intensity (its ring and time kept), is_dense true only if every beam has a return.
+  // z and intensity (its ring and times kept; reflectivity and range 0), is_dense true only if
+  // every beam has a return.
   bool organized = false;
+  PointLayout layout = PointLayout::kVelodyne;  // the fields, their offsets and types
 };
 
 // The cloud of one scan. Beam b of the pattern (ring-major: ring b / azimuthCount(), azimuth
 // column b % azimuthCount()) with a valid range r is the point r * direction(b) in the sensor frame
 // (computed in double, stored as float), with scan.intensities[b] (0 if scan has none), its ring,
-// and time column_times[column] (s after header.stamp; empty: every column at the stamp, an
-// instantaneous scan; see rotatingColumnTimes). Throws std::invalid_argument if scan.ranges,
-// scan.intensities or column_times do not match the pattern's size, or it has over 65536 rings.
+// range r, and time column_times[column] (s after header.stamp; empty: every column at the stamp,
+// an instantaneous scan; see rotatingColumnTimes), each in the fields of options.layout that hold
+// it (PointValue). Throws std::invalid_argument if scan.ranges, scan.intensities or column_times
+// do not match the pattern's size, or the layout cannot hold the scan (pointLayoutLimit).
 void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
                      const std::vector<double>& column_times, const std_msgs::Header& header,
                      const CloudOptions& options, sensor_msgs::PointCloud2* cloud);
