@@ -90,6 +90,9 @@ TEST(NodeStartup, BadSensorInputStopsTheNodeBeforeAnythingStarts) {
   ros::NodeHandle nh;
   refused(scene("/p1") + " _sensor_model:=VLP-15",
           {"~sensor_model", "'VLP-15' is not one of", "VLP-16"});
+  refused(
+      scene("/p7") + " _point_layout:=xyzirt",
+      {"~point_layout", "'xyzirt' is not one of velodyne, ouster, ouster_legacy, livox, hesai"});
   XmlRpc::XmlRpcValue empty;
   empty.setSize(0);
   nh.setParam("/p2/node/elevations", empty);
