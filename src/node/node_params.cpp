@@ -46,9 +46,10 @@ void readReflectivityEntries(ParamReader* r, const std::string& link, const XmlR
 
 // ~reflectivity: {link: value >= 0}; an empty dict is the same as none.
 void readReflectivityDict(ParamReader* r, std::map<std::string, double>* reflectivity) {
-  const XmlRpc::XmlRpcValue* v = r->get("reflectivity");
+  const char* expected = "a dict {link: reflectivity}";
+  const XmlRpc::XmlRpcValue* v = r->container("reflectivity", expected);
   if (v && v->getType() != XmlRpc::XmlRpcValue::TypeStruct) {
-    r->wrongType("reflectivity", *v, "a dict {link: reflectivity}");
+    r->wrongType("reflectivity", *v, expected);
   } else if (v) {
     readReflectivityEntries(r, "", *v, reflectivity);
   }
@@ -130,9 +131,10 @@ bool readModel(ParamReader* r, const std::string& where, const XmlRpc::XmlRpcVal
 }
 
 void readModels(ParamReader* r, std::vector<ModelSource>* models) {
-  const XmlRpc::XmlRpcValue* v = r->get("models");
+  const char* expected = "a non-empty list of {param: NAME} or {file: PATH} entries";
+  const XmlRpc::XmlRpcValue* v = r->container("models", expected);
   if (v && (v->getType() != XmlRpc::XmlRpcValue::TypeArray || v->size() == 0)) {
-    r->wrongType("models", *v, "a non-empty list of {param: NAME} or {file: PATH} entries");
+    r->wrongType("models", *v, expected);
   } else if (v) {
     models->clear();
     for (int i = 0; i < v->size(); ++i) {
@@ -260,7 +262,8 @@ void readSensors(ParamReader* r, const std::string& ns, NodeParams* p,
   SensorParams base;
   readSensor(r, &base, false, warnings);
   p->sensors.clear();
-  const XmlRpc::XmlRpcValue* v = r->get("sensors");
+  const char* expected = "a non-empty list of dicts of sensor parameters";
+  const XmlRpc::XmlRpcValue* v = r->container("sensors", expected);
   if (!v) {
     base.name = base.frame_id;
     base.topic = defaultTopic(base, false);
@@ -269,7 +272,7 @@ void readSensors(ParamReader* r, const std::string& ns, NodeParams* p,
     return;
   }
   if (v->getType() != XmlRpc::XmlRpcValue::TypeArray || v->size() == 0) {
-    r->wrongType("sensors", *v, "a non-empty list of dicts of sensor parameters");
+    r->wrongType("sensors", *v, expected);
     return;
   }
   for (int i = 0; i < v->size(); ++i) {

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <utility>
 
+#include "yaml_value.h"
+
 namespace laser_raycast {
 
 std::string formatNumber(double value) {
@@ -89,6 +91,20 @@ const XmlRpc::XmlRpcValue* ParamReader::get(const std::string& name) {
   return nullptr;
 }
 
+const XmlRpc::XmlRpcValue* ParamReader::container(const std::string& name, const char* expected) {
+  const XmlRpc::XmlRpcValue* v = get(name);
+  if (!v || v->getType() != XmlRpc::XmlRpcValue::TypeString) return v;
+  XmlRpc::XmlRpcValue parsed;
+  std::string error;
+  if (parseYamlContainer(static_cast<const std::string&>(*v), &parsed, &error)) {
+    return &(from_yaml_[name] = parsed);
+  }
+  if (error.empty()) return v;
+  fail(name, "is a string (" + describeValue(*v) + ") that YAML cannot read as a parameter (" +
+                 error + "), expected " + expected);
+  return nullptr;
+}
+
 double ParamReader::number(const std::string& name, double fallback, const char* unit) {
   const double value =
       scalar<double>(name, fallback, "a number", [](const XmlRpc::XmlRpcValue& v, double* out) {
@@ -142,7 +158,7 @@ std::string ParamReader::text(const std::string& name, const std::string& fallba
 
 std::vector<std::string> ParamReader::textList(const std::string& name) {
   std::vector<std::string> value;
-  if (const XmlRpc::XmlRpcValue* v = get(name)) {
+  if (const XmlRpc::XmlRpcValue* v = container(name, "a list of strings")) {
     if (v->getType() != XmlRpc::XmlRpcValue::TypeArray) {
       wrongType(name, *v, "a list of strings");
     } else {
@@ -165,7 +181,7 @@ std::vector<std::string> ParamReader::textList(const std::string& name) {
 std::vector<double> ParamReader::numberList(const std::string& name,
                                             const std::vector<double>& fallback, const char* unit) {
   std::vector<double> value = fallback;
-  if (const XmlRpc::XmlRpcValue* v = get(name)) {
+  if (const XmlRpc::XmlRpcValue* v = container(name, "a list of numbers")) {
     value.clear();
     if (v->getType() != XmlRpc::XmlRpcValue::TypeArray) {
       wrongType(name, *v, "a list of numbers");

@@ -6,6 +6,7 @@
 
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -33,6 +34,12 @@ class ParamReader {
   bool has(const std::string& name);
   // The value, or nullptr if unset.
   const XmlRpc::XmlRpcValue* get(const std::string& name);
+  // The value of a list or dict parameter, or nullptr if unset. roscpp sets _name:=[a, b] from the
+  // command line as a string: a string holding a YAML list or dict is read as that list or dict
+  // (parseYamlContainer), so that the caller's checks apply to it; one that is not YAML, or holds
+  // what no parameter can (a null), fails naming the parameter and the string (then nullptr); any
+  // other string is returned as it is, for the caller to refuse as not `expected`.
+  const XmlRpc::XmlRpcValue* container(const std::string& name, const char* expected);
 
   // Scalars: the fallback if unset, logged as "<prefix>name = value unit". A number may be given
   // as an int or a double.
@@ -82,6 +89,8 @@ class ParamReader {
   }
 
   const XmlRpc::XmlRpcValue& values_;
+  // The lists and dicts read from strings, by name (a map: the values stay where they are).
+  std::map<std::string, XmlRpc::XmlRpcValue> from_yaml_;
   std::string prefix_;
   std::set<std::string> known_;
   std::vector<std::string> known_order_;

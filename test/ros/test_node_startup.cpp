@@ -50,8 +50,8 @@ void expectRefused(const std::string& args, const std::vector<std::string>& ment
 }
 
 // Arguments for a node named `ns`/node whose robot_description is the test scene, so that only the
-// parameter under test is wrong. Scalars go on the command line; lists and dicts through the master
-// (roscpp reads _name:=value as a scalar).
+// parameter under test is wrong. Scalars go on the command line; lists and dicts mostly through the
+// master (ListsAndDictsFromTheCommandLine gives them on the command line, as YAML strings).
 std::string scene(const std::string& ns) {
   ros::NodeHandle nh;
   std::string xml;
@@ -192,6 +192,27 @@ TEST(NodeStartup, SkipBadGeometryStartsWithAWarning) {
   EXPECT_NE(run.output.find("broken_link"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("WARN"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("~samplez is not a parameter"), std::string::npos) << run.output;
+}
+
+// Lists and dicts on the command line, as YAML: roscpp sets them as strings, which the node reads
+// as the lists and dicts they hold.
+TEST(NodeStartup, ListsAndDictsFromTheCommandLine) {
+  const NodeRun run =
+      runNode(scene("/w") +
+                  " '_elevations:=[-0.1, 0.1]' '_ignore_links:=[sphere_link]'"
+                  " '_models:=[{param: robot_description}]' _intensity:=reflectivity"
+                  " '_reflectivity:={wall_link: 0.5}'",
+              4);
+  EXPECT_EQ(run.status, 124) << "the node should still be running when timeout stops it:\n"
+                             << run.output;
+  for (const std::string m : {"~elevations = [-0.1, 0.1] rad", "~ignore_links = [sphere_link]",
+                              "~models[0] = parameter robot_description",
+                              "~reflectivity = {wall_link: 0.5}", "publishing /w/points"}) {
+    EXPECT_NE(run.output.find(m), std::string::npos) << "the log should say '" << m << "':\n"
+                                                     << run.output;
+  }
+  expectRefused(scene("/w2") + " '_elevations:=[-0.1, 0.1'",
+                {"~elevations", "'[-0.1, 0.1'", "YAML", "a list of numbers"});
 }
 
 // The ROS time (s) of the first console line of `severity` ("INFO", "WARN") containing `text`;

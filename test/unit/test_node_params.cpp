@@ -394,6 +394,60 @@ TEST(NodeParams, ReflectivityOfLinksWithATfPrefix) {
                 {"~reflectivity/r2/wall", "'x'", "a number"});
 }
 
+// roscpp sets _elevations:="[-0.1, 0.1]" from the command line as a string: every list and dict
+// parameter given as a string of YAML is read as that list or dict, with the same values, log lines
+// and checks as when the parameter server holds one (the nested reflectivity dict the server makes
+// of a "r2/wall" key included).
+TEST(NodeParams, ListsAndDictsGivenAsYamlStrings) {
+  const XmlRpcValue as_values =
+      values({{"elevations", list({-0.1, 0.1})},
+              {"models", list({values({{"param", "scene"}, {"tf_prefix", "s/"}}), "other"})},
+              {"ignore_links", list({"s/arm", "slider"})},
+              {"intensity", "reflectivity"},
+              {"reflectivity", values({{"wall", 0.5}, {"r2", values({{"wall", 2}})}})},
+              {"sensors", list({values({{"frame_id", "front"}, {"elevations", list({0})}}),
+                                values({{"frame_id", "top"}, {"sensor_model", "VLP-16"}})})}});
+  const XmlRpcValue as_strings = values(
+      {{"elevations", "[-0.1, 0.1]"},
+       {"models", "[{param: scene, tf_prefix: s/}, other]"},
+       {"ignore_links", "[s/arm, slider]"},
+       {"intensity", "reflectivity"},
+       {"reflectivity", "{wall: 0.5, r2/wall: 2}"},
+       {"sensors", "[{frame_id: front, elevations: [0]}, {frame_id: top, sensor_model: VLP-16}]"}});
+  const Parsed expected = parse(as_values), got = parse(as_strings);
+  ASSERT_EQ(expected.error, "");
+  ASSERT_EQ(got.error, "");
+  EXPECT_EQ(got.report.values, expected.report.values);  // every value, as logged
+  EXPECT_EQ(got.report.warnings, expected.report.warnings);
+  EXPECT_EQ(got.params.sensors.at(1).scan.elevations.size(), 16u);
+  EXPECT_EQ(got.params.reflectivity,
+            (std::map<std::string, double>{{"wall", 0.5}, {"r2/wall", 2}}));
+  // A string inside an entry of ~sensors too.
+  const Parsed entry = parse(
+      values({{"sensors", list({values({{"frame_id", "a"}, {"elevations", "[0.2, -0.2]"}})})}}));
+  ASSERT_EQ(entry.error, "");
+  EXPECT_EQ(entry.params.sensors.at(0).scan.elevations, (std::vector<double>{0.2, -0.2}));
+}
+
+// The checks are those of a list or dict, naming the parameter; a string that is not YAML, or
+// holds a null, is refused naming the parameter and the string; a string that YAML reads as a
+// scalar is refused as a string.
+TEST(NodeParams, YamlStringsAreCheckedAsTheirValues) {
+  expectRefused(values({{"elevations", "[-0.1, 0.1"}}),
+                {"~elevations", "'[-0.1, 0.1'", "YAML", "line 1", "a list of numbers"});
+  expectRefused(values({{"elevations", "[0.1, up]"}}), {"~elevations[1]", "'up'", "a number"});
+  expectRefused(values({{"elevations", "[]"}}), {"~elevations", "must not be empty"});
+  expectRefused(values({{"elevations", "{a: 1}"}}), {"~elevations", "is a dict ({a: 1})"});
+  expectRefused(values({{"ignore_links", "base"}}),
+                {"~ignore_links", "is a string ('base')", "a list of strings"});
+  expectRefused(values({{"ignore_links", "[a, ~]"}}), {"~ignore_links", "'[a, ~]'", "[1] is null"});
+  expectRefused(values({{"models", "[{param: a, file: b}]"}}), {"~models[0]", "exactly one"});
+  expectRefused(values({{"reflectivity", "{wall: -1}"}}), {"~reflectivity/wall", "got -1"});
+  expectRefused(values({{"reflectivity", "[wall]"}}), {"~reflectivity", "is a list", "a dict"});
+  expectRefused(values({{"sensors", "[{samples: 10}]"}}), {"~sensors[0]/frame_id", "not set"});
+  expectRefused(values({{"sensors", "[{frame_id: }]"}}), {"~sensors", "[0]/frame_id is null"});
+}
+
 TEST(NodeParams, UnknownParametersGetAWarning) {
   const Parsed parsed = parse(values({{"angle_incremnt", 0.01}, {"rate", 20}}));
   EXPECT_EQ(parsed.error, "");
