@@ -13,7 +13,7 @@ JOBS=${LASER_RAYCAST_JOBS:-$(nproc)}
 APT_PACKAGES=(
   build-essential cmake catkin python3-catkin-pkg
   libeigen3-dev libassimp-dev liburdfdom-dev liburdfdom-headers-dev liborocos-kdl-dev
-  libboost-program-options-dev pybind11-dev python3-dev python3-numpy python3-pytest
+  libboost-program-options-dev libpng-dev pybind11-dev python3-dev python3-numpy python3-pytest
   libroscpp-dev libroslib-dev libtf2-ros-dev libtf2-eigen-dev libtf2-geometry-msgs-dev
   libsensor-msgs-dev libgeometry-msgs-dev libstd-msgs-dev ros-std-msgs
   ros-message-generation ros-message-runtime libnodeletlib-dev libnodeletlib-tools libtopic-tools-dev
