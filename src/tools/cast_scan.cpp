@@ -1,6 +1,6 @@
-// cast_scan: simulated scans of URDF models from a sensor pose, or from each pose of a path,
-// printed as CSV. Needs no roscore: package:// URIs are resolved through ROS_PACKAGE_PATH. See
-// synopsis(), flags() and the README; the path is cast_path.h's.
+// cast_scan: simulated scans of URDF models and map worlds from a sensor pose, or from each pose of
+// a path, printed as CSV. Needs no roscore: package:// URIs are resolved through ROS_PACKAGE_PATH.
+// See synopsis(), flags() and the README; the path is cast_path.h's.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,6 +20,7 @@
 #include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/kinematics.h"
+#include "laser_raycast/loader/map_file.h"
 #include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 
@@ -42,6 +43,8 @@ struct Model {
 
 struct Args {
   std::vector<Model> models;
+  std::vector<Model> maps;  // map files (their path and pose), walls of map_height
+  double map_height = laser_raycast::MapWallOptions::kDefaultHeight;  // m
   laser_raycast::tools::PathArgs path;  // the sensor poses: --sensor or --poses
   core::ScanSpec scan;  // the fan, ranges and method; REP 117 with the default -inf policy
   GeometrySource geometry = laser_raycast::LoaderOptions().geometry;
@@ -52,6 +55,14 @@ struct Args {
   bool rings = false;  // --elevations given: one fan per elevation, and the ring columns
 };
 
+std::string formatNumber(double value) {
+  if (std::isnan(value)) return "nan";  // printf may write "-nan"
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.9g", value);
+  return buffer;
+}
+
 int parseCount(const std::string& flag, const std::string& text) {
   char* end = nullptr;
   const long value = std::strtol(text.c_str(), &end, 10);
@@ -61,8 +72,8 @@ int parseCount(const std::string& flag, const std::string& text) {
   return static_cast<int>(value);
 }
 
-// "PATH" or "PATH@x,y,z,roll,pitch,yaw"
-Model parseModel(const std::string& spec) {
+// "PATH" or "PATH@x,y,z,roll,pitch,yaw", of flag (--urdf or --map)
+Model parseModel(const std::string& flag, const std::string& spec) {
   Model model;
   model.path = spec;
   const std::size_t at = spec.rfind('@');
@@ -70,7 +81,7 @@ Model parseModel(const std::string& spec) {
       laser_raycast::tools::parsePose(spec.substr(at + 1), &model.pose)) {
     model.path = spec.substr(0, at);
   }
-  if (model.path.empty()) throw ArgError("--urdf: empty path");
+  if (model.path.empty()) throw ArgError(flag + ": empty path");
   return model;
 }
 
@@ -135,9 +146,16 @@ po::options_description flags(Args* args) {
   auto add = options.add_options();
   add("urdf",
       repeated("PATH[@POSE]",
-               [args](const std::string& v) { args->models.push_back(parseModel(v)); }),
+               [args](const std::string& v) { args->models.push_back(parseModel("--urdf", v)); }),
       "a URDF file or package:// URI, placed at POSE x,y,z,roll,pitch,yaw (default: the "
       "identity); repeat for several models");
+  add("map",
+      repeated("PATH[@POSE]",
+               [args](const std::string& v) { args->maps.push_back(parseModel("--map", v)); }),
+      "a map_server map file (YAML) or package:// URI: walls over its occupied cells, its frame "
+      "at POSE (default: the identity); repeat for several maps");
+  add("map-height", number("--map-height", "M", &args->map_height),
+      ("the walls' height, > 0 (default " + formatNumber(Args().map_height) + " m)").c_str());
   laser_raycast::tools::addPathFlags(add, &args->path);
   add("angle-min", number("--angle-min", "RAD", &args->scan.fan.angle_min), "the first beam");
   add("angle-max", number("--angle-max", "RAD", &args->scan.fan.angle_max), "the last beam");
@@ -206,7 +224,12 @@ Args parseArgs(int argc, char** argv, bool* help) {
   *help = !laser_raycast::tools::parseCommandLine(argc, argv, flags(&args), &values);
   if (*help) return args;
   const bool has_samples = values.count("samples"), has_increment = values.count("angle-increment");
-  if (args.models.empty()) throw ArgError("give at least one --urdf");
+  if (args.models.empty() && args.maps.empty()) throw ArgError("give at least one --urdf or --map");
+  if (values.count("map-height") && args.maps.empty()) throw ArgError("--map-height needs --map");
+  // Written so that NaN fails (parseNumber refuses it already).
+  if (!(args.map_height > 0)) {
+    throw ArgError("--map-height: must be > 0 m, got " + formatNumber(args.map_height));
+  }
   laser_raycast::tools::checkPathFlags(values, args.path);
   if (has_samples && has_increment) throw ArgError("give --samples or --angle-increment, not both");
   if (!has_samples && !has_increment) args.scan.fan.samples = core::FanSpec::kDefaultSamples;
@@ -224,14 +247,6 @@ Args parseArgs(int argc, char** argv, bool* help) {
   }
   laser_raycast::tools::checkSweepTimes(args.path, args.scan.fan);
   return args;
-}
-
-std::string formatNumber(double value) {
-  if (std::isnan(value)) return "nan";  // printf may write "-nan"
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.9g", value);
-  return buffer;
 }
 
 // "a|b|c": the names of a table, as the synopsis lists the choices of a flag.
@@ -254,7 +269,8 @@ std::string synopsis() {
   const auto& sweeps = laser_raycast::tools::kSweepNames;
   const char* const indent = "                 ";
   std::ostringstream out;
-  out << "usage: cast_scan --urdf PATH[@x,y,z,roll,pitch,yaw] [--urdf ...]\n"
+  out << "usage: cast_scan [--urdf PATH[@x,y,z,roll,pitch,yaw] ...]\n"
+      << indent << "[--map PATH[@x,y,z,roll,pitch,yaw] ...] [--map-height M]\n"
       << indent << "(--sensor x,y,z,roll,pitch,yaw | --poses FILE)\n"
       << indent << "[--sweep " << sweeps.name(Sweep::kInstant) << " | --sweep "
       << sweeps.name(Sweep::kRotating) << " --scan-time S [--twist vx,vy,vz,wx,wy,wz]]\n"
@@ -284,8 +300,10 @@ std::string notes() {
       << laser_raycast::toString(defaults.geometry) << ", method " << core::toString(scan.method)
       << ",\n"
       << defaults.threads << (defaults.threads == 1 ? " thread" : " threads") << ".\n"
-      << "Poses in metres and radians (URDF rpy). Exit status: 0 ok, 2 bad arguments, 3 bad scene\n"
-      << "input.\n";
+      << "Poses in metres and radians (URDF rpy). --urdf and --map together take at least one;\n"
+      << "a map's walls are " << formatNumber(defaults.map_height)
+      << " m high unless --map-height says otherwise, its hits labelled 'map'.\n"
+      << "Exit status: 0 ok, 2 bad arguments, 3 bad scene input.\n";
   return out.str();
 }
 
@@ -294,9 +312,10 @@ struct LoadedScene {
   core::Scene scene;
   core::FramePoses poses;
   bool prefixed = false;  // each model's link names carry a private prefix (not printed)
-  // Over every model, for --repeat's statistics.
+  // Over every model and map, for --repeat's statistics.
   double load_seconds = 0, bvh_build_seconds = 0;
   std::size_t mesh_triangles_built = 0, mesh_bytes_built = 0;
+  std::size_t map_occupied_cells = 0, map_boxes = 0;
 };
 
 // Every joint value must name a movable joint of some model. Throws ArgError.
@@ -320,13 +339,34 @@ void checkJoints(const std::map<std::string, double>& joints,
   }
 }
 
-// Loads every model; with several, gives each a private prefix so that equal link names stay
-// apart. Throws SceneLoadError (bad scene input) or ArgError (a bad joint).
+// Adds the walls of every --map, each on a frame "map" (with the private prefix of the model after
+// the URDFs when there are several models), placed at its pose in *link_poses. Throws
+// SceneLoadError.
+void loadMaps(const Args& args, LoadedScene* out,
+              std::map<std::string, Eigen::Isometry3d>* link_poses) {
+  for (std::size_t m = 0; m < args.maps.size(); ++m) {
+    laser_raycast::MapWallOptions options;
+    options.height = args.map_height;
+    if (out->prefixed) options.frame = "m" + std::to_string(args.models.size() + m) + "/map";
+    const laser_raycast::LoadedMap loaded = laser_raycast::addMapFile(
+        args.maps[m].path, laser_raycast::rosPackagePath, options, &out->scene);
+    for (const std::string& warning : loaded.warnings) {
+      std::cerr << "cast_scan: warning: " << warning << "\n";
+    }
+    (*link_poses)[options.frame] = args.maps[m].pose;
+    out->load_seconds += loaded.read_seconds + loaded.build_seconds;
+    out->map_occupied_cells += loaded.occupied_cells;
+    out->map_boxes += loaded.boxes;
+  }
+}
+
+// Loads every model and map; with several, gives each a private prefix so that equal link names
+// stay apart. Throws SceneLoadError (bad scene input) or ArgError (a bad joint).
 LoadedScene loadScene(const Args& args) {
   laser_raycast::SceneLoader loader(laser_raycast::rosPackagePath);
   LoadedScene out;
   std::vector<laser_raycast::LoadedModel> loaded;
-  out.prefixed = args.models.size() > 1;
+  out.prefixed = args.models.size() + args.maps.size() > 1;
   for (std::size_t m = 0; m < args.models.size(); ++m) {
     laser_raycast::LoaderOptions options;
     options.geometry = args.geometry;
@@ -345,6 +385,7 @@ LoadedScene loadScene(const Args& args) {
         laser_raycast::forwardKinematics(loaded[m], args.models[m].pose, args.joints);
     link_poses.insert(poses.begin(), poses.end());
   }
+  loadMaps(args, &out, &link_poses);
   out.poses = laser_raycast::framePosesFromLinks(out.scene, link_poses);
   return out;
 }
@@ -395,8 +436,9 @@ void reportMedianCastTime(const Args& args, const LoadedScene& loaded, Casting* 
   std::cerr << "cast_ns_per_scan_median=" << ns[ns.size() / 2] << "\n";
 }
 
-// What loading cost: time reading files and building BVHs, and the meshes' memory per triangle
-// (of each mesh read, once however often it is instanced), to stderr.
+// What loading cost: time reading files (map files and covering their cells with boxes included)
+// and building BVHs, the meshes' memory per triangle (of each mesh read, once however often it is
+// instanced), and the maps' occupied cells and boxes, to stderr.
 void reportLoad(const LoadedScene& loaded) {
   std::cerr << "load_seconds=" << formatNumber(loaded.load_seconds) << "\n"
             << "bvh_build_seconds=" << formatNumber(loaded.bvh_build_seconds) << "\n"
@@ -407,6 +449,10 @@ void reportLoad(const LoadedScene& loaded) {
               << formatNumber(static_cast<double>(loaded.mesh_bytes_built) /
                               loaded.mesh_triangles_built)
               << "\n";
+  }
+  if (loaded.map_occupied_cells > 0) {
+    std::cerr << "map_occupied_cells=" << loaded.map_occupied_cells << "\n"
+              << "map_boxes=" << loaded.map_boxes << "\n";
   }
 }
 
