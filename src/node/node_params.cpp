@@ -91,47 +91,107 @@ void readThreads(ParamReader* r, NodeParams* p) {
   }
 }
 
-// One entry of ~models: a parameter name, or a dict with exactly one of param and file, and an
-// optional tf_prefix. False (after r->fail) if it is malformed.
+// The keys of a ~models entry: the one that says what it is, and what each kind may add.
+const char* const kModelKeys = "param, file, tf_prefix, map, map_topic, height, frame";
+
+// Whether key may be given in an entry of this kind (the kind's own key).
+bool keyFitsKind(const std::string& key, const std::string& kind) {
+  if (key == "tf_prefix") return kind == "param" || kind == "file";
+  if (key == "height") return kind == "map" || kind == "map_topic";
+  if (key == "frame") return kind == "map";
+  return key == kind;
+}
+
+// A dict entry's values into m; false (after r->fail) for an unknown key or a wrong type.
+bool readModelKeys(ParamReader* r, const std::string& where, const XmlRpc::XmlRpcValue& e,
+                   ModelSource* m) {
+  for (auto it = e.begin(); it != e.end(); ++it) {
+    const std::string& key = it->first;
+    const XmlRpc::XmlRpcValue& value = it->second;
+    const auto type = value.getType();
+    if (key == "height") {
+      if (type != XmlRpc::XmlRpcValue::TypeDouble && type != XmlRpc::XmlRpcValue::TypeInt) {
+        r->wrongType(where + "/height", value, "a number (m)");
+        return false;
+      }
+      m->height = type == XmlRpc::XmlRpcValue::TypeInt ? static_cast<const int&>(value)
+                                                       : static_cast<const double&>(value);
+      continue;
+    }
+    std::string* field = key == "param"       ? &m->param
+                         : key == "file"      ? &m->file
+                         : key == "tf_prefix" ? &m->tf_prefix
+                         : key == "map"       ? &m->map
+                         : key == "map_topic" ? &m->map_topic
+                         : key == "frame"     ? &m->frame
+                                              : nullptr;
+    if (!field) {
+      r->fail(where, "unknown key '" + key + "' (expected " + kModelKeys + ")");
+      return false;
+    }
+    if (type != XmlRpc::XmlRpcValue::TypeString) {
+      r->wrongType(where + "/" + key, value, "a string");
+      return false;
+    }
+    *field = static_cast<const std::string&>(value);
+  }
+  return true;
+}
+
+// One entry of ~models: a parameter name, or a dict with exactly one of param, file, map and
+// map_topic, and the keys its kind takes (tf_prefix for a URDF; height, and frame for a map file).
+// False (after r->fail) if it is malformed.
 bool readModel(ParamReader* r, const std::string& where, const XmlRpc::XmlRpcValue& e,
                ModelSource* m) {
   if (e.getType() == XmlRpc::XmlRpcValue::TypeString) {
     m->param = static_cast<const std::string&>(e);
   } else if (e.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
+    if (!readModelKeys(r, where, e, m)) return false;
+  } else {
+    r->wrongType(where, e, "a parameter name or a dict {param|file|map|map_topic, ...}");
+    return false;
+  }
+  const std::pair<const char*, const std::string*> kinds[] = {
+      {"param", &m->param}, {"file", &m->file}, {"map", &m->map}, {"map_topic", &m->map_topic}};
+  std::string kind;
+  int given = 0;
+  for (const auto& [name, value] : kinds) {
+    if (!value->empty()) kind = name, ++given;
+  }
+  if (given != 1) {
+    r->fail(where,
+            "give exactly one of 'param', 'file', 'map' and 'map_topic', got " + describeValue(e));
+    return false;
+  }
+  if (e.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
     for (auto it = e.begin(); it != e.end(); ++it) {
-      if (it->second.getType() != XmlRpc::XmlRpcValue::TypeString) {
-        r->wrongType(where + "/" + it->first, it->second, "a string");
-        return false;
-      }
-      const std::string& value = it->second;
-      if (it->first == "param") {
-        m->param = value;
-      } else if (it->first == "file") {
-        m->file = value;
-      } else if (it->first == "tf_prefix") {
-        m->tf_prefix = value;
-      } else {
-        r->fail(where, "unknown key '" + it->first + "' (expected param, file, tf_prefix)");
+      if (!keyFitsKind(it->first, kind)) {
+        r->fail(where, "'" + it->first + "' does not go with '" + kind + "' (" + kind +
+                           " entries take " +
+                           (kind == "map"         ? "height and frame"
+                            : kind == "map_topic" ? "height; the grid gives the frame"
+                                                  : "tf_prefix") +
+                           ")");
         return false;
       }
     }
-  } else {
-    r->wrongType(where, e, "a parameter name or a dict {param|file, tf_prefix}");
-    return false;
-  }
-  if (m->param.empty() == m->file.empty()) {
-    r->fail(where, "give exactly one of 'param' and 'file', got " + describeValue(e));
-    return false;
   }
   if (!m->tf_prefix.empty() && m->tf_prefix[0] == '/') {
     r->fail(where, "tf_prefix '" + m->tf_prefix + "': tf2 frame ids must not start with '/'");
     return false;
   }
-  return true;
+  if (m->isMap() && !(std::isfinite(m->height) && m->height > 0)) {
+    r->fail(where + "/height", "must be finite and > 0 m, got " + formatNumber(m->height));
+    return false;
+  }
+  if (!m->map.empty()) checkFrame(r, where + "/frame", m->frame, false);
+  if (!m->map_topic.empty()) return checkTopic(r, where + "/map_topic", m->map_topic);
+  return r->error().empty();
 }
 
 void readModels(ParamReader* r, std::vector<ModelSource>* models) {
-  const char* expected = "a non-empty list of {param: NAME} or {file: PATH} entries";
+  const char* expected =
+      "a non-empty list of {param: NAME}, {file: PATH}, {map: PATH} or {map_topic: TOPIC} entries";
   const XmlRpc::XmlRpcValue* v = r->container("models", expected);
   if (v && (v->getType() != XmlRpc::XmlRpcValue::TypeArray || v->size() == 0)) {
     r->wrongType("models", *v, expected);
@@ -145,8 +205,10 @@ void readModels(ParamReader* r, std::vector<ModelSource>* models) {
   }
   for (std::size_t i = 0; i < models->size(); ++i) {
     const ModelSource& m = (*models)[i];
-    r->note(r->prefix() + "models[" + std::to_string(i) + "] = " + m.describe() +
-            (m.tf_prefix.empty() ? "" : ", tf_prefix '" + m.tf_prefix + "'"));
+    std::string extra = m.tf_prefix.empty() ? "" : ", tf_prefix '" + m.tf_prefix + "'";
+    if (m.isMap()) extra = ", walls " + formatNumber(m.height) + " m high";
+    if (!m.map.empty()) extra += " in frame '" + m.frame + "'";
+    r->note(r->prefix() + "models[" + std::to_string(i) + "] = " + m.describe() + extra);
   }
 }
 
@@ -305,6 +367,8 @@ void readAll(ParamReader* r, const std::string& ns, NodeParams* p,
 }  // namespace
 
 std::string ModelSource::describe() const {
+  if (!map.empty()) return "map " + map;
+  if (!map_topic.empty()) return "map topic " + map_topic;
   return param.empty() ? "file " + file : "parameter " + param;
 }
 

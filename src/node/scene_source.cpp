@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 
+#include "laser_raycast/loader/map_file.h"
 #include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 #include "param_reader.h"
@@ -43,10 +44,36 @@ LoaderOptions optionsFor(const NodeParams& params, const ModelSource& model) {
   return options;
 }
 
+// Adds the walls of map file entry i to scene; false after ROS_FATAL.
+bool loadMapFile(const NodeParams& params, std::size_t i, core::Scene* scene) {
+  const ModelSource& model = params.models[i];
+  MapWallOptions options;
+  options.height = model.height;
+  options.frame = model.frame;
+  LoadedMap loaded;
+  try {
+    loaded = addMapFile(model.map, rosPackagePath, options, scene);
+  } catch (const SceneLoadError& e) {
+    // The message names the file and the problem.
+    ROS_FATAL_STREAM("~models[" << i << "]: " << e.what());
+    return false;
+  }
+  for (const std::string& warning : loaded.warnings)
+    ROS_WARN_STREAM("~models[" << i << "]: " << warning);
+  ROS_INFO(
+      "map '%s': %d x %d cells of %g m, %zu occupied, walls %g m high in frame '%s' as %zu boxes; "
+      "read in %.3f s, walls built in %.3f s",
+      model.map.c_str(), loaded.width, loaded.height, loaded.resolution, loaded.occupied_cells,
+      model.height, model.frame.c_str(), loaded.boxes, loaded.read_seconds, loaded.build_seconds);
+  return true;
+}
+
 // Adds model i to scene; false after ROS_FATAL.
 bool loadModel(const ros::NodeHandle& nh, const NodeParams& params, std::size_t i,
                core::Scene* scene, std::set<std::string>* all_links) {
   const ModelSource& model = params.models[i];
+  if (!model.map.empty()) return loadMapFile(params, i, scene);
+  if (!model.map_topic.empty()) return true;  // its walls come with its grids (map_topic.h)
   const LoaderOptions options = optionsFor(params, model);
   LoadedModel loaded;
   try {

@@ -136,6 +136,23 @@ TEST(NodeStartup, MissingUrdfFile) {
   expectRefused("__ns:=/h __name:=node", {"/nonexistent/model.urdf"});
 }
 
+// A map entry whose file is missing or not a map, or whose walls have no height: the node stops
+// naming the entry, the file and the problem.
+TEST(NodeStartup, BadMapEntriesNameTheEntryAndFile) {
+  XmlRpc::XmlRpcValue models;
+  models.setSize(1);
+  models[0]["map"] = data("maps/no_such_map.yaml");
+  ros::NodeHandle().setParam("/map_a/node/models", models);
+  expectRefused("__ns:=/map_a __name:=node", {"~models[0]", "no_such_map.yaml", "file not found"});
+  models[0]["map"] = data("cli_joints.urdf");
+  ros::NodeHandle().setParam("/map_b/node/models", models);
+  expectRefused("__ns:=/map_b __name:=node", {"~models[0]", "cli_joints.urdf", "not valid YAML"});
+  models[0]["map"] = data("maps/box_room.yaml");
+  models[0]["height"] = 0.0;
+  ros::NodeHandle().setParam("/map_c/node/models", models);
+  expectRefused("__ns:=/map_c __name:=node", {"~models[0]/height", "> 0"});
+}
+
 TEST(NodeStartup, MissingMeshNamesTheFileAndLink) {
   ros::NodeHandle().setParam("/i/node/models", modelFile(data("bad_mesh.urdf")));
   expectRefused("__ns:=/i __name:=node",

@@ -370,7 +370,7 @@ TEST(NodeParams, BadModelsEntriesNameTheEntry) {
     return values({{"models", list({values({{"param", "robot_description"}}), entry})}});
   };
   expectRefused(models(values({{"param", "a"}, {"file", "/b.urdf"}})),
-                {"~models[1]", "exactly one of 'param' and 'file'", "/b.urdf"});
+                {"~models[1]", "exactly one of 'param', 'file', 'map' and 'map_topic'", "/b.urdf"});
   expectRefused(models(values({{"tf_prefix", "r2/"}})), {"~models[1]", "exactly one of"});
   expectRefused(models(values({{"param", ""}})), {"~models[1]", "exactly one of"});
   expectRefused(models(values({{"path", "/b.urdf"}})), {"~models[1]", "unknown key 'path'"});
@@ -378,6 +378,62 @@ TEST(NodeParams, BadModelsEntriesNameTheEntry) {
   expectRefused(models(XmlRpcValue(3)), {"~models[1]", "int (3)", "a parameter name or a dict"});
   expectRefused(models(values({{"file", "/b.urdf"}, {"tf_prefix", "/r2/"}})),
                 {"~models[1]", "tf_prefix '/r2/'", "'/'"});
+}
+
+TEST(NodeParams, MapEntries) {
+  const Parsed parsed = parse(values(
+      {{"models",
+        list({values(
+                  {{"map", "package://pkg/maps/office.yaml"}, {"height", 1.5}, {"frame", "world"}}),
+              values({{"map", "/maps/lab.yaml"}}),
+              values({{"map_topic", "/map"}, {"height", 3}})})}}));
+  ASSERT_EQ(parsed.error, "");
+  const auto& m = parsed.params.models;
+  ASSERT_EQ(m.size(), 3u);
+  EXPECT_EQ(m[0].map, "package://pkg/maps/office.yaml");
+  EXPECT_EQ(m[0].height, 1.5);
+  EXPECT_EQ(m[0].frame, "world");
+  EXPECT_EQ(m[0].param, "");
+  EXPECT_EQ(m[1].map, "/maps/lab.yaml");
+  EXPECT_EQ(m[1].height, laser_raycast::MapWallOptions::kDefaultHeight);
+  EXPECT_EQ(m[1].frame, "map");
+  EXPECT_EQ(m[2].map_topic, "/map");
+  EXPECT_EQ(m[2].height, 3.0);
+  EXPECT_TRUE(m[2].isMap());
+  const auto logged = [&](const std::string& line) {
+    const auto& v = parsed.report.values;
+    EXPECT_NE(std::find(v.begin(), v.end(), line), v.end()) << line;
+  };
+  logged("~models[0] = map package://pkg/maps/office.yaml, walls 1.5 m high in frame 'world'");
+  logged("~models[2] = map topic /map, walls 3 m high");
+}
+
+TEST(NodeParams, BadMapEntriesNameTheEntry) {
+  const auto models = [](const XmlRpcValue& entry) {
+    return values({{"models", list({values({{"param", "robot_description"}}), entry})}});
+  };
+  expectRefused(models(values({{"map", "/m.yaml"}, {"height", 0}})),
+                {"~models[1]/height", "> 0", "got 0"});
+  expectRefused(models(values({{"map", "/m.yaml"}, {"height", -2.5}})),
+                {"~models[1]/height", "got -2.5"});
+  expectRefused(models(values({{"map", "/m.yaml"}, {"height", "tall"}})),
+                {"~models[1]/height", "string ('tall')", "a number"});
+  expectRefused(models(values({{"map", "/m.yaml"}, {"heigth", 2}})),
+                {"~models[1]", "unknown key 'heigth'", "height"});
+  expectRefused(models(values({{"map", "/m.yaml"}, {"file", "/b.urdf"}})),
+                {"~models[1]", "exactly one of"});
+  expectRefused(models(values({{"map", "/m.yaml"}, {"tf_prefix", "r2/"}})),
+                {"~models[1]", "'tf_prefix' does not go with 'map'"});
+  expectRefused(models(values({{"file", "/b.urdf"}, {"height", 2}})),
+                {"~models[1]", "'height' does not go with 'file'"});
+  expectRefused(models(values({{"map_topic", "/map"}, {"frame", "odom"}})),
+                {"~models[1]", "'frame' does not go with 'map_topic'", "the grid gives the frame"});
+  expectRefused(models(values({{"map", "/m.yaml"}, {"frame", "/map"}})),
+                {"~models[1]/frame", "'/map'", "'/'"});
+  expectRefused(models(values({{"map", "/m.yaml"}, {"frame", ""}})),
+                {"~models[1]/frame", "must not be empty"});
+  expectRefused(models(values({{"map_topic", "bad topic"}})),
+                {"~models[1]/map_topic", "'bad topic'", "not a valid topic name"});
 }
 
 TEST(NodeParams, ReflectivityOfLinksWithATfPrefix) {

@@ -11,6 +11,7 @@
 
 #include "laser_raycast/core/enum_names.h"
 #include "laser_raycast/core/scan_spec.h"
+#include "laser_raycast/loader/map_walls.h"
 #include "laser_raycast/loader/scene_loader.h"
 #include "laser_raycast/node/point_layout.h"
 
@@ -21,13 +22,25 @@ class NodeHandle;
 namespace laser_raycast {
 
 // One entry of ~models: a URDF from a parameter or a file, with an optional TF prefix for its
-// links.
+// links; or a map world (map_walls.h), walls over the occupied cells of a map file or of the
+// nav_msgs/OccupancyGrid messages on a topic. Exactly one of param, file, map and map_topic is set.
 struct ModelSource {
   std::string param;  // parameter name, resolved in the node's namespace (like robot_description)
   std::string file;   // path or package:// URI of a URDF file
   std::string tf_prefix;  // prepended to the model's link names, e.g. "robot2/"
+  std::string map;        // path or package:// URI of a map_server map file (YAML)
+  std::string map_topic;  // topic of latched grids, relative or global; rebuilt on each new one
+  double height = MapWallOptions::kDefaultHeight;  // m, > 0: a map's walls, from z = 0
+  std::string frame = "map";  // the TF frame a map file's origin is in (a grid gives its own)
 
-  std::string describe() const;  // "parameter robot_description" / "file /path/x.urdf"
+  static ModelSource fromParam(const std::string& name) {
+    ModelSource m;
+    m.param = name;
+    return m;
+  }
+  bool isMap() const { return !map.empty() || !map_topic.empty(); }
+  // "parameter robot_description" / "file /path/x.urdf" / "map /path/m.yaml" / "map topic /map"
+  std::string describe() const;
 };
 
 // ~intensity: whether intensities are published.
@@ -106,7 +119,7 @@ struct NodeParams {
   // ~mesh_import_max_memory_mb, ~mesh_import_timeout: the bounds of one mesh file's import, 0 (the
   // default) for bounds that follow the file's size (MeshImportBounds).
   MeshImportBounds mesh_import;
-  std::vector<ModelSource> models = {ModelSource{"robot_description", "", ""}};
+  std::vector<ModelSource> models = {ModelSource::fromParam("robot_description")};
   std::vector<std::string> ignore_links;
   std::map<std::string, double> reflectivity;  // link name (with TF prefix) -> reflectivity
   double default_reflectivity = 1.0;
