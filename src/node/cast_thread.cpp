@@ -7,13 +7,23 @@
 
 namespace laser_raycast {
 
-CastThread::CastThread(Context context)
-    : context_(std::move(context)),
-      link_poses_(*context_.scene, [this](const std::string& frame, const ros::Time& t,
-                                          Eigen::Isometry3d* pose, std::string* error) {
-        return context_.tf->lookup(context_.fixed_frame, frame, t, pose, error);
-      }) {
+CastThread::CastThread(Context context) : context_(std::move(context)) {
+  takeScene();
   thread_ = std::thread([this] { run(); });
+}
+
+void CastThread::takeScene() {
+  std::shared_ptr<const CastScene> scene = context_.scene->current();
+  if (scene == scene_ && link_poses_) return;
+  if (link_poses_) earlier_lookups_ += link_poses_->lookups();
+  // The poses looked up so far are of the old scene's frames; the new one's are looked up anew.
+  link_poses_ = std::make_unique<LinkPoses>(
+      scene->scene, [this](const std::string& frame, const ros::Time& t, Eigen::Isometry3d* pose,
+                           std::string* error) {
+        return context_.tf->lookup(context_.fixed_frame, frame, t, pose, error);
+      });
+  scene_ = std::move(scene);
+  wait_.chains.clear();
 }
 
 CastThread::~CastThread() {
@@ -58,6 +68,7 @@ void CastThread::run() {
     }
     const ScanJob front = queue_.front();
     lock.unlock();
+    takeScene();
     const bool go = ready(front);
     lock.lock();
     if (!go) {
@@ -72,7 +83,7 @@ void CastThread::run() {
     lock.lock();
     // Times before the oldest stamp still queued (or this job's) are needed by no scan any more.
     const std::optional<ros::Time> oldest = queue_.oldestStamp();
-    link_poses_.forgetBefore(oldest && *oldest < job.stamp() ? *oldest : job.stamp());
+    link_poses_->forgetBefore(oldest && *oldest < job.stamp() ? *oldest : job.stamp());
   }
 }
 
@@ -82,7 +93,7 @@ bool CastThread::ready(const ScanJob& job) {
   if (wait_.last != job.last() || wait_.chains.empty()) {
     wait_.last = job.last();
     wait_.chains.clear();
-    for (const std::string& frame : context_.scene->frames()) {
+    for (const std::string& frame : scene_->scene.frames()) {
       wait_.chains.emplace_back(context_.fixed_frame, frame);
     }
     wait_.state.assign(wait_.chains.size(), FrameAvailability::kWaiting);
@@ -148,7 +159,7 @@ bool CastThread::acceptMissing(Sensor& sensor, const ScanJob& job, bool quiet,
         "%zu of %zu link frames have no transform to '%s' at t = %.3f; their geometry is "
         "left out of this scan (a transform older than ~tf_timeout %.3f s is not waited "
         "for): %s (%s)",
-        links.missing.size(), context_.scene->frames().size(), context_.fixed_frame.c_str(),
+        links.missing.size(), scene_->scene.frames().size(), context_.fixed_frame.c_str(),
         job.last().toSec(), context_.tf_timeout.toSec(),
         joinFirst(links.missing, kLinksInWarning).c_str(), links.first_error.c_str());
   }
@@ -160,11 +171,11 @@ void CastThread::castSensor(Sensor& sensor, const ScanJob& job) {
   std::vector<Eigen::Isometry3d> poses;
   if (!sensorPoses(sensor, job, quiet, &poses)) return;
   // Looked up once per time for every sensor whose scan needs it.
-  const LinkPosesAt links = link_poses_.at(job.times);
-  link_lookups_ = link_poses_.lookups();
+  const LinkPosesAt links = link_poses_->at(job.times);
+  link_lookups_ = earlier_lookups_ + link_poses_->lookups();
   sensor.monitor().lookupFailures(links.failures);
   if (!acceptMissing(sensor, job, quiet, links)) return;
-  sensor.castAndPublish(*context_.scene, *context_.reflectivity, job.times, links.frames, poses,
+  sensor.castAndPublish(scene_->scene, scene_->reflectivity, job.times, links.frames, poses,
                         links.missing.size());
 }
 

@@ -3,7 +3,8 @@
 // late transform is waited for up to ~tf_timeout, a dead one not at all), looks the link poses up
 // once per time for every sensor due then (link_poses.h), and has each sensor cast and publish. So
 // a wait for TF never costs the timers their rate: scans queue up behind it and are cast as the
-// transforms come.
+// transforms come. The scene is taken from a SharedScene at the start of each job (shared_scene.h):
+// a scene swapped in meanwhile serves the next job, never part of one.
 #pragma once
 
 #include <ros/ros.h>
@@ -22,6 +23,7 @@
 #include "link_poses.h"
 #include "scan_queue.h"
 #include "sensor.h"
+#include "shared_scene.h"
 #include "tf_source.h"
 
 namespace laser_raycast {
@@ -30,8 +32,7 @@ class CastThread {
  public:
   // Everything the thread reads; it must outlive the thread (the node owns both).
   struct Context {
-    const core::Scene* scene = nullptr;
-    const std::vector<double>* reflectivity = nullptr;  // by label
+    const SharedScene* scene = nullptr;
     const TfSource* tf = nullptr;
     std::vector<std::unique_ptr<Sensor>>* sensors = nullptr;
     std::string fixed_frame;
@@ -58,6 +59,8 @@ class CastThread {
   };
 
   void run();
+  // Takes the shared scene if it changed: the link poses and the wait start anew for its frames.
+  void takeScene();
   // Whether every transform the job needs is covered, stale or missing (none still late).
   bool ready(const ScanJob& job);
   void process(const ScanJob& job);
@@ -81,8 +84,12 @@ class CastThread {
   std::condition_variable wake_;
   ScanQueue queue_;
   bool stop_ = false;
-  Wait wait_;             // the cast thread's own
-  LinkPoses link_poses_;  // the cast thread's own
+  // The cast thread's own: the scene of the job at hand, the wait for its transforms, its link
+  // poses, and the link look-ups made for the scenes before it.
+  std::shared_ptr<const CastScene> scene_;
+  Wait wait_;
+  std::unique_ptr<LinkPoses> link_poses_;
+  std::uint64_t earlier_lookups_ = 0;
   std::atomic<std::uint64_t> link_lookups_{0};
   ros::WallTime last_link_warning_;
   std::thread thread_;

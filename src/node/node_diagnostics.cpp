@@ -8,17 +8,18 @@ using diagnostic_msgs::DiagnosticStatus;
 
 NodeDiagnostics::NodeDiagnostics(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
                                  const std::vector<std::unique_ptr<Sensor>>& sensors,
-                                 std::size_t link_frames,
+                                 std::function<std::size_t()> link_frames,
                                  std::function<std::uint64_t()> link_lookups)
     : updater_(nh, pnh), windows_(sensors.size()), previous_(sensors.size()) {
   updater_.setHardwareID(ros::this_node::getName());
   // One look-up per link frame and scan time, however many sensors are due then.
-  updater_.add("link poses", [link_frames, link_lookups = std::move(link_lookups)](
-                                 diagnostic_updater::DiagnosticStatusWrapper& stat) {
-    stat.add("Link frames", link_frames);
-    stat.add("Link pose look-ups", link_lookups());
-    stat.summary(DiagnosticStatus::OK, "ok");
-  });
+  updater_.add("link poses",
+               [link_frames = std::move(link_frames), link_lookups = std::move(link_lookups)](
+                   diagnostic_updater::DiagnosticStatusWrapper& stat) {
+                 stat.add("Link frames", link_frames());
+                 stat.add("Link pose look-ups", link_lookups());
+                 stat.summary(DiagnosticStatus::OK, "ok");
+               });
   for (std::size_t i = 0; i < sensors.size(); ++i) {
     const Sensor* sensor = sensors[i].get();
     updater_.add(sensor->name() + " scan rate",

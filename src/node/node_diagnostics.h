@@ -18,10 +18,11 @@ namespace laser_raycast {
 
 class NodeDiagnostics {
  public:
-  // The sensors must outlive this. link_frames: the scene's; link_lookups: the TF look-ups of link
-  // poses so far (CastThread::linkLookups).
+  // The sensors must outlive this. link_frames: the scene's (now: a map topic's grid can add one);
+  // link_lookups: the TF look-ups of link poses so far (CastThread::linkLookups).
   NodeDiagnostics(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
-                  const std::vector<std::unique_ptr<Sensor>>& sensors, std::size_t link_frames,
+                  const std::vector<std::unique_ptr<Sensor>>& sensors,
+                  std::function<std::size_t()> link_frames,
                   std::function<std::uint64_t()> link_lookups);
   // Publishes the status of every sensor now (called every second).
   void publish();

@@ -4,10 +4,12 @@
 #include <cmath>
 
 #include "cast_thread.h"
+#include "map_topics.h"
 #include "node_diagnostics.h"
 #include "scene_source.h"
 #include "sensor.h"
 #include "sensor_reconfigure.h"
+#include "shared_scene.h"
 #include "tf_source.h"
 #include "tf_timing.h"
 
@@ -21,6 +23,7 @@ RaycastNode::~RaycastNode() {
   reconfigure_.clear();
   for (ros::Timer& t : align_timers_) t.stop();
   for (ros::Timer& t : timers_) t.stop();
+  map_topics_.reset();   // joins its builder: no scene is swapped in after this
   cast_thread_.reset();  // joins: nothing casts after this
 }
 
@@ -30,7 +33,10 @@ bool RaycastNode::init() {
     ROS_FATAL_STREAM(error);
     return false;
   }
-  if (!loadScene(nh_, params_, &scene_, &reflectivity_)) return false;
+  auto base = std::make_shared<CastScene>();
+  if (!loadScene(nh_, params_, &base->scene, &base->reflectivity)) return false;
+  scene_ = std::make_unique<SharedScene>();
+  scene_->set(base);
 
   // TF and pose topics keep data as far back as the oldest time a queued scan can still need.
   double longest_scan = 0;
@@ -43,8 +49,7 @@ bool RaycastNode::init() {
                                                 ros::Duration(pose_history), params_.threads));
   }
   CastThread::Context context;
-  context.scene = &scene_;
-  context.reflectivity = &reflectivity_;
+  context.scene = scene_.get();
   context.tf = tf_.get();
   context.sensors = &sensors_;
   context.fixed_frame = params_.fixed_frame;
@@ -52,8 +57,11 @@ bool RaycastNode::init() {
   cast_thread_ = std::make_unique<CastThread>(context);
   updateCapacity();
   diagnostics_ = std::make_unique<NodeDiagnostics>(
-      nh_, pnh_, sensors_, scene_.frames().size(),
+      nh_, pnh_, sensors_, [this] { return scene_->current()->scene.frames().size(); },
       [this] { return cast_thread_ ? cast_thread_->linkLookups() : 0; });
+  const bool map_topics = std::any_of(params_.models.begin(), params_.models.end(),
+                                      [](const ModelSource& m) { return !m.map_topic.empty(); });
+  if (map_topics) map_topics_ = std::make_unique<MapTopics>(nh_, params_, base, scene_.get());
 
   align_timers_.resize(sensors_.size());
   timers_.resize(sensors_.size());
@@ -78,8 +86,9 @@ bool RaycastNode::init() {
         nh_.resolveName(s.topic).c_str());
   }
   report_timer_ = nh_.createTimer(ros::Duration(kReportPeriod), &RaycastNode::onReport, this);
-  ROS_INFO("laser_raycast: started, %zu sensor%s over %zu bodies", sensors_.size(),
-           sensors_.size() == 1 ? "" : "s", scene_.bodies().size());
+  ROS_INFO("laser_raycast: started, %zu sensor%s over %zu bodies%s", sensors_.size(),
+           sensors_.size() == 1 ? "" : "s", base->scene.bodies().size(),
+           map_topics ? " (and the walls of the map topics' grids when they come)" : "");
   return true;
 }
 

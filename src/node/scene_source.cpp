@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include "laser_raycast/loader/map_file.h"
@@ -135,24 +136,35 @@ bool loadScene(const ros::NodeHandle& nh, const NodeParams& params, core::Scene*
 
   // Reflectivity per label (labels are the links, with their TF prefix).
   const auto& labels = scene->labels();
+  const bool map_topics = std::any_of(params.models.begin(), params.models.end(),
+                                      [](const ModelSource& m) { return !m.map_topic.empty(); });
   for (const auto& entry : params.reflectivity) {
-    if (std::find(labels.begin(), labels.end(), entry.first) == labels.end()) {
-      ROS_FATAL_STREAM("~reflectivity names link '"
-                       << entry.first << "', which has no geometry in any model (links with "
-                       << "geometry: " << joinFirst(labels, kLinksInError) << ")");
+    if (std::find(labels.begin(), labels.end(), entry.first) != labels.end()) continue;
+    std::ostringstream message;
+    message << "~reflectivity names link '" << entry.first
+            << "', which has no geometry in any model (links with geometry: "
+            << joinFirst(labels, kLinksInError) << ")";
+    if (!map_topics) {
+      ROS_FATAL_STREAM(message.str());
       return false;
     }
+    ROS_WARN_STREAM(message.str() << ", unless a map topic's grids come in that frame");
   }
-  reflectivity->clear();
-  for (const std::string& label : labels) {
-    const auto it = params.reflectivity.find(label);
-    reflectivity->push_back(it != params.reflectivity.end() ? it->second
-                                                            : params.default_reflectivity);
-  }
-  if (scene->bodies().empty()) {
+  *reflectivity = labelReflectivity(params, *scene);
+  if (scene->bodies().empty() && !map_topics) {
     ROS_WARN("the scene has no geometry: every beam will report +Inf");
   }
   return true;
+}
+
+std::vector<double> labelReflectivity(const NodeParams& params, const core::Scene& scene) {
+  std::vector<double> reflectivity;
+  for (const std::string& label : scene.labels()) {
+    const auto it = params.reflectivity.find(label);
+    reflectivity.push_back(it != params.reflectivity.end() ? it->second
+                                                           : params.default_reflectivity);
+  }
+  return reflectivity;
 }
 
 }  // namespace laser_raycast

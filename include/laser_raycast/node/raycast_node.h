@@ -18,9 +18,11 @@
 namespace laser_raycast {
 
 class CastThread;
+class MapTopics;
 class NodeDiagnostics;
 class Sensor;
 class SensorReconfigure;
+class SharedScene;
 class TfSource;
 
 class RaycastNode {
@@ -33,7 +35,7 @@ class RaycastNode {
   static constexpr double kTfGracePeriod = 5.0;  // s
 
   RaycastNode(ros::NodeHandle nh, ros::NodeHandle pnh);
-  ~RaycastNode();  // stops the timers, then the cast thread
+  ~RaycastNode();  // stops the timers and the map topics, then the cast thread
 
   // Reads and validates the parameters, loads the scene, and starts publishing. Returns false after
   // logging (ROS_FATAL) what is wrong: a bad parameter, a missing URDF, or bad geometry.
@@ -51,8 +53,9 @@ class RaycastNode {
 
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
-  core::Scene scene_;
-  std::vector<double> reflectivity_;  // by label
+  // The scene cast, swapped whole when a map topic's grid changes it (shared_scene.h).
+  std::unique_ptr<SharedScene> scene_;
+  std::unique_ptr<MapTopics> map_topics_;
   std::unique_ptr<TfSource> tf_;
   std::vector<std::unique_ptr<Sensor>> sensors_;
   std::unique_ptr<CastThread> cast_thread_;
