@@ -81,7 +81,8 @@ void readSettings(const YAML::Node& doc, const std::string& yaml_dir,
                   const PackageResolver& resolver, MapFile* map) {
   if (!doc.IsMap()) throw SceneLoadError("not a YAML map of keys");
   for (auto it = doc.begin(); it != doc.end(); ++it) {
-    const std::string key = it->first.as<std::string>();
+    if (!it->first.IsScalar()) throw SceneLoadError("a key that is not a name");
+    const std::string key = it->first.Scalar();
     if (!kKnownKeys.count(key)) {
       map->warnings.push_back("key '" + key + "' is not one map_server reads (ignored)");
     }

@@ -248,6 +248,7 @@ TEST(MapFile, BadInputIsNamed) {
   const std::vector<Case> cases = {
       {"bad_yaml", "image: good.pgm\nresolution: [0.5\n", {"not valid YAML"}},
       {"list", "- image\n- good.pgm\n", {"not a YAML map"}},
+      {"list_key", "? [image, mode]\n: good.pgm\n" + settings, {"not a name"}},
       {"no_image", settings, {"key 'image' is missing"}},
       {"empty_image", "image: ''\n" + settings, {"key 'image' is empty"}},
       {"missing_image", "image: none.pgm\n" + settings, {"none.pgm", "cannot open"}},
