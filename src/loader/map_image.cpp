@@ -52,22 +52,27 @@ class PgmReader {
     }
     image.maxval = static_cast<int>(maxval);
     const std::size_t count = static_cast<std::size_t>(width) * height;
+    const std::size_t bytes = maxval > 255 ? 2 : 1;  // a binary sample's
+    // A header that promises more samples than the file holds is refused before anything is
+    // allocated for them: each takes at least a digit and a separator in ASCII (the last no
+    // separator), one or two bytes in binary after the one white space byte that ends the header.
+    const std::size_t rest = data_.size() - pos_;
+    const std::size_t have = ascii ? rest : rest - std::min<std::size_t>(rest, 1);
+    const std::size_t need = ascii ? 2 * count - 1 : count * bytes;
+    if (have < need) {
+      throw SceneLoadError("PGM data cut short: " + std::to_string(count) + " pixels need " +
+                           (ascii ? "at least " : "") + std::to_string(need) +
+                           " bytes, the file has " + std::to_string(have) + " after its header");
+    }
     image.samples.resize(count);
     if (ascii) {
       for (std::size_t k = 0; k < count; ++k) image.samples[k] = sample(k, maxval);
     } else {
       // Exactly one white space character ends the header.
-      if (pos_ >= data_.size() || !std::isspace(static_cast<unsigned char>(data_[pos_]))) {
+      if (!std::isspace(static_cast<unsigned char>(data_[pos_]))) {
         throw SceneLoadError("PGM header ends without white space before the pixels");
       }
       ++pos_;
-      const std::size_t bytes = maxval > 255 ? 2 : 1;
-      if (data_.size() - pos_ < count * bytes) {
-        throw SceneLoadError("PGM data cut short: " + std::to_string(count) + " pixels of " +
-                             std::to_string(bytes) + " bytes need " +
-                             std::to_string(count * bytes) + " bytes, the file has " +
-                             std::to_string(data_.size() - pos_));
-      }
       const auto* in = reinterpret_cast<const unsigned char*>(data_.data() + pos_);
       for (std::size_t k = 0; k < count; ++k) {
         const unsigned v = bytes == 2 ? (in[2 * k] << 8) | in[2 * k + 1] : in[k];
@@ -154,11 +159,27 @@ void pngError(png_structp png, png_const_charp message) {
 
 void pngWarning(png_structp, png_const_charp) {}  // libpng's warnings are not errors
 
+// Deflate compresses at most 1032 to 1: a PNG's rows, filter bytes included, are never more than
+// this many times its file (plus a little for the smallest files).
+constexpr double kMaxInflation = 1032;
+
 // Fills image (its samples sized here) and returns true, or returns false with state->message.
-bool pngRead(PngState* state, Image* image, std::vector<png_bytep>* rows) {
+// file_bytes: the file's size.
+bool pngRead(PngState* state, double file_bytes, Image* image, std::vector<png_bytep>* rows) {
   if (setjmp(png_jmpbuf(state->png))) return false;
   png_init_io(state->png, state->file);
   png_read_info(state->png, state->info);
+  // A header that promises more pixels than the file can hold is refused before anything is
+  // allocated for them.
+  const double stored = double(png_get_image_height(state->png, state->info)) *
+                        (double(png_get_rowbytes(state->png, state->info)) + 1);
+  if (stored > kMaxInflation * file_bytes + 4096) {
+    std::snprintf(state->message, sizeof state->message,
+                  "%u x %u pixels cannot be held in a file of %.0f bytes",
+                  png_get_image_width(state->png, state->info),
+                  png_get_image_height(state->png, state->info), file_bytes);
+    return false;
+  }
   // Palettes to RGB, grey of 1, 2 or 4 bits to 8, a transparent colour to an alpha channel; 16-bit
   // samples stay 16-bit. No gamma correction: the samples are taken as stored, as map_server does.
   png_set_expand(state->png);
@@ -211,7 +232,7 @@ bool pngRead(PngState* state, Image* image, std::vector<png_bytep>* rows) {
   return true;
 }
 
-Image readPng(const std::string& path) {
+Image readPng(const std::string& path, double file_bytes) {
   PngState state;
   state.file = std::fopen(path.c_str(), "rb");
   if (!state.file) throw SceneLoadError("cannot open the image for reading");
@@ -219,7 +240,7 @@ Image readPng(const std::string& path) {
   if (state.png) state.info = png_create_info_struct(state.png);
   Image image;
   std::vector<png_bytep> rows;
-  const bool ok = state.png && state.info && pngRead(&state, &image, &rows);
+  const bool ok = state.png && state.info && pngRead(&state, file_bytes, &image, &rows);
   png_destroy_read_struct(state.png ? &state.png : nullptr, state.info ? &state.info : nullptr,
                           nullptr);
   std::fclose(state.file);
@@ -236,7 +257,8 @@ Image read(const std::string& path) {
   in.read(magic, sizeof magic);
   if (in.gcount() == sizeof magic &&
       png_sig_cmp(reinterpret_cast<png_const_bytep>(magic), 0, 8) == 0) {
-    return readPng(path);
+    in.seekg(0, std::ios::end);
+    return readPng(path, static_cast<double>(in.tellg()));
   }
   if (in.gcount() >= 2 && magic[0] == 'P' && (magic[1] == '5' || magic[1] == '2')) {
     in.seekg(0);

@@ -4,6 +4,7 @@
 // worked out by hand from map_server's rules (docs/maps.md).
 #include <gtest/gtest.h>
 #include <png.h>
+#include <zlib.h>
 
 #include <cmath>
 #include <cstdio>
@@ -304,6 +305,8 @@ TEST(MapFile, BadImagesAreNamed) {
       {"text.pgm", "hello world", {"neither PGM", "PNG"}},
       {"p6.pgm", "P6 1 1 255\n\xff\xff\xff", {"neither PGM"}},
       {"cut.pgm", "P5 3 2 255\n\x01\x02", {"cut short", "6 pixels", "the file has 2"}},
+      {"promise.pgm", "P5 40000 40000 255\n\x01", {"cut short", "1600000000 pixels"}},
+      {"promise2.pgm", "P2 40000 40000 255\n1 2", {"cut short", "at least 3199999999 bytes"}},
       {"cut16.pgm", std::string("P5 1 1 65535\n\x01", 14), {"cut short", "2 bytes"}},
       {"no_height.pgm", "P5 3\n", {"height", "expected a number"}},
       {"word.pgm", "P2 3 two 255\n", {"height", "'two'"}},
@@ -321,6 +324,36 @@ TEST(MapFile, BadImagesAreNamed) {
     words.push_back(writeYaml(c.name + ".yaml", c.name));
     refusal(words.back(), words);
   }
+}
+
+// A PNG chunk: length, type, data, CRC (zlib's crc32, over type and data).
+std::string pngChunk(const std::string& type, const std::string& data) {
+  std::string out;
+  const auto u32 = [&out](std::uint32_t v) {
+    for (int shift = 24; shift >= 0; shift -= 8) out += static_cast<char>(v >> shift & 0xff);
+  };
+  u32(static_cast<std::uint32_t>(data.size()));
+  out += type + data;
+  const std::string body = type + data;
+  u32(static_cast<std::uint32_t>(
+      crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size()))));
+  return out;
+}
+
+// A PNG whose header promises 40000 x 40000 grey pixels, with one row of them: refused for its
+// file's size before its pixels are allocated (3.2 GB as samples; a 16-bit RGBA header would ask
+// for 12.8).
+TEST(MapFile, PngHeadersPromisingMoreThanTheFileHoldsAreRefused) {
+  const std::string ihdr("\x00\x00\x9c\x40\x00\x00\x9c\x40\x08\x00\x00\x00\x00", 13);
+  const std::string row = std::string(1, '\0') + std::string(40000, '\xff');
+  std::string idat(compressBound(row.size()), '\0');
+  uLongf size = idat.size();
+  compress(reinterpret_cast<Bytef*>(idat.data()), &size, reinterpret_cast<const Bytef*>(row.data()),
+           row.size());
+  idat.resize(size);
+  writeFile("promise.png", "\x89PNG\r\n\x1a\n" + pngChunk("IHDR", ihdr) + pngChunk("IDAT", idat));
+  refusal(writeYaml("promise_png.yaml", "promise.png"),
+          {"promise.png", "40000 x 40000 pixels cannot be held in a file of"});
 }
 
 TEST(MapFile, MissingFilesAreNamed) {
