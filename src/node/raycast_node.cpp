@@ -1,7 +1,6 @@
 #include "laser_raycast/node/raycast_node.h"
 
 #include <algorithm>
-#include <cmath>
 
 #include "cast_thread.h"
 #include "node_diagnostics.h"
@@ -36,7 +35,7 @@ bool RaycastNode::init() {
   double longest_scan = 0;
   for (const SensorParams& s : params_.sensors) longest_scan = std::max(longest_scan, 1.0 / s.rate);
   const double history = params_.tf_timeout + longest_scan + 1.0;
-  tf_ = std::make_unique<TfSource>(nh_, ros::Duration(std::max(10.0, history)));
+  tf_ = std::make_unique<TfListener>(nh_, ros::Duration(std::max(10.0, history)));
   for (const SensorParams& s : params_.sensors) {
     const double pose_history = history + std::min(s.pose_timeout, NodeParams::kMaxTfTimeout);
     sensors_.push_back(std::make_unique<Sensor>(nh_, s, params_.fixed_frame, kTfGracePeriod,
@@ -45,7 +44,7 @@ bool RaycastNode::init() {
   CastThread::Context context;
   context.scene = &scene_;
   context.reflectivity = &reflectivity_;
-  context.tf = tf_.get();
+  context.tf = &tf_->source();
   context.sensors = &sensors_;
   context.fixed_frame = params_.fixed_frame;
   context.tf_timeout = ros::Duration(params_.tf_timeout);
@@ -84,12 +83,7 @@ bool RaycastNode::init() {
 }
 
 void RaycastNode::updateCapacity() {
-  std::size_t capacity = 0;
-  for (const auto& sensor : sensors_) {
-    const double rate = sensor->live().rate;
-    capacity += static_cast<std::size_t>(std::ceil(rate * params_.tf_timeout)) + 2;
-  }
-  cast_thread_->setCapacity(capacity);
+  cast_thread_->setCapacity(castQueueCapacity(sensors_, params_.tf_timeout));
 }
 
 void RaycastNode::startTimer(int i) {

@@ -21,7 +21,7 @@ class CastThread;
 class NodeDiagnostics;
 class Sensor;
 class SensorReconfigure;
-class TfSource;
+class TfListener;
 
 class RaycastNode {
  public:
@@ -53,7 +53,7 @@ class RaycastNode {
   NodeParams params_;
   core::Scene scene_;
   std::vector<double> reflectivity_;  // by label
-  std::unique_ptr<TfSource> tf_;
+  std::unique_ptr<TfListener> tf_;
   std::vector<std::unique_ptr<Sensor>> sensors_;
   std::unique_ptr<CastThread> cast_thread_;
   std::unique_ptr<NodeDiagnostics> diagnostics_;
