@@ -4,6 +4,7 @@
 
 #include "cast_thread.h"
 #include "node_diagnostics.h"
+#include "pose_topic.h"
 #include "scene_source.h"
 #include "sensor.h"
 #include "sensor_reconfigure.h"
@@ -29,7 +30,15 @@ bool RaycastNode::init() {
     ROS_FATAL_STREAM(error);
     return false;
   }
-  if (!loadScene(nh_, params_, &scene_, &reflectivity_)) return false;
+  const auto urdf_param = [this](const std::string& name, std::string* xml, std::string* resolved) {
+    *resolved = nh_.resolveName(name);
+    return nh_.getParam(name, *xml);
+  };
+  error = loadScene(params_, urdf_param, &scene_, &reflectivity_);
+  if (!error.empty()) {
+    ROS_FATAL_STREAM(error);
+    return false;
+  }
 
   // TF and pose topics keep data as far back as the oldest time a queued scan can still need.
   double longest_scan = 0;
@@ -37,9 +46,17 @@ bool RaycastNode::init() {
   const double history = params_.tf_timeout + longest_scan + 1.0;
   tf_ = std::make_unique<TfListener>(nh_, ros::Duration(std::max(10.0, history)));
   for (const SensorParams& s : params_.sensors) {
-    const double pose_history = history + std::min(s.pose_timeout, NodeParams::kMaxTfTimeout);
-    sensors_.push_back(std::make_unique<Sensor>(nh_, s, params_.fixed_frame, kTfGracePeriod,
-                                                ros::Duration(pose_history), params_.threads));
+    std::unique_ptr<PoseTopic> poses;
+    if (!s.pose_topic.empty()) {
+      const double pose_history = history + std::min(s.pose_timeout, NodeParams::kMaxTfTimeout);
+      poses =
+          std::make_unique<PoseTopic>(nh_.resolveName(s.pose_topic), params_.fixed_frame,
+                                      ros::Duration(s.pose_timeout), ros::Duration(pose_history));
+      pose_subscribers_.push_back(std::make_unique<PoseSubscriber>(nh_, s.pose_topic, poses.get()));
+    }
+    sensors_.push_back(
+        std::make_unique<Sensor>(s, params_.fixed_frame, kTfGracePeriod, params_.threads,
+                                 std::make_unique<TopicOutput>(nh_, s), std::move(poses)));
   }
   CastThread::Context context;
   context.scene = &scene_;

@@ -19,6 +19,7 @@ namespace laser_raycast {
 
 class CastThread;
 class NodeDiagnostics;
+class PoseSubscriber;
 class Sensor;
 class SensorReconfigure;
 class TfListener;
@@ -55,6 +56,8 @@ class RaycastNode {
   std::vector<double> reflectivity_;  // by label
   std::unique_ptr<TfListener> tf_;
   std::vector<std::unique_ptr<Sensor>> sensors_;
+  // After the sensors: destroyed first, as they add to the sensors' pose topics.
+  std::vector<std::unique_ptr<PoseSubscriber>> pose_subscribers_;
   std::unique_ptr<CastThread> cast_thread_;
   std::unique_ptr<NodeDiagnostics> diagnostics_;
   std::vector<std::unique_ptr<SensorReconfigure>> reconfigure_;
