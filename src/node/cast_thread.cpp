@@ -62,9 +62,7 @@ void CastThread::run() {
     caster_.cast(job);
     link_lookups_ = caster_.linkLookups();
     lock.lock();
-    // Times before the oldest stamp still queued (or this job's) are needed by no scan any more.
-    const std::optional<ros::Time> oldest = queue_.oldestStamp();
-    caster_.forgetBefore(oldest && *oldest < job.stamp() ? *oldest : job.stamp());
+    caster_.done(job, queue_.oldestStamp());
   }
 }
 

@@ -44,6 +44,12 @@ void JobCaster::cast(const ScanJob& job) {
   for (const int s : job.sensors) castSensor(*(*context_.sensors)[s], job);
 }
 
+void JobCaster::done(const ScanJob& job, const std::optional<ros::Time>& oldest_queued) {
+  // Times before the oldest stamp still queued (or this job's) are needed by no scan any more.
+  link_poses_.forgetBefore(oldest_queued && *oldest_queued < job.stamp() ? *oldest_queued
+                                                                         : job.stamp());
+}
+
 bool JobCaster::sensorPoses(Sensor& sensor, const ScanJob& job, bool quiet,
                             std::vector<Eigen::Isometry3d>* poses) {
   poses->resize(job.times.size());

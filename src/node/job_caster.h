@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -41,8 +42,9 @@ class JobCaster {
   bool ready(const ScanJob& job, const ros::Time& now);
   // Casts the job's sensors (each one skipped, and counted by its monitor, without a pose).
   void cast(const ScanJob& job);
-  // No job still to be cast needs a time before t.
-  void forgetBefore(const ros::Time& t) { link_poses_.forgetBefore(t); }
+  // After `job` was cast: forgets the link poses that no job still queued needs (oldest_queued: the
+  // earliest stamp in the queue, if any).
+  void done(const ScanJob& job, const std::optional<ros::Time>& oldest_queued);
   // TF look-ups of link poses so far (LinkPoses::lookups).
   std::uint64_t linkLookups() const { return link_poses_.lookups(); }
 

@@ -1,7 +1,5 @@
 #include "laser_raycast/node/raycast_node.h"
 
-#include <algorithm>
-
 #include "cast_thread.h"
 #include "node_diagnostics.h"
 #include "pose_topic.h"
@@ -40,18 +38,13 @@ bool RaycastNode::init() {
     return false;
   }
 
-  // TF and pose topics keep data as far back as the oldest time a queued scan can still need.
-  double longest_scan = 0;
-  for (const SensorParams& s : params_.sensors) longest_scan = std::max(longest_scan, 1.0 / s.rate);
-  const double history = params_.tf_timeout + longest_scan + 1.0;
-  tf_ = std::make_unique<TfListener>(nh_, ros::Duration(std::max(10.0, history)));
+  tf_ = std::make_unique<TfListener>(nh_, ros::Duration(params_.tfCache()));
   for (const SensorParams& s : params_.sensors) {
     std::unique_ptr<PoseTopic> poses;
     if (!s.pose_topic.empty()) {
-      const double pose_history = history + std::min(s.pose_timeout, NodeParams::kMaxTfTimeout);
-      poses =
-          std::make_unique<PoseTopic>(nh_.resolveName(s.pose_topic), params_.fixed_frame,
-                                      ros::Duration(s.pose_timeout), ros::Duration(pose_history));
+      poses = std::make_unique<PoseTopic>(nh_.resolveName(s.pose_topic), params_.fixed_frame,
+                                          ros::Duration(s.pose_timeout),
+                                          ros::Duration(params_.poseHistory(s)));
       pose_subscribers_.push_back(std::make_unique<PoseSubscriber>(nh_, s.pose_topic, poses.get()));
     }
     sensors_.push_back(
