@@ -12,6 +12,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include <Eigen/Geometry>
+#include <boost/make_shared.hpp>
 #include <cmath>
 #include <map>
 #include <string>
@@ -87,6 +88,19 @@ inline tf2_msgs::TFMessage driveTf(const Drive& drive, const ros::Time& t) {
   tf2_msgs::TFMessage m;
   m.transforms.push_back(toMsg(drive.base(t), t, "world", "base_link"));
   return m;
+}
+
+// The connection header of a latched publisher of M, as rosbag record keeps /tf_static's (a header
+// given to Bag::write is written as it is, so it names the type itself).
+template <class M>
+boost::shared_ptr<ros::M_string> latchedHeader() {
+  auto header = boost::make_shared<ros::M_string>();
+  (*header)["type"] = ros::message_traits::datatype<M>();
+  (*header)["md5sum"] = ros::message_traits::md5sum<M>();
+  (*header)["message_definition"] = ros::message_traits::definition<M>();
+  (*header)["callerid"] = "/static_publisher";
+  (*header)["latching"] = "1";
+  return header;
 }
 
 // The messages of type M on topic in a bag, by header stamp.

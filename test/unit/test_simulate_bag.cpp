@@ -53,21 +53,12 @@ std::string writeDriveBag(const std::string& name, const BagSpec& spec) {
   rosbag::Bag bag(path, rosbag::bagmode::Write);
   Drive drive{kStart};
   if (spec.tf) {
-    // As rosbag record keeps /tf_static: the publisher's connection header, latched (a header
-    // given to write() is written as it is, so it names the type itself).
-    using Statics = tf2_msgs::TFMessage;
-    auto latched = boost::make_shared<ros::M_string>();
-    (*latched)["type"] = ros::message_traits::datatype<Statics>();
-    (*latched)["md5sum"] = ros::message_traits::md5sum<Statics>();
-    (*latched)["message_definition"] = ros::message_traits::definition<Statics>();
-    (*latched)["callerid"] = "/static_publisher";
-    (*latched)["latching"] = "1";
     const ros::Time at = kStart + ros::Duration(spec.static_delay);
-    Statics statics = staticTf(at);
+    tf2_msgs::TFMessage statics = staticTf(at);
     if (!spec.with_bumper) {
       statics.transforms.erase(statics.transforms.begin() + 1);  // mounts(): laser, bumper, lidar
     }
-    bag.write("/tf_static", at, statics, latched);
+    bag.write("/tf_static", at, statics, latchedHeader<tf2_msgs::TFMessage>());
     for (int i = 0; i <= static_cast<int>(std::lround(spec.seconds * 100)); ++i) {
       const ros::Time t = kStart + ros::Duration(0.01 * i);
       bag.write("/tf", t + ros::Duration(spec.tf_delay), driveTf(drive, t));
