@@ -18,7 +18,7 @@ APT_PACKAGES=(
   libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libstd-msgs-dev ros-std-msgs
   ros-message-generation ros-message-runtime libnodeletlib-dev libnodeletlib-tools libtopic-tools-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure libdiagnostic-updater-dev
-  libdiagnostic-msgs-dev libyaml-cpp-dev
+  libdiagnostic-msgs-dev librosbag-storage-dev libtf2-msgs-dev libyaml-cpp-dev python3-rosbag
   librostest-dev libgtest-dev python3-rostest python3-roslaunch python3-rosmaster python3-rostopic
   python3-rospy python3-tf2-ros python3-sensor-msgs python3-geometry-msgs python3-std-msgs
   rosbash ros-robot-state-publisher

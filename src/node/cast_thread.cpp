@@ -1,9 +1,9 @@
 #include "cast_thread.h"
 
-#include <algorithm>
 #include <chrono>
-
-#include "param_reader.h"
+#include <cmath>
+#include <optional>
+#include <string>
 
 namespace laser_raycast {
 
@@ -14,16 +14,17 @@ CastThread::CastThread(Context context) : context_(std::move(context)) {
 
 void CastThread::takeScene() {
   std::shared_ptr<const CastScene> scene = context_.scene->current();
-  if (scene == scene_ && link_poses_) return;
-  if (link_poses_) earlier_lookups_ += link_poses_->lookups();
-  // The poses looked up so far are of the old scene's frames; the new one's are looked up anew.
-  link_poses_ = std::make_unique<LinkPoses>(
-      scene->scene, [this](const std::string& frame, const ros::Time& t, Eigen::Isometry3d* pose,
-                           std::string* error) {
-        return context_.tf->lookup(context_.fixed_frame, frame, t, pose, error);
-      });
+  if (scene == scene_ && caster_) return;
+  if (caster_) earlier_lookups_ += caster_->linkLookups();
+  JobCaster::Context context;
+  context.scene = &scene->scene;
+  context.reflectivity = &scene->reflectivity;
+  context.tf = context_.tf;
+  context.sensors = context_.sensors;
+  context.fixed_frame = context_.fixed_frame;
+  context.tf_timeout = context_.tf_timeout;
+  caster_ = std::make_unique<JobCaster>(std::move(context));
   scene_ = std::move(scene);
-  wait_.chains.clear();
 }
 
 CastThread::~CastThread() {
@@ -49,13 +50,7 @@ void CastThread::schedule(int sensor, const std::vector<ros::Time>& times) {
     queued = queue_.size();
   }
   wake_.notify_all();
-  if (!dropped) return;
-  for (const int s : dropped->sensors) {
-    (*context_.sensors)[s]->monitor().skipped(
-        SensorMonitor::Skip::kBehind, dropped->stamp(),
-        "the cast thread is " + std::to_string(queued) +
-            " scans behind (casting takes longer than the scan period)");
-  }
+  if (dropped) reportDropped(*dropped, queued, *context_.sensors);
 }
 
 void CastThread::run() {
@@ -69,7 +64,9 @@ void CastThread::run() {
     const ScanJob front = queue_.front();
     lock.unlock();
     takeScene();
-    const bool go = ready(front);
+    const ros::Time now = ros::Time::now();
+    // Zero: simulated time has not started.
+    const bool go = !now.isZero() && caster_->ready(front, now);
     lock.lock();
     if (!go) {
       wake_.wait_for(lock, poll, [this] { return stop_; });
@@ -79,104 +76,30 @@ void CastThread::run() {
     if (queue_.empty() || queue_.front().times != front.times) continue;
     const ScanJob job = queue_.pop();
     lock.unlock();
-    process(job);
+    caster_->cast(job);
+    link_lookups_ = earlier_lookups_ + caster_->linkLookups();
     lock.lock();
-    // Times before the oldest stamp still queued (or this job's) are needed by no scan any more.
-    const std::optional<ros::Time> oldest = queue_.oldestStamp();
-    link_poses_->forgetBefore(oldest && *oldest < job.stamp() ? *oldest : job.stamp());
+    caster_->done(job, queue_.oldestStamp());
   }
 }
 
-bool CastThread::ready(const ScanJob& job) {
-  const ros::Time now = ros::Time::now();
-  if (now.isZero()) return false;  // simulated time has not started
-  if (wait_.last != job.last() || wait_.chains.empty()) {
-    wait_.last = job.last();
-    wait_.chains.clear();
-    for (const std::string& frame : scene_->scene.frames()) {
-      wait_.chains.emplace_back(context_.fixed_frame, frame);
-    }
-    wait_.state.assign(wait_.chains.size(), FrameAvailability::kWaiting);
+std::size_t castQueueCapacity(const std::vector<std::unique_ptr<Sensor>>& sensors,
+                              double tf_timeout) {
+  std::size_t capacity = 0;
+  for (const auto& sensor : sensors) {
+    const double rate = sensor->live().rate;
+    capacity += static_cast<std::size_t>(std::ceil(rate * tf_timeout)) + 2;
   }
-  // The sensors' chains, for sensors that joined the job since.
-  for (const int s : job.sensors) {
-    const auto chain = (*context_.sensors)[s]->tfChain();
-    if (std::find(wait_.chains.begin(), wait_.chains.end(), chain) == wait_.chains.end()) {
-      wait_.chains.push_back(chain);
-      wait_.state.push_back(FrameAvailability::kWaiting);
-    }
-  }
-  for (std::size_t i = 0; i < wait_.chains.size(); ++i) {
-    if (wait_.state[i] != FrameAvailability::kWaiting) continue;
-    const auto& [target, source] = wait_.chains[i];
-    wait_.state[i] =
-        context_.tf->availability(target, source, job.last(), now, context_.tf_timeout);
-    if (wait_.state[i] == FrameAvailability::kWaiting) return false;
-  }
-  return true;
+  return capacity;
 }
 
-void CastThread::process(const ScanJob& job) {
-  for (const int s : job.sensors) castSensor(*(*context_.sensors)[s], job);
-}
-
-bool CastThread::sensorPoses(Sensor& sensor, const ScanJob& job, bool quiet,
-                             std::vector<Eigen::Isometry3d>* poses) {
-  poses->resize(job.times.size());
-  for (std::size_t j = 0; j < job.times.size(); ++j) {
-    std::string why;
-    bool from_tf;
-    std::uint64_t failures = 0;
-    const bool ok =
-        sensor.poseAt(job.times[j], *context_.tf, &(*poses)[j], &why, &from_tf, &failures);
-    sensor.monitor().lookupFailures(failures);
-    if (!ok) {
-      using Skip = SensorMonitor::Skip;
-      sensor.monitor().skipped(quiet     ? Skip::kWaiting
-                               : from_tf ? Skip::kNoTransform
-                                         : Skip::kStalePose,
-                               job.stamp(), why);
-      return false;
-    }
+void reportDropped(const ScanJob& dropped, std::size_t queued,
+                   const std::vector<std::unique_ptr<Sensor>>& sensors) {
+  for (const int s : dropped.sensors) {
+    sensors[s]->monitor().skipped(SensorMonitor::Skip::kBehind, dropped.stamp(),
+                                  "the cast thread is " + std::to_string(queued) +
+                                      " scans behind (casting takes longer than the scan period)");
   }
-  return true;
-}
-
-bool CastThread::acceptMissing(Sensor& sensor, const ScanJob& job, bool quiet,
-                               const LinkPosesAt& links) {
-  if (links.missing.empty()) return true;
-  if (quiet) {
-    sensor.monitor().skipped(SensorMonitor::Skip::kWaiting, job.stamp(),
-                             std::to_string(links.missing.size()) +
-                                 " link frames have no transform yet (" +
-                                 joinFirst(links.missing, kLinksInWarning) + ")");
-    return false;
-  }
-  const ros::WallTime now = ros::WallTime::now();
-  if (last_link_warning_.isZero() || (now - last_link_warning_).toSec() >= kWarnPeriod) {
-    last_link_warning_ = now;
-    ROS_WARN(
-        "%zu of %zu link frames have no transform to '%s' at t = %.3f; their geometry is "
-        "left out of this scan (a transform older than ~tf_timeout %.3f s is not waited "
-        "for): %s (%s)",
-        links.missing.size(), scene_->scene.frames().size(), context_.fixed_frame.c_str(),
-        job.last().toSec(), context_.tf_timeout.toSec(),
-        joinFirst(links.missing, kLinksInWarning).c_str(), links.first_error.c_str());
-  }
-  return true;
-}
-
-void CastThread::castSensor(Sensor& sensor, const ScanJob& job) {
-  const bool quiet = sensor.monitor().quiet(job.stamp());
-  std::vector<Eigen::Isometry3d> poses;
-  if (!sensorPoses(sensor, job, quiet, &poses)) return;
-  // Looked up once per time for every sensor whose scan needs it.
-  const LinkPosesAt links = link_poses_->at(job.times);
-  link_lookups_ = earlier_lookups_ + link_poses_->lookups();
-  sensor.monitor().lookupFailures(links.failures);
-  if (!acceptMissing(sensor, job, quiet, links)) return;
-  sensor.castAndPublish(scene_->scene, scene_->reflectivity, job.times, links.frames, poses,
-                        links.missing.size());
 }
 
 }  // namespace laser_raycast

@@ -366,6 +366,18 @@ void readAll(ParamReader* r, const std::string& ns, NodeParams* p,
 
 }  // namespace
 
+double NodeParams::history() const {
+  double longest_scan = 0;
+  for (const SensorParams& s : sensors) longest_scan = std::max(longest_scan, 1.0 / s.rate);
+  return tf_timeout + longest_scan + 1.0;
+}
+
+double NodeParams::tfCache() const { return std::max(10.0, history()); }
+
+double NodeParams::poseHistory(const SensorParams& sensor) const {
+  return history() + std::min(sensor.pose_timeout, kMaxTfTimeout);
+}
+
 std::string ModelSource::describe() const {
   if (!map.empty()) return "map " + map;
   if (!map_topic.empty()) return "map topic " + map_topic;

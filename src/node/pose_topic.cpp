@@ -1,8 +1,5 @@
 #include "pose_topic.h"
 
-#include <geometry_msgs/PoseStamped.h>
-#include <geometry_msgs/PoseWithCovarianceStamped.h>
-
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -37,42 +34,31 @@ std::string seconds(double s) {
 
 }  // namespace
 
-PoseTopic::PoseTopic(ros::NodeHandle& nh, const std::string& topic, std::string fixed_frame,
-                     ros::Duration timeout, ros::Duration keep)
-    : fixed_frame_(std::move(fixed_frame)), timeout_(timeout), history_(keep, kMaxEntries) {
-  sub_ = nh.subscribe(topic, kQueue, &PoseTopic::onPose, this);
-}
+PoseTopic::PoseTopic(std::string topic, std::string fixed_frame, ros::Duration timeout,
+                     ros::Duration keep)
+    : topic_(std::move(topic)),
+      fixed_frame_(std::move(fixed_frame)),
+      timeout_(timeout),
+      history_(keep, kMaxEntries) {}
 
-void PoseTopic::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
-  const std::string& type = msg->getDataType();
-  std_msgs::Header header;
-  geometry_msgs::Pose pose_msg;
-  if (type == "geometry_msgs/PoseStamped") {
-    const auto m = msg->instantiate<geometry_msgs::PoseStamped>();
-    header = m->header;
-    pose_msg = m->pose;
-  } else if (type == "geometry_msgs/PoseWithCovarianceStamped") {
-    const auto m = msg->instantiate<geometry_msgs::PoseWithCovarianceStamped>();
-    header = m->header;
-    pose_msg = m->pose.pose;
-  } else {
-    const ros::WallTime now = ros::WallTime::now();
-    if (last_type_error_.isZero() || (now - last_type_error_).toSec() >= kErrorPeriod) {
-      last_type_error_ = now;
-      ROS_ERROR(
-          "~pose_topic %s carries %s; expected geometry_msgs/PoseStamped or "
-          "geometry_msgs/PoseWithCovarianceStamped (message ignored)",
-          sub_.getTopic().c_str(), type.c_str());
-    }
-    return;
-  }
-  PoseHistory::Entry entry;
-  // A publisher that leaves the stamp unset means "now".
-  entry.stamp = header.stamp.isZero() ? ros::Time::now() : header.stamp;
-  entry.frame = header.frame_id.empty() ? fixed_frame_ : header.frame_id;
-  entry.valid = poseFromMsg(pose_msg, &entry.pose);
+void PoseTopic::add(const PoseHistory::Entry& entry) {
   std::lock_guard<std::mutex> lock(mutex_);
   history_.add(entry);
+}
+
+PoseHistory::Entry poseEntry(const std_msgs::Header& header, const geometry_msgs::Pose& pose,
+                             const std::string& fixed_frame, const ros::Time& received) {
+  PoseHistory::Entry entry;
+  entry.stamp = header.stamp.isZero() ? received : header.stamp;
+  entry.frame = header.frame_id.empty() ? fixed_frame : header.frame_id;
+  entry.valid = poseFromMsg(pose, &entry.pose);
+  return entry;
+}
+
+std::string wrongPoseType(const std::string& topic, const std::string& type) {
+  return "~pose_topic " + topic + " carries " + type + "; expected " +
+         ros::message_traits::datatype<geometry_msgs::PoseStamped>() + " or " +
+         ros::message_traits::datatype<geometry_msgs::PoseWithCovarianceStamped>();
 }
 
 bool PoseTopic::inFixedFrame(const PoseHistory::Entry& e, const TfSource& tf,
@@ -82,8 +68,8 @@ bool PoseTopic::inFixedFrame(const PoseHistory::Entry& e, const TfSource& tf,
   std::string error;
   if (!tf.lookup(fixed_frame_, e.frame, e.stamp, &fixed_from_frame, &error)) {
     ++*tf_failures;
-    *why = "the pose on " + sub_.getTopic() + " is in '" + e.frame +
-           "', which has no transform to '" + fixed_frame_ + "' at its stamp (" + error + ")";
+    *why = "the pose on " + topic_ + " is in '" + e.frame + "', which has no transform to '" +
+           fixed_frame_ + "' at its stamp (" + error + ")";
     return false;
   }
   *pose = fixed_from_frame * e.pose;
@@ -99,14 +85,14 @@ bool PoseTopic::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d
   }
   switch (q.status) {
     case PoseHistory::Status::kNone:
-      *why = "no pose received yet on " + sub_.getTopic();
+      *why = "no pose received yet on " + topic_;
       return false;
     case PoseHistory::Status::kInvalid:
-      *why = "the pose on " + sub_.getTopic() + " at t = " + seconds(q.a.stamp.toSec()) +
+      *why = "the pose on " + topic_ + " at t = " + seconds(q.a.stamp.toSec()) +
              " is not finite or its quaternion is not unit length";
       return false;
     case PoseHistory::Status::kStale:
-      *why = "the pose on " + sub_.getTopic() + " is " + seconds(q.age) +
+      *why = "the pose on " + topic_ + " is " + seconds(q.age) +
              " s old at the scan's time t = " + seconds(t.toSec()) + " (~pose_timeout " +
              seconds(timeout_.toSec()) + " s)";
       return false;
@@ -120,6 +106,25 @@ bool PoseTopic::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d
   }
   *pose = core::interpolatePose(a, b, q.s);
   return true;
+}
+
+PoseSubscriber::PoseSubscriber(ros::NodeHandle& nh, const std::string& topic, PoseTopic* poses)
+    : poses_(poses) {
+  sub_ = nh.subscribe(topic, kQueue, &PoseSubscriber::onPose, this);
+}
+
+void PoseSubscriber::onPose(const topic_tools::ShapeShifter::ConstPtr& msg) {
+  const std::optional<PoseHistory::Entry> entry =
+      poseEntry(*msg, poses_->fixedFrame(), ros::Time::now());
+  if (entry) {
+    poses_->add(*entry);
+    return;
+  }
+  const ros::WallTime now = ros::WallTime::now();
+  if (last_type_error_.isZero() || (now - last_type_error_).toSec() >= kErrorPeriod) {
+    last_type_error_ = now;
+    ROS_ERROR_STREAM(wrongPoseType(sub_.getTopic(), msg->getDataType()) << " (message ignored)");
+  }
 }
 
 }  // namespace laser_raycast

@@ -1,11 +1,9 @@
 #include "laser_raycast/node/raycast_node.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include "cast_thread.h"
 #include "map_topics.h"
 #include "node_diagnostics.h"
+#include "pose_topic.h"
 #include "scene_source.h"
 #include "sensor.h"
 #include "sensor_reconfigure.h"
@@ -34,23 +32,34 @@ bool RaycastNode::init() {
     return false;
   }
   auto base = std::make_shared<CastScene>();
-  if (!loadScene(nh_, params_, &base->scene, &base->reflectivity)) return false;
+  const auto urdf_param = [this](const std::string& name, std::string* xml, std::string* resolved) {
+    *resolved = nh_.resolveName(name);
+    return nh_.getParam(name, *xml);
+  };
+  error = loadScene(params_, urdf_param, &base->scene, &base->reflectivity);
+  if (!error.empty()) {
+    ROS_FATAL_STREAM(error);
+    return false;
+  }
   scene_ = std::make_unique<SharedScene>();
   scene_->set(base);
 
-  // TF and pose topics keep data as far back as the oldest time a queued scan can still need.
-  double longest_scan = 0;
-  for (const SensorParams& s : params_.sensors) longest_scan = std::max(longest_scan, 1.0 / s.rate);
-  const double history = params_.tf_timeout + longest_scan + 1.0;
-  tf_ = std::make_unique<TfSource>(nh_, ros::Duration(std::max(10.0, history)));
+  tf_ = std::make_unique<TfListener>(nh_, ros::Duration(params_.tfCache()));
   for (const SensorParams& s : params_.sensors) {
-    const double pose_history = history + std::min(s.pose_timeout, NodeParams::kMaxTfTimeout);
-    sensors_.push_back(std::make_unique<Sensor>(nh_, s, params_.fixed_frame, kTfGracePeriod,
-                                                ros::Duration(pose_history), params_.threads));
+    std::unique_ptr<PoseTopic> poses;
+    if (!s.pose_topic.empty()) {
+      poses = std::make_unique<PoseTopic>(nh_.resolveName(s.pose_topic), params_.fixed_frame,
+                                          ros::Duration(s.pose_timeout),
+                                          ros::Duration(params_.poseHistory(s)));
+      pose_subscribers_.push_back(std::make_unique<PoseSubscriber>(nh_, s.pose_topic, poses.get()));
+    }
+    sensors_.push_back(
+        std::make_unique<Sensor>(s, params_.fixed_frame, kTfGracePeriod, params_.threads,
+                                 std::make_unique<TopicOutput>(nh_, s), std::move(poses)));
   }
   CastThread::Context context;
   context.scene = scene_.get();
-  context.tf = tf_.get();
+  context.tf = &tf_->source();
   context.sensors = &sensors_;
   context.fixed_frame = params_.fixed_frame;
   context.tf_timeout = ros::Duration(params_.tf_timeout);
@@ -93,12 +102,7 @@ bool RaycastNode::init() {
 }
 
 void RaycastNode::updateCapacity() {
-  std::size_t capacity = 0;
-  for (const auto& sensor : sensors_) {
-    const double rate = sensor->live().rate;
-    capacity += static_cast<std::size_t>(std::ceil(rate * params_.tf_timeout)) + 2;
-  }
-  cast_thread_->setCapacity(capacity);
+  cast_thread_->setCapacity(castQueueCapacity(sensors_, params_.tf_timeout));
 }
 
 void RaycastNode::startTimer(int i) {

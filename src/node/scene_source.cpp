@@ -1,5 +1,7 @@
 #include "scene_source.h"
 
+#include <ros/console.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <mutex>
@@ -45,8 +47,8 @@ LoaderOptions optionsFor(const NodeParams& params, const ModelSource& model) {
   return options;
 }
 
-// Adds the walls of map file entry i to scene; false after ROS_FATAL.
-bool loadMapFile(const NodeParams& params, std::size_t i, core::Scene* scene) {
+// Adds the walls of map file entry i to scene; "" or what is wrong (naming the file).
+std::string loadMapFile(const NodeParams& params, std::size_t i, core::Scene* scene) {
   const ModelSource& model = params.models[i];
   MapWallOptions options;
   options.height = model.height;
@@ -56,8 +58,7 @@ bool loadMapFile(const NodeParams& params, std::size_t i, core::Scene* scene) {
     loaded = addMapFile(model.map, rosPackagePath, options, scene);
   } catch (const SceneLoadError& e) {
     // The message names the file and the problem.
-    ROS_FATAL_STREAM("~models[" << i << "]: " << e.what());
-    return false;
+    return "~models[" + std::to_string(i) + "]: " + e.what();
   }
   for (const std::string& warning : loaded.warnings)
     ROS_WARN_STREAM("~models[" << i << "]: " << warning);
@@ -66,38 +67,35 @@ bool loadMapFile(const NodeParams& params, std::size_t i, core::Scene* scene) {
       "read in %.3f s, walls built in %.3f s",
       model.map.c_str(), loaded.width, loaded.height, loaded.resolution, loaded.occupied_cells,
       model.height, model.frame.c_str(), loaded.boxes, loaded.read_seconds, loaded.build_seconds);
-  return true;
+  return "";
 }
 
-// Adds model i to scene; false after ROS_FATAL.
-bool loadModel(const ros::NodeHandle& nh, const NodeParams& params, std::size_t i,
-               core::Scene* scene, std::set<std::string>* all_links) {
+// Adds model i to scene; "" or what is wrong.
+std::string loadModel(const NodeParams& params, const UrdfParam& urdf_param, std::size_t i,
+                      core::Scene* scene, std::set<std::string>* all_links) {
   const ModelSource& model = params.models[i];
   if (!model.map.empty()) return loadMapFile(params, i, scene);
-  if (!model.map_topic.empty()) return true;  // its walls come with its grids (map_topic.h)
+  if (!model.map_topic.empty()) return "";  // its walls come with its grids (map_topics.h)
   const LoaderOptions options = optionsFor(params, model);
   LoadedModel loaded;
   try {
     SharedLoader& shared = sharedLoader();
     std::lock_guard<std::mutex> lock(shared.mutex);
     if (!model.param.empty()) {
-      std::string xml;
-      if (!nh.getParam(model.param, xml)) {
-        ROS_FATAL_STREAM("~models[" << i << "]: parameter " << nh.resolveName(model.param)
-                                    << " is not set or is not a string: no URDF to load");
-        return false;
+      std::string xml, resolved = model.param;
+      if (!urdf_param(model.param, &xml, &resolved)) {
+        return "~models[" + std::to_string(i) + "]: parameter " + resolved +
+               " is not set or is not a string: no URDF to load";
       }
-      loaded = shared.loader.addUrdfString(xml, "", options, scene,
-                                           "parameter " + nh.resolveName(model.param));
+      loaded = shared.loader.addUrdfString(xml, "", options, scene, "parameter " + resolved);
     } else {
       loaded = shared.loader.addUrdfFile(model.file, options, scene);
     }
   } catch (const SceneLoadError& e) {
     // The message starts with the URDF's source (file or parameter).
-    ROS_FATAL_STREAM(e.what() << (params.skip_bad_geometry
+    return e.what() + std::string(params.skip_bad_geometry
                                       ? ""
-                                      : " (set ~skip_bad_geometry to skip bad elements)"));
-    return false;
+                                      : " (set ~skip_bad_geometry to skip bad elements)");
   }
   for (const std::string& warning : loaded.warnings) ROS_WARN_STREAM("skipped: " << warning);
   for (const auto& link : loaded.link_frames) all_links->insert(link.first);
@@ -115,16 +113,17 @@ bool loadModel(const ros::NodeHandle& nh, const NodeParams& params, std::size_t 
       "%.3f s%s",
       loaded.name.c_str(), model.describe().c_str(), loaded.links, loaded.bodies, loaded.triangles,
       loaded.load_seconds, loaded.bvh_build_seconds, memory.c_str());
-  return true;
+  return "";
 }
 
 }  // namespace
 
-bool loadScene(const ros::NodeHandle& nh, const NodeParams& params, core::Scene* scene,
-               std::vector<double>* reflectivity) {
+std::string loadScene(const NodeParams& params, const UrdfParam& urdf_param, core::Scene* scene,
+                      std::vector<double>* reflectivity) {
   std::set<std::string> all_links;
   for (std::size_t i = 0; i < params.models.size(); ++i) {
-    if (!loadModel(nh, params, i, scene, &all_links)) return false;
+    const std::string error = loadModel(params, urdf_param, i, scene, &all_links);
+    if (!error.empty()) return error;
   }
   for (const std::string& link : params.ignore_links) {
     bool found = all_links.count(link) > 0;
@@ -144,17 +143,14 @@ bool loadScene(const ros::NodeHandle& nh, const NodeParams& params, core::Scene*
     message << "~reflectivity names link '" << entry.first
             << "', which has no geometry in any model (links with geometry: "
             << joinFirst(labels, kLinksInError) << ")";
-    if (!map_topics) {
-      ROS_FATAL_STREAM(message.str());
-      return false;
-    }
+    if (!map_topics) return message.str();
     ROS_WARN_STREAM(message.str() << ", unless a map topic's grids come in that frame");
   }
   *reflectivity = labelReflectivity(params, *scene);
   if (scene->bodies().empty() && !map_topics) {
     ROS_WARN("the scene has no geometry: every beam will report +Inf");
   }
-  return true;
+  return "";
 }
 
 std::vector<double> labelReflectivity(const NodeParams& params, const core::Scene& scene) {

@@ -3,8 +3,8 @@
 // read each mesh file (with its scale) and build its BVH once between them.
 #pragma once
 
-#include <ros/ros.h>
-
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "laser_raycast/core/scene.h"
@@ -12,12 +12,18 @@
 
 namespace laser_raycast {
 
-// Loads the models into *scene and fills *reflectivity (by label). Entries with a map_topic are
-// left for map_topics.h. Returns false after logging (ROS_FATAL) what is wrong: a missing URDF,
-// bad geometry, a bad map file, a reflectivity for an unknown link (only a warning when a map
-// topic's grids may bring it, in a frame not known before they come).
-bool loadScene(const ros::NodeHandle& nh, const NodeParams& params, core::Scene* scene,
-               std::vector<double>* reflectivity);
+// The text of a URDF given by parameter name (~models' {param: NAME}); false if there is none. Sets
+// *resolved to the parameter's full name, for messages.
+using UrdfParam =
+    std::function<bool(const std::string& name, std::string* xml, std::string* resolved)>;
+
+// Loads the models into *scene and fills *reflectivity (by label), logging each model (INFO) and
+// what was skipped (WARN). Entries with a map_topic are left for map_topics.h. Returns "", or what
+// is wrong for the caller to report: a missing URDF, bad geometry, a bad map file, a reflectivity
+// for an unknown link (only a warning when a map topic's grids may bring it, in a frame not known
+// before they come).
+std::string loadScene(const NodeParams& params, const UrdfParam& urdf_param, core::Scene* scene,
+                      std::vector<double>* reflectivity);
 
 // The reflectivity of each of scene's labels: ~reflectivity's for those it names, else
 // ~default_reflectivity.

@@ -14,8 +14,9 @@
 
 namespace laser_raycast {
 
-Sensor::Sensor(ros::NodeHandle& nh, const SensorParams& params, const std::string& fixed_frame,
-               double grace_period, ros::Duration history, int threads)
+Sensor::Sensor(const SensorParams& params, const std::string& fixed_frame, double grace_period,
+               int threads, std::unique_ptr<ScanOutput> output,
+               std::unique_ptr<PoseTopic> pose_topic)
     : name_(params.name),
       fixed_frame_(fixed_frame),
       params_(params),
@@ -24,18 +25,10 @@ Sensor::Sensor(ros::NodeHandle& nh, const SensorParams& params, const std::strin
       cast_config_(params.scan.castConfig()),
       threads_(threads),
       measurement_model_(params.scan.output),
-      monitor_(params.name, nh.resolveName(params.topic), grace_period) {
+      output_(std::move(output)),
+      pose_topic_(std::move(pose_topic)),
+      monitor_(params.name, output_->topic(), grace_period) {
   cast_config_.threads = threads_;
-  if (params.planar()) {
-    scan_pub_ = nh.advertise<sensor_msgs::LaserScan>(params.topic, kPublishQueue);
-  } else {
-    cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>(params.topic, kPublishQueue);
-  }
-  labels_pub_ = nh.advertise<laser_raycast::ScanLabels>(params.labelsTopic(), kPublishQueue);
-  if (!params.pose_topic.empty()) {
-    pose_topic_ = std::make_unique<PoseTopic>(nh, params.pose_topic, fixed_frame_,
-                                              ros::Duration(params.pose_timeout), history);
-  }
   if (params.sweep == Sweep::kRotating) {
     column_times_ = rotatingColumnTimes(pattern_.azimuthCount(), params.timeIncrement());
   }
@@ -44,11 +37,6 @@ Sensor::Sensor(ros::NodeHandle& nh, const SensorParams& params, const std::strin
 std::pair<std::string, std::string> Sensor::tfChain() const {
   if (!pose_topic_) return {fixed_frame_, params_.frame_id};
   return {params_.pose_frame.empty() ? params_.frame_id : params_.pose_frame, params_.frame_id};
-}
-
-bool Sensor::hasSubscribers() const {
-  return scan_pub_.getNumSubscribers() > 0 || cloud_pub_.getNumSubscribers() > 0 ||
-         labels_pub_.getNumSubscribers() > 0;
 }
 
 ros::Duration Sensor::period() const {
@@ -164,7 +152,7 @@ void Sensor::publishScan(const ros::Time& stamp) {
   scan.range_max = static_cast<float>(cast_params_.scan.output.range_max);
   scan.ranges = measured_.ranges;
   scan.intensities = measured_.intensities;
-  scan_pub_.publish(scan);
+  output_->send(scan);
 }
 
 void Sensor::publishCloud(const ros::Time& stamp) {
@@ -176,17 +164,17 @@ void Sensor::publishCloud(const ros::Time& stamp) {
   options.layout = cast_params_.point_layout;
   sensor_msgs::PointCloud2 cloud;
   buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud);
-  cloud_pub_.publish(cloud);
+  output_->send(cloud);
 }
 
 void Sensor::publishLabels(const core::Scene& scene, const std_msgs::Header& header) {
   // The labels are computed with every scan; the message is built only for a subscriber.
-  if (labels_pub_.getNumSubscribers() == 0) return;
+  if (!output_->labelsWanted()) return;
   laser_raycast::ScanLabels labels;
   labels.header = header;
   labels.link_names = scene.labels();
   labels.labels.assign(measured_.labels.begin(), measured_.labels.end());
-  labels_pub_.publish(labels);
+  output_->send(labels);
 }
 
 }  // namespace laser_raycast

@@ -1,7 +1,8 @@
 // One simulated sensor of the node: its beams, caster and model, where its pose comes from (TF or
-// a pose topic), its publishers (LaserScan for a planar pattern, PointCloud2 otherwise, and the
-// per-beam labels), its live parameters, and its monitor. The cast thread casts it; its timer, the
-// subscriber check and live reconfiguration run on the node's callback thread.
+// a pose topic), the messages it makes (LaserScan for a planar pattern, PointCloud2 otherwise, and
+// the per-beam labels) and where they go (sensor_output.h), its live parameters, and its monitor.
+// The cast thread casts it; its timer, the subscriber check and live reconfiguration run on the
+// node's callback thread.
 #pragma once
 
 #include <ros/ros.h>
@@ -23,6 +24,7 @@
 #include "live_params.h"
 #include "pose_topic.h"
 #include "sensor_monitor.h"
+#include "sensor_output.h"
 #include "tf_source.h"
 
 namespace laser_raycast {
@@ -37,16 +39,17 @@ class Sensor {
   // The parameters that can change while the node runs (cfg/Raycast.cfg).
   using Live = LiveParams;
 
-  // history: how long pose topic messages are kept (s); threads: per cast (CastConfig::threads).
-  Sensor(ros::NodeHandle& nh, const SensorParams& params, const std::string& fixed_frame,
-         double grace_period, ros::Duration history, int threads);
+  // threads: per cast (CastConfig::threads). output: where its messages go; pose_topic: where its
+  // pose comes from if params.pose_topic is set (nullptr: from TF).
+  Sensor(const SensorParams& params, const std::string& fixed_frame, double grace_period,
+         int threads, std::unique_ptr<ScanOutput> output, std::unique_ptr<PoseTopic> pose_topic);
 
   const std::string& name() const { return name_; }
   // The TF chain its pose needs, as (target, source): fixed_frame <- frame_id, or, with a pose
   // topic, pose_frame <- frame_id.
   std::pair<std::string, std::string> tfChain() const;
   // Whether anyone listens to any of its topics (otherwise it is not cast).
-  bool hasSubscribers() const;
+  bool hasSubscribers() const { return output_->wanted(); }
   ros::Duration period() const;
   // The pose sample times of a scan stamped at `stamp`: the stamp alone for an instantaneous scan,
   // else across the sweep up to its last beam column's time.
@@ -63,7 +66,7 @@ class Sensor {
   bool poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose, std::string* why,
               bool* from_tf, std::uint64_t* tf_failures);
   // Casts the scan whose pose samples are at `times`, from the frames and sensor poses at each,
-  // and publishes it. missing_links: link transforms left out of it.
+  // and sends it to its output. missing_links: link transforms left out of it.
   void castAndPublish(const core::Scene& scene, const std::vector<double>& reflectivity,
                       const std::vector<ros::Time>& times,
                       const std::vector<core::FramePoses>& frames,
@@ -78,9 +81,6 @@ class Sensor {
   void publishScan(const ros::Time& stamp);
   void publishCloud(const ros::Time& stamp);
   void publishLabels(const core::Scene& scene, const std_msgs::Header& header);
-
-  // Scans queued for a slow subscriber before the oldest is dropped (1 s at the default rate).
-  static constexpr std::uint32_t kPublishQueue = 10;
 
   const std::string name_;
   const std::string fixed_frame_;
@@ -97,8 +97,8 @@ class Sensor {
   core::MeasuredScan measured_;
   std::vector<double> column_times_;  // s after the stamp, per azimuth column (rotating)
 
+  std::unique_ptr<ScanOutput> output_;
   std::unique_ptr<PoseTopic> pose_topic_;
-  ros::Publisher scan_pub_, cloud_pub_, labels_pub_;
   SensorMonitor monitor_;
 };
 

@@ -39,6 +39,7 @@ void SensorMonitor::lookupFailures(std::uint64_t failures) {
 
 void SensorMonitor::skipped(Skip kind, const ros::Time& stamp, const std::string& why) {
   std::lock_guard<std::mutex> lock(mutex_);
+  stats_.last_skip = why;
   switch (kind) {
     case Skip::kNoTransform:
       ++stats_.skipped.no_transform;

@@ -31,6 +31,7 @@ struct SensorStats {
   double last_cast_seconds = 0;  // wall time of the last cast (look-ups and publishing excluded)
   double last_hit_share = 0;     // share of the last scan's beams with a valid return
   bool active = false;           // someone subscribes: scans are queued
+  std::string last_skip;         // why the last scan not published was skipped
 };
 
 class SensorMonitor {

@@ -4,9 +4,6 @@
 
 namespace laser_raycast {
 
-TfSource::TfSource(const ros::NodeHandle& nh, ros::Duration cache)
-    : buffer_(cache), listener_(buffer_, nh) {}
-
 std::optional<ros::Time> TfSource::latest(const std::string& target, const std::string& source,
                                           std::string* error) const {
   if (target == source) return ros::Time(0);

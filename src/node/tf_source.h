@@ -1,9 +1,11 @@
-// The node's TF input: one buffer and listener for every sensor. It answers two questions without
-// ever waiting (the cast thread decides how long a scan waits, tf_timing.h): how recent a
-// transform is, and what it is at a time.
+// The node's TF input: look-ups in a tf2 buffer, which the node's listener fills as transforms
+// arrive and simulate_bag as it reads a bag. It answers two questions without ever waiting (the
+// cast thread decides how long a scan waits, tf_timing.h): how recent a transform is, and what it
+// is at a time.
 #pragma once
 
 #include <ros/ros.h>
+#include <tf2/buffer_core.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
@@ -17,8 +19,8 @@ namespace laser_raycast {
 
 class TfSource {
  public:
-  // cache: how far back the buffer keeps transforms (tf2's default is 10 s).
-  TfSource(const ros::NodeHandle& nh, ros::Duration cache);
+  // buffer must outlive this; it may be filled from another thread (tf2 locks it).
+  explicit TfSource(const tf2::BufferCore& buffer) : buffer_(buffer) {}
 
   // The newest time target <- source can be looked up at (ros::Time(0): static only), nullopt if
   // TF has no chain between them (TF's message in *error).
@@ -35,8 +37,22 @@ class TfSource {
               Eigen::Isometry3d* pose, std::string* error) const;
 
  private:
+  const tf2::BufferCore& buffer_;
+};
+
+// The node's buffer, filled by a listener on its own thread (TF arrives while scans are cast).
+class TfListener {
+ public:
+  // cache: how far back the buffer keeps transforms (tf2's default is 10 s).
+  TfListener(const ros::NodeHandle& nh, ros::Duration cache)
+      : buffer_(cache), listener_(buffer_, nh), source_(buffer_) {}
+
+  const TfSource& source() const { return source_; }
+
+ private:
   tf2_ros::Buffer buffer_;
-  tf2_ros::TransformListener listener_;  // on its own thread: TF arrives while scans are cast
+  tf2_ros::TransformListener listener_;
+  TfSource source_;
 };
 
 }  // namespace laser_raycast

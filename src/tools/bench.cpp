@@ -29,8 +29,7 @@ namespace core = laser_raycast::core;
 namespace po = boost::program_options;
 using laser_raycast::tools::ArgError;
 
-constexpr int kExitRunFailed = 1;
-constexpr int kExitBadArguments = 2;
+constexpr int kExitRunFailed = 1;  // bad command lines: tools::kExitBadArguments
 
 const char* const kSynopsis =
     "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--method NAME ...] [--list-methods]\n"
@@ -314,18 +313,9 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   Options options;
-  bool help = false;
-  try {
-    options = parseArgs(argc, argv, &help);
-  } catch (const ArgError& e) {
-    std::cerr << "bench: " << e.what() << "\n" << kSynopsis << kNotes;
-    return kExitBadArguments;
-  }
-  if (help) {
-    Options unused;
-    std::cout << kSynopsis << "\n" << flags(&unused) << "\n" << kNotes;
-    return 0;
-  }
+  const auto exit_now = laser_raycast::tools::readCommandLine("bench", kSynopsis, kNotes, parseArgs,
+                                                              flags, argc, argv, &options);
+  if (exit_now) return *exit_now;
   if (options.list_methods || options.list_scenes) {
     if (options.list_methods)
       for (const auto& m : allMethodNames()) std::cout << m << "\n";

@@ -33,7 +33,7 @@ using laser_raycast::tools::single;
 namespace core = laser_raycast::core;
 namespace po = boost::program_options;
 
-constexpr int kExitBadArguments = 2;
+using laser_raycast::tools::kExitBadArguments;
 constexpr int kExitBadScene = 3;
 
 struct Model {
@@ -498,18 +498,9 @@ void print(const std::string& text) { std::fwrite(text.data(), 1, text.size(), s
 
 int main(int argc, char** argv) {
   Args args;
-  bool help = false;
-  try {
-    args = parseArgs(argc, argv, &help);
-  } catch (const ArgError& e) {
-    std::cerr << "cast_scan: " << e.what() << "\n" << synopsis() << notes();
-    return kExitBadArguments;
-  }
-  if (help) {
-    Args unused;
-    std::cout << synopsis() << "\n" << flags(&unused) << "\n" << notes();
-    return 0;
-  }
+  const auto exit_now = laser_raycast::tools::readCommandLine("cast_scan", synopsis(), notes(),
+                                                              parseArgs, flags, argc, argv, &args);
+  if (exit_now) return *exit_now;
   LoadedScene loaded;
   try {
     loaded = loadScene(args);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,17 @@ bool parseCommandLine(int argc, char** argv, const po::options_description& opti
     throw ArgError(e.what());
   }
   return true;
+}
+
+std::optional<int> readCommandLine(const ToolText& text, const std::function<bool()>& parse) {
+  try {
+    if (parse()) return std::nullopt;
+  } catch (const ArgError& e) {
+    std::cerr << text.name << ": " << e.what() << "\n" << text.synopsis << text.notes;
+    return kExitBadArguments;
+  }
+  std::cout << text.synopsis << "\n" << text.flags() << "\n" << text.notes;
+  return 0;
 }
 
 po::typed_value<std::string>* single(const char* value_name,

@@ -4,6 +4,7 @@
 
 #include <boost/program_options.hpp>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +16,42 @@ class ArgError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// Every tool's exit status for a bad command line.
+constexpr int kExitBadArguments = 2;
+
+// What a tool says about its command line: its name (messages start with it), its usage lines,
+// its flags (for --help) and the notes after them.
+struct ToolText {
+  std::string name;
+  std::string synopsis;
+  std::function<boost::program_options::options_description()> flags;
+  std::string notes;
+};
+
+// Calls parse, which reads the command line (throwing ArgError for a bad one) and returns false
+// for --help. Returns what main should exit with now: kExitBadArguments after a bad command line
+// (the message, the usage and the notes on stderr), 0 after --help (the usage, the flags and the
+// notes on stdout); nullopt to go on.
+std::optional<int> readCommandLine(const ToolText& text, const std::function<bool()>& parse);
+
+// The same for a tool whose parse(argc, argv, &help) gives its Args (help: --help was given) and
+// whose flags(&args) describes the flags that store into args.
+template <class Args>
+std::optional<int> readCommandLine(const std::string& name, const std::string& synopsis,
+                                   const std::string& notes, Args (*parse)(int, char**, bool*),
+                                   boost::program_options::options_description (*flags)(Args*),
+                                   int argc, char** argv, Args* args) {
+  const auto help_flags = [flags] {
+    Args unused;
+    return flags(&unused);
+  };
+  return readCommandLine(ToolText{name, synopsis, help_flags, notes}, [&] {
+    bool help = false;
+    *args = parse(argc, argv, &help);
+    return !help;
+  });
+}
 
 // Reads argv against options: --name VALUE or --name=VALUE, a multi-value option takes the words
 // up to the next flag, a flag may not be abbreviated, and a word that is no flag's value is an

@@ -1,6 +1,7 @@
 // The rig of the sensors rostest (node_sensors.test, nodelet_sensors.test; test_node_sensors.cpp):
-// the closed room of test/data/sensors_room.urdf worked out by hand, the sensors' transforms (the
-// static ones and the spinner's path), what the node publishes, and reading its diagnostics.
+// the sensors' transforms in the closed room of test/data/sensors_room.urdf (sensors_room.h: its
+// distances worked out by hand), the static ones and the spinner's path, what the node publishes,
+// and reading its diagnostics.
 #pragma once
 
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -19,6 +20,8 @@
 #include <mutex>
 #include <string>
 #include <vector>
+
+#include "sensors_room.h"
 
 namespace laser_raycast_test {
 
@@ -41,17 +44,6 @@ inline geometry_msgs::TransformStamped transform(const ros::Time& stamp, const s
   m.transform.rotation.z = std::sin(yaw / 2);
   m.transform.rotation.w = std::cos(yaw / 2);
   return m;
-}
-
-// The distance from p (inside the room) along unit direction d to the room's inner faces.
-inline double roomDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
-  const Eigen::Vector3d lo(-5, -4, 0), hi(5, 4, 4);
-  double t = kInf;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (d[axis] > 0) t = std::min(t, (hi[axis] - p[axis]) / d[axis]);
-    if (d[axis] < 0) t = std::min(t, (lo[axis] - p[axis]) / d[axis]);
-  }
-  return t;
 }
 
 // The sensor poses and what the node publishes, recorded from the spinner's threads.

@@ -413,13 +413,17 @@ TEST(Layers, TheLoaderIncludesNoRoscppTfMessagesOrNode) {
   }
 }
 
+// The one exception is the node's offline front end, the tool simulate_bag, through the node's
+// public header for it.
 TEST(Layers, NothingOutsideTheNodeIncludesTheNode) {
-  const auto includes = includesUnder({kSource / "include/laser_raycast/core", kSource / "src/core",
-                                       kSource / "include/laser_raycast/loader",
-                                       kSource / "src/loader", kSource / "src/python",
-                                       kSource / "src/tools"});
+  const auto includes =
+      includesUnder({kSource / "include/laser_raycast/core", kSource / "src/core",
+                     kSource / "include/laser_raycast/loader", kSource / "src/loader",
+                     kSource / "src/python", kSource / "src/tools"});
   for (const Include& inc : includes) {
-    EXPECT_FALSE(startsWith(inc.name, "laser_raycast/node/"))
+    const bool front_end = inc.file == kSource / "src/tools/simulate_bag.cpp" &&
+                           inc.name == "laser_raycast/node/bag_simulation.h";
+    EXPECT_FALSE(startsWith(inc.name, "laser_raycast/node/") && !front_end)
         << inc.file.string() << ":" << inc.line << " includes " << inc.name;
   }
 }

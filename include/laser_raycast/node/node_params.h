@@ -124,6 +124,14 @@ struct NodeParams {
   std::map<std::string, double> reflectivity;  // link name (with TF prefix) -> reflectivity
   double default_reflectivity = 1.0;
   std::vector<SensorParams> sensors;  // at least one after parsing
+
+  // TF and pose topics keep data as far back as the oldest time a queued scan can still need: this
+  // many seconds (tf_timeout, the longest period, and a second to spare).
+  double history() const;
+  // s of TF the buffer keeps: history(), and at least tf2's default of 10 s.
+  double tfCache() const;
+  // s of a sensor's pose topic messages kept: history() and the age a message may still serve at.
+  double poseHistory(const SensorParams& sensor) const;
 };
 
 // What parsing reports besides the values.

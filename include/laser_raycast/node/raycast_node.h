@@ -20,10 +20,11 @@ namespace laser_raycast {
 class CastThread;
 class MapTopics;
 class NodeDiagnostics;
+class PoseSubscriber;
 class Sensor;
 class SensorReconfigure;
 class SharedScene;
-class TfSource;
+class TfListener;
 
 class RaycastNode {
  public:
@@ -56,8 +57,10 @@ class RaycastNode {
   // The scene cast, swapped whole when a map topic's grid changes it (shared_scene.h).
   std::unique_ptr<SharedScene> scene_;
   std::unique_ptr<MapTopics> map_topics_;
-  std::unique_ptr<TfSource> tf_;
+  std::unique_ptr<TfListener> tf_;
   std::vector<std::unique_ptr<Sensor>> sensors_;
+  // After the sensors: destroyed first, as they add to the sensors' pose topics.
+  std::vector<std::unique_ptr<PoseSubscriber>> pose_subscribers_;
   std::unique_ptr<CastThread> cast_thread_;
   std::unique_ptr<NodeDiagnostics> diagnostics_;
   std::vector<std::unique_ptr<SensorReconfigure>> reconfigure_;

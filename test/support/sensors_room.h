@@ -1,0 +1,23 @@
+// The closed room of test/data/sensors_room.urdf, worked out by hand: its inner faces are the
+// planes x = -5, x = 5, y = -4, y = 4, z = 0 and z = 4. Used by the sensors rostest and
+// simulate_bag's tests.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <limits>
+
+namespace laser_raycast_test {
+
+// The distance from p (inside the room) along unit direction d to the room's inner faces.
+inline double roomDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
+  const Eigen::Vector3d lo(-5, -4, 0), hi(5, 4, 4);
+  double t = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (d[axis] > 0) t = std::min(t, (hi[axis] - p[axis]) / d[axis]);
+    if (d[axis] < 0) t = std::min(t, (lo[axis] - p[axis]) / d[axis]);
+  }
+  return t;
+}
+
+}  // namespace laser_raycast_test
