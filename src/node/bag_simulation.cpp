@@ -355,6 +355,7 @@ BagSimulationResult Simulation::result() const {
     s.written = outputs_[i]->written();
     s.before_transforms = stats.skipped.waiting;
     s.no_pose = stats.skipped.no_transform + stats.skipped.stale_pose;
+    s.dropped = stats.skipped.behind;
     s.missing_links = stats.missing_links;
     s.uncovered_at_end = uncovered[i];
     s.last_problem = stats.last_skip;

@@ -112,7 +112,8 @@ class ProgressBar {
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     if (!last && elapsed - drawn_ < kProgressPeriod) return;
     drawn_ = elapsed;
-    const double share = p.total > 0 ? std::min(1.0, p.done / p.total) : 1.0;
+    // A pose topic's messages may come before the first transform: done is then negative.
+    const double share = p.total > 0 ? std::clamp(p.done / p.total, 0.0, 1.0) : 1.0;
     const int filled = static_cast<int>(share * kBarWidth);
     const double speed = elapsed > 0 ? p.done / elapsed : 0;
     std::ostringstream line;
@@ -146,6 +147,7 @@ void printSummary(const laser_raycast::BagSimulationResult& result) {
       std::cerr << ", " << s.before_transforms << " before the transforms covered them";
     }
     if (s.no_pose > 0) std::cerr << ", " << s.no_pose << " skipped without a pose";
+    if (s.dropped > 0) std::cerr << ", " << s.dropped << " dropped waiting for TF";
     if (s.missing_links > 0) std::cerr << ", " << s.missing_links << " links left out";
     if (s.uncovered_at_end > 0) {
       std::cerr << ", " << s.uncovered_at_end << " at the end not covered by TF";

@@ -44,6 +44,8 @@ struct SimulatedSensor {
   std::uint64_t before_transforms = 0;
   // Not cast later: no sensor pose (TF, or a stale or bad pose topic message).
   std::uint64_t no_pose = 0;
+  // Dropped from the full queue while waiting for late TF (the node's "cast thread behind").
+  std::uint64_t dropped = 0;
   std::uint64_t missing_links = 0;  // link transforms left out of scans written
   // Queued when the bag ended but never cast: TF never covered their last beam.
   std::uint64_t uncovered_at_end = 0;
@@ -53,7 +55,7 @@ struct SimulatedSensor {
 struct BagSimulationResult {
   std::vector<SimulatedSensor> sensors;
   double bag_seconds = 0;   // from the first TF message to the last
-  double wall_seconds = 0;  // from opening the input bag to closing the output
+  double wall_seconds = 0;  // from loading the models to closing the output
   std::uint64_t tf_messages = 0;
 };
 
