@@ -370,8 +370,10 @@ TEST(EdgeFilter, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
 }
 
 // The same for the column raster, on a lidar's rings and on rings up to its steepest elevation.
-// Widened for a sweep block (ColumnMotion): every beam from its column's pose whose exact hit could
-// be kept is a candidate, with the triangle's plane distance as the near distance.
+// For a sweep block (ColumnMotion): every beam from its column's pose whose exact hit could be
+// kept is a candidate, the raster widened by the block's spread with the triangle's plane distance
+// as the near distance, and the raster that follows each column's origin (its planes nearer than
+// twice the shift widened instead: shifts up to 5 cm and triangles from 10 cm away have both).
 TEST(ColumnRaster, WithASpreadLetsThroughEveryColumnsBeamWhoseExactHitCouldBeKept) {
   Rng rng(47);
   std::vector<double> lidar;
@@ -394,6 +396,16 @@ TEST(ColumnRaster, WithASpreadLetsThroughEveryColumnsBeamWhoseExactHitCouldBeKep
                     ? std::sin(std::min(M_PI / 2, spread.turn + std::asin(spread.shift / near)))
                     : 1.0;
             core::ColumnRaster(beams, t.a, t.b, t.c, widen, spread.shift, spread.turn)
+                .forEachCandidate(beams, beams.grid().all(),
+                                  [&](int row, int col) { mark(row, col); });
+          },
+          &hits, &motion);
+      if (HasFailure()) return;
+      if (pattern.planar()) continue;  // the walks raster a planar fan by its windows
+      expectEveryKeptHitACandidate(
+          rng, pattern,
+          [&](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
+            core::ColumnRaster(beams, t.a, t.b, t.c, motion, 0.0)
                 .forEachCandidate(beams, beams.grid().all(),
                                   [&](int row, int col) { mark(row, col); });
           },

@@ -19,6 +19,13 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
     in_plane_ = in_plane_ && r(0, 2) == 0 && r(1, 2) == 0 && r(2, 0) == 0 && r(2, 1) == 0 &&
                 r(2, 2) == 1 && m.translation().z() == 0;
   }
+  padded_lo_ = col_lo_ & ~3;
+  const int padded_hi = colHi() | 3;
+  for (std::vector<float>& axis : origin_) axis.resize(padded_hi - padded_lo_ + 1);
+  for (int c = padded_lo_; c <= padded_hi; ++c) {
+    const Eigen::Vector3d& o = refFromColumn(std::clamp(c, col_lo_, colHi())).translation();
+    for (int k = 0; k < 3; ++k) origin_[k][c - padded_lo_] = static_cast<float>(o[k]);
+  }
   // A rotation by angle a moves the unit axes by |R - I|_F = 2 sqrt(2) sin(a / 2), and the z axis
   // by |R e_z - e_z| = 2 sin(tilt / 2): both well conditioned for small angles, and increasing in
   // the angle, so the largest gives the largest angle.

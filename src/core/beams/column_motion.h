@@ -45,6 +45,13 @@ class ColumnMotion {
   Eigen::Vector3d toColumn(int col, const Eigen::Vector3d& n) const {
     return refFromColumn(col).linear().transpose() * n;
   }
+  // Each column's origin (refFromColumn(c).translation()) rounded to float, one array per axis,
+  // for the columns from colLo() rounded down to a multiple of 4 to colHi() rounded up to one less
+  // than a multiple of 4 (the padding repeats the nearest column's): originX(base)[j] is column
+  // base + j's, base a multiple of 4 (the column raster's groups, column_raster.h).
+  const float* originX(int base) const { return origin_[0].data() + (base - padded_lo_); }
+  const float* originY(int base) const { return origin_[1].data() + (base - padded_lo_); }
+  const float* originZ(int base) const { return origin_[2].data() + (base - padded_lo_); }
   // For inPlane(): a point of the scan plane, the reference sensor's x, y, in column col's.
   Eigen::Vector2d pointToColumn(int col, const Eigen::Vector2d& p) const {
     const Eigen::Isometry3d& m = refFromColumn(col);
@@ -56,6 +63,8 @@ class ColumnMotion {
   std::vector<Eigen::Isometry3d> ref_from_column_;
   Spread spread_;
   bool in_plane_ = true;
+  int padded_lo_;
+  std::vector<float> origin_[3];
 };
 
 }  // namespace core

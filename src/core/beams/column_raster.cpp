@@ -1,5 +1,7 @@
 #include "beams/column_raster.h"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "util/float_rounding.h"
@@ -16,6 +18,30 @@ constexpr double kSmallest = 1e-30;
 
 ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                            const Eigen::Vector3d& c, double widen, double shift, double turn) {
+  init(beams, a, b, c, widen, shift, turn);
+}
+
+ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                           const Eigen::Vector3d& c, const ColumnMotion& motion, double near) {
+  const double shift = motion.spread().shift, turn = motion.spread().turn;
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const double plane = std::abs(n.dot(a)) / n.norm() * (1 - 1e-9);
+  if (std::isfinite(plane) && plane > 2 * shift) {
+    motion_ = &motion;
+    init(beams, a, b, c, std::sin(std::min(M_PI / 2, turn)), shift, turn);
+    return;
+  }
+  // The plane passes near the sensor: every edge test widened by the shift, from the triangle's
+  // nearest point (the larger of the leaf's near and the plane's distance).
+  const double nearest = std::max(near, std::isfinite(plane) ? plane : 0.0);
+  const double widen = nearest > 2 * shift
+                           ? std::sin(std::min(M_PI / 2, turn + std::asin(shift / nearest)))
+                           : 1;  // every beam of the rect
+  init(beams, a, b, c, widen, shift, turn);
+}
+
+void ColumnRaster::init(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                        const Eigen::Vector3d& c, double widen, double shift, double turn) {
   // In double: a small or far triangle's edge normals cancel far beyond float's precision.
   const Eigen::Vector3d m[3] = {b.cross(c), c.cross(a), a.cross(b)};
   const double det = a.dot(m[0]);
@@ -27,6 +53,9 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
   if (all_) return;
   const double sign = det > 0 ? 1 : -1;
   const __m128 ones = _mm_castsi128_ps(_mm_set1_epi32(-1)), none = _mm_setzero_ps();
+  // The edges whose cross product with a column's origin moves m (m - o x e).
+  const Eigen::Vector3d e[3] = {c - b, a - c, b - a};
+  double factor = 1, moves = 0;
   for (int k = 0; k < 3; ++k) {
     const double scale = sign / (std::abs(m[k].x()) + std::abs(m[k].y()) + std::abs(m[k].z()));
     const float z = static_cast<float>(m[k].z() * scale);
@@ -36,9 +65,27 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
     lower_[k] = z > 0 ? ones : none;
     upper_[k] = z < 0 ? ones : none;
     flat_[k] = z == 0 ? ones : none;
+    if (motion_) {
+      const Eigen::Vector3d scaled = e[k] * scale;
+      mz_[k] = _mm_set1_ps(z);
+      ex_[k] = _mm_set1_ps(static_cast<float>(scaled.x()));
+      ey_[k] = _mm_set1_ps(static_cast<float>(scaled.y()));
+      ez_[k] = _mm_set1_ps(static_cast<float>(scaled.z()));
+      factor = std::max(factor, 1 + std::sqrt(3.0) * shift * scaled.lpNorm<1>());
+      moves = std::max(moves, shift * scaled.lpNorm<1>());
+    }
   }
-  edge_margin_ = _mm_set1_ps(
-      floatAbove((kMargin + widen * (1 + 1e-6)) / beams.grid().smallestRowCos()));
+  widen *= factor;
+  if (!(widen < 0.5)) {
+    all_ = true;
+    return;
+  }
+  edge_margin_ = _mm_set1_ps(floatAbove((kMargin * factor + widen * (1 + 1e-6)) /
+                                        beams.grid().smallestRowCos()));
+  reference_margin_ =
+      motion_ ? _mm_set1_ps(floatAbove((kMargin * factor + (widen + moves) * (1 + 1e-6)) /
+                                       beams.grid().smallestRowCos()))
+              : edge_margin_;
   // The plane's normal (b - a) x (c - a) is the sum of the edge normals, and its dot product with
   // a is det.
   const Eigen::Vector3d plane = m[0] + m[1] + m[2];

@@ -22,6 +22,16 @@
 // within sin(alpha) of each unit edge plane, and |m|_2 <= |m|_1 = 1 makes that m.d >= -sin(alpha).
 // The range test then takes the plane's distance from the sensor less `shift` (no origin is nearer
 // to the plane by more) over |n.d| plus `turn` (|n.d' - n.d| <= |d' - d| <= turn for the scaled n).
+//
+// Given the block's ColumnMotion, the edge planes follow each column's origin o instead: the plane
+// through o and edge (b, c) has the normal (b - o) x (c - o) = m - o x (c - b), linear in o, so
+// each group of four columns gets its own three normals, and only the turn widens the tests. The
+// shift then costs a triangle no columns, where the widening above adds asin(shift / near) to
+// every side (a rack's small triangles a metre away, from a sensor moving a few millimetres in a
+// block, gain two columns a side). It holds while no origin crosses the triangle's plane (then
+// the inward orientation of the edges is the reference's); nearer planes take the widening.
+// Scaled by the reference's |m|_1, a column's normal has |m'|_1 <= 1 + |o x e|_1 <= 1 +
+// sqrt(3) shift |e|_1, which scales the margin and the turn's sin(turn) |m'|_2.
 #pragma once
 
 #include <emmintrin.h>
@@ -30,6 +40,7 @@
 #include <cmath>
 
 #include "beams/beam_set.h"
+#include "beams/column_motion.h"
 #include "util/simd_math.h"
 
 namespace laser_raycast {
@@ -45,6 +56,12 @@ class ColumnRaster {
   // a, b, c in the sensor frame. The pattern's rows must allow it (BeamGrid::columnRaster()).
   ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                const Eigen::Vector3d& c, double widen = 0, double shift = 0, double turn = 0);
+  // For a sweep's block: a, b, c in the reference sensor frame, the beams from motion's column
+  // origins; near: no point of the triangle is nearer the reference sensor (a leaf's near). The
+  // edge planes follow the columns' origins where the triangle's plane is farther than twice the
+  // block's shift, else they are widened by it. motion must outlive the raster.
+  ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+               const Eigen::Vector3d& c, const ColumnMotion& motion, double near);
 
   // Calls f(row, col) for every beam of rect that may hit the triangle nearer than its current
   // range: row by row in a rect of fewer than kRowMajorRows rows, else column by column.
@@ -66,6 +83,22 @@ class ColumnRaster {
   };
   // The groups are gathered, then scanned, this many at a time (an array on the stack).
   static constexpr int kChunkGroups = 16;
+  // The three normals, the widening and the plane from the reference pose; factor scales the
+  // margin (a column's normals' largest |m|_1).
+  void init(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+            const Eigen::Vector3d& c, double widen, double shift, double turn);
+  // Columns base..base + 3's bounds on tan E (lo > hi: none), from their cos A and sin A: from the
+  // reference's normals with `margin`, or each column's own normals (following the origins).
+  void referenceBounds(__m128 ca, __m128 sa, __m128 margin, __m128* lo, __m128* hi) const;
+  void columnBounds(int base, __m128 ca, __m128 sa, __m128* lo, __m128* hi) const;
+  // The columns whose bounds meet the rect's rows' (tan E from rows_lo to rows_hi), of first..last.
+  static int meetsRows(__m128 lo, __m128 hi, __m128 rows_lo, __m128 rows_hi, int base, int first,
+                       int last) {
+    const int mask = _mm_movemask_ps(
+        _mm_and_ps(_mm_cmple_ps(lo, hi),
+                   _mm_and_ps(_mm_cmpnlt_ps(rows_hi, lo), _mm_cmpnlt_ps(hi, rows_lo))));
+    return mask & (0xF << (first - base)) & (0xF >> (base + 3 - last));
+  }
   template <class F>
   void scanRows(const BeamSet& beams, const BeamRect& rect, const Group* groups, int n,
                 F&& f) const;
@@ -78,6 +111,13 @@ class ColumnRaster {
   // (m_z < 0) or nothing (m_z = 0: the edge decides by h(A) alone).
   __m128 mx_[3], my_[3], inv_mz_[3], lower_[3], upper_[3], flat_[3];
   __m128 edge_margin_;  // the margin over the smallest cos E of the pattern
+  // Following the columns' origins: the block, each edge's m_z scaled and its (c - b, a - c,
+  // b - a) scaled as m is.
+  const ColumnMotion* motion_ = nullptr;
+  __m128 mz_[3], ex_[3], ey_[3], ez_[3];
+  // The margin of the reference's normals that lets through every column whose own normals do:
+  // edge_margin_ plus the most any normal moves (|o x e|_2 <= shift |e|_1), a first cheap test.
+  __m128 reference_margin_;
   // The plane: normal (scaled), |n.a| rounded down.
   __m128 nx_, ny_;
   float nz_, plane_distance_;
@@ -94,7 +134,6 @@ void ColumnRaster::forEachCandidate(const BeamSet& beams, const BeamRect& rect, 
   }
   const float* cos_a = beams.grid().columnCos();
   const float* sin_a = beams.grid().columnSin();
-  const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
   const __m128 rows_tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(rect.row_lo));
   const __m128 rows_tan_hi = _mm_set1_ps(beams.grid().rowTanAbove(rect.row_hi));
   const bool by_rows = rect.row_hi - rect.row_lo < kRowMajorRows;
@@ -112,27 +151,18 @@ void ColumnRaster::forEachCandidate(const BeamSet& beams, const BeamRect& rect, 
   };
   for (int base = rect.col_lo & ~3; base <= rect.col_hi; base += 4) {
     const __m128 ca = _mm_loadu_ps(cos_a + base), sa = _mm_loadu_ps(sin_a + base);
-    __m128 lo = _mm_sub_ps(_mm_setzero_ps(), inf), hi = inf;
-    for (int k = 0; k < 3; ++k) {
-      const __m128 h = _mm_add_ps(_mm_mul_ps(mx_[k], ca), _mm_mul_ps(my_[k], sa));
-      // h + m_z tan E >= -margin  <=>  tan E >= or <= (-margin - h) / m_z.
-      const __m128 bound =
-          _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_setzero_ps(), edge_margin_), h), inv_mz_[k]);
-      lo = _mm_max_ps(lo, _mm_or_ps(_mm_and_ps(lower_[k], bound), _mm_andnot_ps(lower_[k], lo)));
-      hi = _mm_min_ps(hi, _mm_or_ps(_mm_and_ps(upper_[k], bound), _mm_andnot_ps(upper_[k], hi)));
-      // A flat edge (m_z = 0) keeps a column only if h >= -margin.
-      const __m128 out =
-          _mm_and_ps(flat_[k], _mm_cmplt_ps(h, _mm_sub_ps(_mm_setzero_ps(), edge_margin_)));
-      lo = _mm_or_ps(_mm_and_ps(out, inf), _mm_andnot_ps(out, lo));
-    }
+    __m128 lo, hi;
+    referenceBounds(ca, sa, reference_margin_, &lo, &hi);
     // The columns whose bounds meet the rect's rows' (float bounds on their tan E): only those
     // need their rows looked at.
-    int mask = _mm_movemask_ps(
-        _mm_and_ps(_mm_cmple_ps(lo, hi),
-                   _mm_and_ps(_mm_cmpnlt_ps(rows_tan_hi, lo), _mm_cmpnlt_ps(hi, rows_tan_lo))));
     const int first = std::max(base, rect.col_lo), last = std::min(base + 3, rect.col_hi);
-    mask &= (0xF << (first - base)) & (0xF >> (base + 3 - last));
+    int mask = meetsRows(lo, hi, rows_tan_lo, rows_tan_hi, base, first, last);
     if (!mask) continue;
+    if (motion_) {
+      columnBounds(base, ca, sa, &lo, &hi);
+      mask = meetsRows(lo, hi, rows_tan_lo, rows_tan_hi, base, first, last);
+      if (!mask) continue;
+    }
     Group& g = groups[n++];
     g.base = base;
     g.mask = mask;
@@ -142,6 +172,57 @@ void ColumnRaster::forEachCandidate(const BeamSet& beams, const BeamRect& rect, 
     if (n == kChunkGroups) flush();
   }
   if (n > 0) flush();
+}
+
+// One edge's bounds on tan E, into lo and hi, from its normal's h(A) = m_x cos A + m_y sin A and 1 /
+// m_z, with masks of the columns where m_z > 0 (a lower bound), < 0 (an upper one) or = 0.
+inline void edgeBounds(__m128 h, __m128 inv_mz, __m128 lower, __m128 upper, __m128 flat,
+                       __m128 neg_margin, __m128* lo, __m128* hi) {
+  const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  // h + m_z tan E >= -margin  <=>  tan E >= or <= (-margin - h) / m_z.
+  const __m128 bound = _mm_mul_ps(_mm_sub_ps(neg_margin, h), inv_mz);
+  *lo = _mm_max_ps(*lo, _mm_or_ps(_mm_and_ps(lower, bound), _mm_andnot_ps(lower, *lo)));
+  *hi = _mm_min_ps(*hi, _mm_or_ps(_mm_and_ps(upper, bound), _mm_andnot_ps(upper, *hi)));
+  // A flat edge (m_z = 0) keeps a column only if h >= -margin.
+  const __m128 out = _mm_and_ps(flat, _mm_cmplt_ps(h, neg_margin));
+  *lo = _mm_or_ps(_mm_and_ps(out, inf), _mm_andnot_ps(out, *lo));
+}
+
+inline void ColumnRaster::referenceBounds(__m128 ca, __m128 sa, __m128 margin, __m128* lo,
+                                          __m128* hi) const {
+  const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  const __m128 neg_margin = _mm_sub_ps(_mm_setzero_ps(), margin);
+  *lo = _mm_sub_ps(_mm_setzero_ps(), inf);
+  *hi = inf;
+  for (int k = 0; k < 3; ++k) {
+    edgeBounds(_mm_add_ps(_mm_mul_ps(mx_[k], ca), _mm_mul_ps(my_[k], sa)), inv_mz_[k], lower_[k],
+               upper_[k], flat_[k], neg_margin, lo, hi);
+  }
+}
+
+inline void ColumnRaster::columnBounds(int base, __m128 ca, __m128 sa, __m128* lo,
+                                       __m128* hi) const {
+  const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  const __m128 zero = _mm_setzero_ps(), neg_margin = _mm_sub_ps(zero, edge_margin_);
+  *lo = _mm_sub_ps(zero, inf);
+  *hi = inf;
+  const __m128 ox = _mm_loadu_ps(motion_->originX(base));
+  const __m128 oy = _mm_loadu_ps(motion_->originY(base));
+  const __m128 oz = _mm_loadu_ps(motion_->originZ(base));
+  for (int k = 0; k < 3; ++k) {
+    // m - o x e, each column's own.
+    const __m128 mx =
+        _mm_sub_ps(mx_[k], _mm_sub_ps(_mm_mul_ps(oy, ez_[k]), _mm_mul_ps(oz, ey_[k])));
+    const __m128 my =
+        _mm_sub_ps(my_[k], _mm_sub_ps(_mm_mul_ps(oz, ex_[k]), _mm_mul_ps(ox, ez_[k])));
+    const __m128 mz =
+        _mm_sub_ps(mz_[k], _mm_sub_ps(_mm_mul_ps(ox, ey_[k]), _mm_mul_ps(oy, ex_[k])));
+    const __m128 flat = _mm_cmpeq_ps(mz, zero);
+    // 1 / m_z where it is not 0 (there the bound is not used).
+    const __m128 inv_mz = _mm_andnot_ps(flat, _mm_div_ps(_mm_set1_ps(1.0f), mz));
+    edgeBounds(_mm_add_ps(_mm_mul_ps(mx, ca), _mm_mul_ps(my, sa)), inv_mz, _mm_cmpgt_ps(mz, zero),
+               _mm_cmplt_ps(mz, zero), flat, neg_margin, lo, hi);
+  }
 }
 
 template <class F>

@@ -348,7 +348,8 @@ class MeshWalk {
                               [&] { return columnNormal(col, triangle); });
       };
       if (beams_.grid().columnRaster()) {
-        ColumnRaster(beams_, s.a, s.b, s.c, rasterWidening(s, e.near), spread_.shift, spread_.turn)
+        (motion_ ? ColumnRaster(beams_, s.a, s.b, s.c, *motion_, e.near)
+                 : ColumnRaster(beams_, s.a, s.b, s.c))
             .forEachCandidate(beams_, e.rect, test);
       } else if (motion_) {
         forEachInWindow(s, e.rect, test);
@@ -360,20 +361,6 @@ class MeshWalk {
         }
       }
     }
-  }
-
-  // How far the column raster widens a triangle's edge tests for a sweep's block (ColumnRaster):
-  // sin(turn + asin(shift / near)), near the larger of the leaf's and the triangle's plane's
-  // distance (lowered for the rounding), so that a leaf around the sensor (a room's walls) still
-  // rasterises. 0 for a scan from one pose.
-  double rasterWidening(const SensorTriangle& s, double leaf_near) const {
-    if (!motion_) return 0;
-    const Eigen::Vector3d n = (s.b - s.a).cross(s.c - s.a);
-    const double plane = std::abs(n.dot(s.a)) / n.norm() * (1 - 1e-9);
-    const double near = std::max(leaf_near, std::isfinite(plane) ? plane : 0.0);
-    const double shift = spread_.shift;
-    if (!(near > 2 * shift)) return 1;  // every beam of the rect
-    return std::sin(std::min(M_PI / 2, spread_.turn + std::asin(shift / near)));
   }
 
   // The beams of rect in the triangle's own window (the view of its sensor-frame box, widened by
