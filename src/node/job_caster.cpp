@@ -11,6 +11,9 @@ JobCaster::JobCaster(Context context)
       link_poses_(*context_.scene, [this](const std::string& frame, const ros::Time& t,
                                           Eigen::Isometry3d* pose, std::string* error) {
         return context_.tf->lookup(context_.fixed_frame, frame, t, pose, error);
+      },
+      [this](const std::string& frame) {
+        return context_.tf->isStatic(context_.fixed_frame, frame);
       }) {}
 
 bool JobCaster::ready(const ScanJob& job, const ros::Time& now) {

@@ -24,6 +24,10 @@ namespace laser_raycast {
 using TimedPoseLookup = std::function<bool(const std::string& frame, const ros::Time& t,
                                            Eigen::Isometry3d* pose, std::string* error)>;
 
+// Whether `frame`'s pose in the fixed frame is the same at every time (TF holds only static
+// transforms between them): then a scan's several times take it from one look-up.
+using StaticFrameCheck = std::function<bool(const std::string& frame)>;
+
 // The link poses of one scan.
 struct LinkPosesAt {
   std::vector<core::FramePoses> frames;  // one per time asked for
@@ -38,11 +42,14 @@ class LinkPoses {
   // far fewer, the times of the scans still queued).
   static constexpr std::size_t kMaxTimes = 1024;
 
-  // scene must outlive this.
-  LinkPoses(const core::Scene& scene, TimedPoseLookup lookup);
+  // scene must outlive this. Without is_static every frame is looked up at every time.
+  LinkPoses(const core::Scene& scene, TimedPoseLookup lookup, StaticFrameCheck is_static = {});
 
   // Every frame at each of `times`: looked up at a time not seen since it was last forgotten,
-  // taken from here otherwise.
+  // taken from here otherwise. When two or more times are new, a frame that is_static says is
+  // static is looked up at the first of them only, and its pose (or failure) copied to the rest:
+  // a rotating scan's sweep samples of a warehouse's hundreds of fixed links cost one look-up
+  // each, not one a sample.
   LinkPosesAt at(const std::vector<ros::Time>& times);
   // Forgets the times before t.
   void forgetBefore(const ros::Time& t);
@@ -58,10 +65,13 @@ class LinkPoses {
     std::string first_error;
   };
 
-  const Entry& entry(const ros::Time& t);
+  // The entry at t, looked up unless already here; `copy` (if not null) gives the frames marked in
+  // `fixed` instead of looking them up.
+  const Entry& entry(const ros::Time& t, const std::vector<char>& fixed, const Entry* copy);
 
   const core::Scene& scene_;
   TimedPoseLookup lookup_;
+  StaticFrameCheck is_static_;
   std::map<ros::Time, Entry> entries_;
   std::uint64_t lookups_ = 0;
 };

@@ -26,6 +26,12 @@ class TfSource {
   // TF has no chain between them (TF's message in *error).
   std::optional<ros::Time> latest(const std::string& target, const std::string& source,
                                   std::string* error) const;
+  // Whether TF has a chain target <- source made of static transforms only (the same at every
+  // time).
+  bool isStatic(const std::string& target, const std::string& source) const {
+    const std::optional<ros::Time> t = latest(target, source, nullptr);
+    return t && t->isZero();
+  }
   // Whether target <- source can serve a scan whose last beam is at `needed` (tf_timing.h). The
   // same frame twice is always covered.
   FrameAvailability availability(const std::string& target, const std::string& source,

@@ -2,7 +2,9 @@
 // roscore: a look-up that counts its calls and places each frame where the test computes it.
 // Sensors due at one stamp with different sample times (an instantaneous scan and a rotating one,
 // as in the demo) are separate jobs; each link is looked up once per time for all of them.
+#include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
+#include <tf2/buffer_core.h>
 
 #include <cmath>
 #include <map>
@@ -13,6 +15,7 @@
 
 #include "link_poses.h"
 #include "scan_queue.h"
+#include "tf_source.h"
 #include "tf_timing.h"
 
 namespace laser_raycast_test {
@@ -31,18 +34,30 @@ struct Rig {
     for (const char* name : {"base", "arm", "door"}) scene.addFrame(name);
   }
 
-  LinkPoses poses() {
-    return LinkPoses(scene, [this](const std::string& frame, const ros::Time& t,
-                                   Eigen::Isometry3d* pose, std::string* error) {
-      ++calls[{frame, t}];
-      if (broken.count(frame)) {
-        *error = "no transform for " + frame;
-        return false;
-      }
-      pose->setIdentity();
-      pose->translation().x() = index(frame) + t.toSec();
-      return true;
-    });
+  // A static frame (in `fixed`) is at x = its index at every time; with check_static, LinkPoses
+  // is told which frames those are.
+  LinkPoses poses(bool check_static = false) {
+    laser_raycast::StaticFrameCheck check;
+    if (check_static) {
+      check = [this](const std::string& frame) {
+        ++static_checks;
+        return fixed.count(frame) > 0;
+      };
+    }
+    return LinkPoses(
+        scene,
+        [this](const std::string& frame, const ros::Time& t, Eigen::Isometry3d* pose,
+               std::string* error) {
+          ++calls[{frame, t}];
+          if (broken.count(frame)) {
+            *error = "no transform for " + frame;
+            return false;
+          }
+          pose->setIdentity();
+          pose->translation().x() = index(frame) + (fixed.count(frame) ? 0.0 : t.toSec());
+          return true;
+        },
+        check);
   }
 
   int index(const std::string& frame) const {
@@ -59,7 +74,8 @@ struct Rig {
 
   laser_raycast::core::Scene scene;
   std::map<std::pair<std::string, ros::Time>, int> calls;
-  std::set<std::string> broken;
+  std::set<std::string> broken, fixed;
+  int static_checks = 0;
 };
 
 // The demo's case: an instantaneous sensor and a rotating one (0.1 s sweep, sampled every 10 ms)
@@ -103,6 +119,66 @@ TEST(LinkPoses, SensorsDueAtOneStampLookEachLinkUpOncePerTime) {
   EXPECT_EQ(rig.totalCalls(), 3u * 11u);
   poses.at({stamp + ros::Duration(0.2)});
   EXPECT_EQ(rig.totalCalls(), 3u * 12u);
+}
+
+// A rotating scan's static frames (a warehouse's fixed racks) are looked up at its first new time
+// only and copied to the others, failures included; the moving ones at every time. The poses are
+// the ones a look-up at each time gives. An instantaneous scan (one new time) asks nothing more.
+TEST(LinkPoses, StaticFramesAreLookedUpOncePerScan) {
+  for (const bool broken_static : {false, true}) {
+    Rig rig;
+    rig.fixed = {"base", "door"};
+    if (broken_static) rig.broken = {"door"};
+    LinkPoses poses = rig.poses(true);
+    const std::vector<ros::Time> rotating =
+        laser_raycast::sampleTimes(at(7), ros::Duration(0.1), ros::Duration(0.01));
+    const LinkPosesAt r = poses.at(rotating);
+    EXPECT_EQ(rig.static_checks, 3);
+    EXPECT_EQ((rig.calls[{"base", at(7)}]), 1);
+    EXPECT_EQ((rig.calls[{"door", at(7)}]), 1);
+    EXPECT_EQ(rig.totalCalls(), 2u + 11u);  // base and door once, arm at each time
+    EXPECT_EQ(poses.lookups(), 2u + 11u);
+    ASSERT_EQ(r.frames.size(), 11u);
+    for (std::size_t j = 0; j < rotating.size(); ++j) {
+      EXPECT_DOUBLE_EQ(r.frames[j].pose[0].translation().x(), 0.0);
+      EXPECT_DOUBLE_EQ(r.frames[j].pose[1].translation().x(), 1 + rotating[j].toSec());
+      EXPECT_TRUE(r.frames[j].valid[0] && r.frames[j].valid[1]);
+      EXPECT_EQ(bool(r.frames[j].valid[2]), !broken_static);
+      if (!broken_static) EXPECT_DOUBLE_EQ(r.frames[j].pose[2].translation().x(), 2.0);
+    }
+    EXPECT_EQ(r.failures, broken_static ? 11u : 0u);
+    EXPECT_EQ(r.first_error, broken_static ? "no transform for door" : "");
+    // One new time: looked up as before, no static check.
+    poses.at({at(8)});
+    EXPECT_EQ(rig.static_checks, 3);
+    EXPECT_EQ(rig.totalCalls(), 2u + 11u + 3u);
+  }
+}
+
+// TF says which chains are static, as the node asks it for LinkPoses: a chain of /tf_static
+// transforms only is; one with a transform from /tf, or none at all, is not.
+TEST(TfSource, AChainOfStaticTransformsOnlyIsStatic) {
+  tf2::BufferCore buffer;
+  auto add = [&](const std::string& parent, const std::string& child, double stamp, bool fixed) {
+    geometry_msgs::TransformStamped t;
+    t.header.frame_id = parent;
+    t.header.stamp = ros::Time(stamp);
+    t.child_frame_id = child;
+    t.transform.rotation.w = 1;
+    buffer.setTransform(t, "test", fixed);
+  };
+  add("map", "rack", 1, true);
+  add("rack", "shelf", 1, true);
+  add("map", "base", 1, false);
+  add("map", "base", 2, false);
+  add("base", "arm", 1, true);
+  const laser_raycast::TfSource tf(buffer);
+  EXPECT_TRUE(tf.isStatic("map", "rack"));
+  EXPECT_TRUE(tf.isStatic("map", "shelf"));
+  EXPECT_TRUE(tf.isStatic("map", "map"));
+  EXPECT_FALSE(tf.isStatic("map", "base"));
+  EXPECT_FALSE(tf.isStatic("map", "arm"));    // static below a moving frame
+  EXPECT_FALSE(tf.isStatic("map", "wheel"));  // no such frame
 }
 
 // A link without a transform is missing from the scan; every time it is needed at is a failed
