@@ -15,7 +15,7 @@ namespace {
 
 constexpr char kRequestMagic[4] = {'L', 'R', 'M', 'Q'};
 constexpr char kReplyMagic[4] = {'L', 'R', 'M', 'I'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;
 constexpr std::size_t kHeaderBytes = 12;          // magic, version, status (or path length)
 constexpr std::uint32_t kMaxPathBytes = 1 << 16;  // far beyond PATH_MAX
 
@@ -109,13 +109,102 @@ Status readReplyHeader(Reader* in) {
   return static_cast<Status>(status);
 }
 
+// The surface attributes' bytes (writeMesh's layout), empty for none.
+std::string surfaceBytes(const core::SurfaceAttributes* surface) {
+  std::string out;
+  if (!surface) return out;
+  auto put = [&out](const void* data, std::size_t size) {
+    out.append(static_cast<const char*>(data), size);
+  };
+  const std::uint64_t counts[4] = {surface->colors.size(), surface->uvs.size(),
+                                   surface->normals.size(), surface->triangle_material.size()};
+  const auto materials = static_cast<std::uint32_t>(surface->materials.size());
+  put(counts, sizeof(counts));
+  put(&materials, sizeof(materials));
+  for (const Eigen::Vector3f& c : surface->colors) put(c.data(), 3 * sizeof(float));
+  for (const Eigen::Vector2f& uv : surface->uvs) put(uv.data(), 2 * sizeof(float));
+  for (const Eigen::Vector3f& n : surface->normals) put(n.data(), 3 * sizeof(float));
+  put(surface->triangle_material.data(), counts[3] * sizeof(std::uint32_t));
+  for (const core::SurfaceMaterial& m : surface->materials) {
+    const std::uint8_t has_diffuse = m.has_diffuse ? 1 : 0;
+    put(&has_diffuse, 1);
+    put(m.diffuse.data(), 3 * sizeof(double));
+    const std::uint32_t size[2] = {m.texture ? static_cast<std::uint32_t>(m.texture->width) : 0u,
+                                   m.texture ? static_cast<std::uint32_t>(m.texture->height) : 0u};
+    put(size, sizeof(size));
+    if (m.texture) put(m.texture->rgb.data(), m.texture->rgb.size());
+  }
+  return out;
+}
+
+template <typename Vector>
+void readVectors(Reader* in, std::uint64_t count, std::vector<Vector>* out, const char* what) {
+  constexpr std::size_t kBytes = Vector::SizeAtCompileTime * sizeof(typename Vector::Scalar);
+  if (count > in->remaining() / kBytes) {
+    throw SceneLoadError(std::string("the importer's reply is truncated (in ") + what + ")");
+  }
+  out->resize(count);
+  for (Vector& v : *out) in->read(v.data(), kBytes, what);
+}
+
+// The surface attributes of a mesh of `vertices` and `triangles`; null for none.
+std::shared_ptr<core::SurfaceAttributes> parseSurface(const std::string& bytes,
+                                                      std::uint64_t vertices,
+                                                      std::uint64_t triangles) {
+  if (bytes.empty()) return nullptr;
+  Reader in(bytes);
+  std::uint64_t counts[4];
+  in.read(counts, sizeof(counts), "the surface counts");
+  const auto materials = in.read<std::uint32_t>("the surface counts");
+  auto surface = std::make_shared<core::SurfaceAttributes>();
+  readVectors(&in, counts[0], &surface->colors, "the colours");
+  readVectors(&in, counts[1], &surface->uvs, "the texture coordinates");
+  readVectors(&in, counts[2], &surface->normals, "the normals");
+  if (counts[3] > in.remaining() / sizeof(std::uint32_t)) {
+    throw SceneLoadError("the importer's reply is truncated (in the triangles' materials)");
+  }
+  surface->triangle_material.resize(counts[3]);
+  in.read(surface->triangle_material.data(), counts[3] * sizeof(std::uint32_t),
+          "the triangles' materials");
+  for (std::uint32_t m = 0; m < materials; ++m) {
+    core::SurfaceMaterial material;
+    material.has_diffuse = in.read<std::uint8_t>("a material") != 0;
+    in.read(material.diffuse.data(), 3 * sizeof(double), "a material");
+    std::uint32_t size[2];
+    in.read(size, sizeof(size), "a material");
+    if (size[0] > 0 || size[1] > 0) {
+      const std::uint64_t bytes_needed = 3ull * size[0] * size[1];
+      if (bytes_needed > in.remaining()) {
+        throw SceneLoadError("the importer's reply is truncated (in a texture)");
+      }
+      auto texture = std::make_shared<core::Texture>();
+      texture->width = static_cast<int>(size[0]);
+      texture->height = static_cast<int>(size[1]);
+      texture->rgb.resize(bytes_needed);
+      in.read(texture->rgb.data(), bytes_needed, "a texture");
+      material.texture = std::move(texture);
+    }
+    surface->materials.push_back(std::move(material));
+  }
+  if (in.remaining() != 0) throw SceneLoadError("the importer's reply has trailing bytes");
+  try {
+    surface->validate(vertices, triangles);
+  } catch (const std::invalid_argument& e) {
+    throw SceneLoadError(std::string("the importer's reply has bad surface attributes: ") +
+                         e.what());
+  }
+  return surface;
+}
+
 mesh_file::MeshData parseMesh(Reader* in) {
   const auto vertices = in->read<std::uint64_t>("the vertex count");
   const auto triangles = in->read<std::uint64_t>("the triangle count");
+  const auto attributes = in->read<std::uint64_t>("the surface byte count");
   // The counts must match the bytes that came, before anything is allocated for them.
   const std::uint64_t remaining = in->remaining();
   if (vertices > remaining / kVertexBytes || triangles > remaining / kTriangleBytes ||
-      vertices * kVertexBytes + triangles * kTriangleBytes != remaining) {
+      attributes > remaining ||
+      vertices * kVertexBytes + triangles * kTriangleBytes + attributes != remaining) {
     throw SceneLoadError("the importer's reply does not hold the " + std::to_string(vertices) +
                          " vertices and " + std::to_string(triangles) + " triangles it announces");
   }
@@ -124,6 +213,8 @@ mesh_file::MeshData parseMesh(Reader* in) {
   mesh.triangles.resize(triangles);
   in->read(mesh.vertices.data(), vertices * kVertexBytes, "the vertices");
   in->read(mesh.triangles.data(), triangles * kTriangleBytes, "the triangles");
+  std::string surface(attributes, '\0');
+  in->read(surface.data(), attributes, "the surface attributes");
   for (const Eigen::Vector3d& v : mesh.vertices) {
     if (!v.allFinite()) throw SceneLoadError("the importer's reply has a non-finite vertex");
   }
@@ -134,6 +225,7 @@ mesh_file::MeshData parseMesh(Reader* in) {
       }
     }
   }
+  mesh.surface = parseSurface(surface, vertices, triangles);
   return mesh;
 }
 
@@ -148,10 +240,14 @@ bool writeRequest(int fd, const std::string& path, const Eigen::Vector3d& scale)
 bool writeMesh(int fd, const mesh_file::MeshData& mesh) {
   const std::uint64_t vertices = mesh.vertices.size();
   const std::uint64_t triangles = mesh.triangles.size();
+  const std::string surface = surfaceBytes(mesh.surface.get());
+  const std::uint64_t attributes = surface.size();
   return writeHeader(fd, kReplyMagic, static_cast<std::uint32_t>(Status::kMesh)) &&
          writeAll(fd, &vertices, sizeof(vertices)) && writeAll(fd, &triangles, sizeof(triangles)) &&
+         writeAll(fd, &attributes, sizeof(attributes)) &&
          writeAll(fd, mesh.vertices.data(), vertices * kVertexBytes) &&
-         writeAll(fd, mesh.triangles.data(), triangles * kTriangleBytes);
+         writeAll(fd, mesh.triangles.data(), triangles * kTriangleBytes) &&
+         writeAll(fd, surface.data(), surface.size());
 }
 
 bool writeFailure(int fd, Status status, const char* message) {
@@ -189,16 +285,17 @@ std::optional<std::uint64_t> replySize(const std::string& prefix) {
     if (!in.has(sizeof(std::uint32_t))) return std::nullopt;
     return kHeaderBytes + sizeof(std::uint32_t) + in.read<std::uint32_t>("the message length");
   }
-  if (!in.has(2 * sizeof(std::uint64_t))) return std::nullopt;
+  if (!in.has(3 * sizeof(std::uint64_t))) return std::nullopt;
   const auto vertices = in.read<std::uint64_t>("the vertex count");
   const auto triangles = in.read<std::uint64_t>("the triangle count");
+  const auto attributes = in.read<std::uint64_t>("the surface byte count");
   // Counts that no reply could hold (their bytes would overflow) are garbage.
   constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max() / 64;
-  if (vertices > kMax / kVertexBytes || triangles > kMax / kTriangleBytes) {
+  if (vertices > kMax / kVertexBytes || triangles > kMax / kTriangleBytes || attributes > kMax) {
     throw SceneLoadError("the importer's reply announces an impossible size");
   }
-  return kHeaderBytes + 2 * sizeof(std::uint64_t) + vertices * kVertexBytes +
-         triangles * kTriangleBytes;
+  return kHeaderBytes + 3 * sizeof(std::uint64_t) + vertices * kVertexBytes +
+         triangles * kTriangleBytes + attributes;
 }
 
 Reply parseReply(const std::string& bytes) {

@@ -6,7 +6,12 @@
 //
 //   request:  "LRMQ" u32 version, u32 N, N bytes (the file's path), 3 double (the scale)
 //   reply:    "LRMI" u32 version, u32 status, then
-//     status kMesh:  u64 V, u64 T, V x 3 double (vertices), T x 3 u32 (triangles' vertex indices)
+//     status kMesh:  u64 V, u64 T, u64 A, V x 3 double (vertices), T x 3 u32 (triangles' vertex
+//                    indices), A bytes of surface attributes (none if A is 0):
+//                      u64 C, u64 U, u64 N, u64 M, u32 K, C x 3 float (colours), U x 2 float
+//                      (texture coordinates), N x 3 float (normals), M x u32 (triangles'
+//                      materials), then K materials: u8 has_diffuse, 3 double (diffuse),
+//                      u32 width, u32 height, width x height x 3 bytes (RGB texture; 0 x 0: none)
 //     otherwise:     u32 N, N bytes (the message)
 #pragma once
 

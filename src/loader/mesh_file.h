@@ -3,10 +3,12 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
+#include "laser_raycast/core/surface.h"
 #include "laser_raycast/loader/errors.h"
 #include "laser_raycast/loader/package_resolver.h"
 
@@ -23,6 +25,8 @@ std::string resolveUri(const std::string& uri, const std::string& base_dir,
 struct MeshData {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<core::TriangleIndices> triangles;
+  // Colours, texture coordinates, normals and materials, when the file has any (assimp formats).
+  std::shared_ptr<core::SurfaceAttributes> surface;
 };
 
 }  // namespace mesh_file

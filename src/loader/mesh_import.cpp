@@ -15,11 +15,16 @@
 #include <utility>
 #include <vector>
 
+#include "map_image.h"
+
 namespace laser_raycast {
 namespace mesh_file {
 namespace {
 
 namespace fs = std::filesystem;
+
+// A triangle's material while collecting: none (assimp's default material).
+constexpr std::uint32_t kNoMaterial = 0xFFFFFFFFu;
 
 // ---------------------------------------------------------------------------------------------------
 // The stages of importMeshInProcess, in order: read, check the vertices, post-process, then collect
@@ -119,9 +124,138 @@ Eigen::Affine3d toAffine(const aiNode& node) {
   return t;
 }
 
+// ---------------------------------------------------------------------------------------------------
+// Surface attributes: per-vertex colours, texture coordinates and normals, and the materials'
+// diffuse colours and textures, collected beside the triangles.
+
+// What the sub-meshes gave so far: a per-vertex array is kept only if every sub-mesh has it
+// (texture coordinates: if any has them; the others get (0, 0), and their materials' textures are
+// then sampled there).
+struct SurfaceCollector {
+  core::SurfaceAttributes surface;
+  bool all_colors = true, all_normals = true, any_uvs = false;
+  std::vector<int> material_slot;  // assimp material index -> index in surface.materials, -1: none
+};
+
+// An RGB texture from a PNG file (grey and alpha are converted); null if it cannot be read: a
+// mesh whose texture is missing or in another format still loads, with its material's colour.
+std::shared_ptr<const core::Texture> readTexture(const std::string& mesh_path,
+                                                 const aiMaterial& material) {
+  aiString name;
+  if (material.GetTexture(aiTextureType_DIFFUSE, 0, &name) != AI_SUCCESS) return nullptr;
+  std::string file = name.C_Str();
+  if (file.empty() || file[0] == '*') return nullptr;  // embedded: not read
+  if (file.rfind("file://", 0) == 0) file = file.substr(7);
+  fs::path path(file);
+  if (path.is_relative()) path = fs::path(mesh_path).parent_path() / path;
+  try {
+    const map_image::Image image = map_image::read(path.string());
+    auto texture = std::make_shared<core::Texture>();
+    texture->width = image.width;
+    texture->height = image.height;
+    const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
+    texture->rgb.resize(3 * pixels);
+    for (std::size_t p = 0; p < pixels; ++p) {
+      for (int c = 0; c < 3; ++c) {
+        const int channel = image.colors == 3 ? c : 0;
+        const double value = image.samples[p * image.channels() + channel];
+        texture->rgb[3 * p + c] =
+            static_cast<std::uint8_t>(std::lround(255.0 * value / image.maxval));
+      }
+    }
+    return texture;
+  } catch (const SceneLoadError&) {
+    return nullptr;
+  }
+}
+
+// The index in surface.materials of assimp's material m, added at its first use; -1 for assimp's
+// default material (the file named none).
+int materialSlot(const aiScene& scene, unsigned m, const std::string& path,
+                 SurfaceCollector* collector) {
+  if (m >= scene.mNumMaterials) return -1;
+  if (collector->material_slot.size() < scene.mNumMaterials) {
+    collector->material_slot.assign(scene.mNumMaterials, -2);
+  }
+  int& slot = collector->material_slot[m];
+  if (slot != -2) return slot;
+  const aiMaterial& material = *scene.mMaterials[m];
+  aiString name;
+  if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
+      std::string(name.C_Str()) == AI_DEFAULT_MATERIAL_NAME) {
+    return slot = -1;
+  }
+  core::SurfaceMaterial out;
+  aiColor3D diffuse;
+  if (material.Get(AI_MATKEY_COLOR_DIFFUSE, diffuse) == AI_SUCCESS &&
+      std::isfinite(diffuse.r) && std::isfinite(diffuse.g) && std::isfinite(diffuse.b)) {
+    out.has_diffuse = true;
+    out.diffuse = Eigen::Vector3d(diffuse.r, diffuse.g, diffuse.b).cwiseMax(0.0).cwiseMin(1.0);
+  }
+  out.texture = readTexture(path, material);
+  collector->surface.materials.push_back(std::move(out));
+  return slot = static_cast<int>(collector->surface.materials.size()) - 1;
+}
+
+// One sub-mesh's per-vertex attributes, normals turned by `turn` (the inverse transpose of the
+// placement's linear part).
+void appendVertexAttributes(const aiMesh& mesh, const Eigen::Matrix3d& turn,
+                            SurfaceCollector* collector) {
+  core::SurfaceAttributes& s = collector->surface;
+  collector->all_colors = collector->all_colors && mesh.mColors[0];
+  collector->all_normals = collector->all_normals && mesh.mNormals;
+  collector->any_uvs = collector->any_uvs || mesh.mTextureCoords[0];
+  for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+    if (mesh.mColors[0]) {
+      const aiColor4D& c = mesh.mColors[0][v];
+      s.colors.push_back(Eigen::Vector3f(c.r, c.g, c.b).cwiseMax(0.0f).cwiseMin(1.0f));
+    } else {
+      s.colors.push_back(Eigen::Vector3f::Ones());
+    }
+    if (mesh.mTextureCoords[0]) {
+      const aiVector3D& t = mesh.mTextureCoords[0][v];
+      s.uvs.push_back(Eigen::Vector2f(t.x, t.y));
+    } else {
+      s.uvs.push_back(Eigen::Vector2f::Zero());
+    }
+    Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+    if (mesh.mNormals) {
+      const aiVector3D& n = mesh.mNormals[v];
+      const Eigen::Vector3d turned = turn * Eigen::Vector3d(n.x, n.y, n.z);
+      if (turned.allFinite() && turned.norm() > 0) normal = turned.normalized().cast<float>();
+    }
+    s.normals.push_back(normal);
+  }
+}
+
+// The attributes, or null if the file has none worth keeping.
+std::shared_ptr<core::SurfaceAttributes> finishSurface(SurfaceCollector* collector) {
+  core::SurfaceAttributes& s = collector->surface;
+  if (!collector->all_colors) s.colors.clear();
+  if (!collector->all_normals) s.normals.clear();
+  if (!collector->any_uvs) s.uvs.clear();
+  const bool any_material = std::any_of(s.triangle_material.begin(), s.triangle_material.end(),
+                                        [](std::uint32_t m) { return m != kNoMaterial; });
+  if (!any_material) {
+    s.triangle_material.clear();
+    s.materials.clear();
+  } else {
+    // Triangles without a material get one without colour.
+    const auto none = static_cast<std::uint32_t>(s.materials.size());
+    s.materials.emplace_back();
+    for (std::uint32_t& m : s.triangle_material) {
+      if (m == kNoMaterial) m = none;
+    }
+  }
+  if (s.colors.empty() && s.normals.empty() && s.materials.empty()) return nullptr;
+  if (s.materials.empty()) s.uvs.clear();
+  return std::make_shared<core::SurfaceAttributes>(std::move(s));
+}
+
 // The triangles of one node's meshes, placed by to_link, appended to *out.
 void appendNodeMeshes(const aiScene& scene, const aiNode& node, const Eigen::Affine3d& to_link,
-                      MeshData* out) {
+                      const std::string& path, SurfaceCollector* collector, MeshData* out) {
+  const Eigen::Matrix3d turn = to_link.linear().inverse().transpose();
   // A mirroring transform turns triangles inside out: swap two corners to keep the front face.
   const bool flip = to_link.linear().determinant() < 0;
   for (unsigned i = 0; i < node.mNumMeshes; ++i) {
@@ -135,6 +269,8 @@ void appendNodeMeshes(const aiScene& scene, const aiNode& node, const Eigen::Aff
       const aiVector3D& p = mesh.mVertices[v];
       out->vertices.push_back(to_link * Eigen::Vector3d(p.x, p.y, p.z));
     }
+    appendVertexAttributes(mesh, turn, collector);
+    const int material = materialSlot(scene, mesh.mMaterialIndex, path, collector);
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
       if (face.mNumIndices != 3) continue;  // a point or a line
@@ -142,19 +278,23 @@ void appendNodeMeshes(const aiScene& scene, const aiNode& node, const Eigen::Aff
       for (int k = 0; k < 3; ++k) tri[k] = static_cast<std::uint32_t>(first + face.mIndices[k]);
       if (flip) std::swap(tri[1], tri[2]);
       out->triangles.push_back(tri);
+      collector->surface.triangle_material.push_back(
+          material >= 0 ? static_cast<std::uint32_t>(material) : kNoMaterial);
     }
   }
 }
 
 // Every node's triangles, depth first over the root's children with an explicit stack (deep graphs
 // must not overflow); meshes attached to the root itself get no node transform.
-MeshData collectTriangles(const aiScene& scene, const Eigen::Affine3d& scale_unit) {
+MeshData collectTriangles(const aiScene& scene, const Eigen::Affine3d& scale_unit,
+                          const std::string& path) {
   MeshData out;
+  SurfaceCollector collector;
   std::vector<std::pair<const aiNode*, Eigen::Affine3d>> stack;
   for (unsigned c = 0; c < scene.mRootNode->mNumChildren; ++c) {
     stack.emplace_back(scene.mRootNode->mChildren[c], Eigen::Affine3d::Identity());
   }
-  appendNodeMeshes(scene, *scene.mRootNode, scale_unit, &out);
+  appendNodeMeshes(scene, *scene.mRootNode, scale_unit, path, &collector, &out);
   while (!stack.empty()) {
     const auto [node, parent_transform] = stack.back();
     stack.pop_back();
@@ -162,11 +302,12 @@ MeshData collectTriangles(const aiScene& scene, const Eigen::Affine3d& scale_uni
     for (unsigned c = 0; c < node->mNumChildren; ++c) {
       stack.emplace_back(node->mChildren[c], transform);
     }
-    appendNodeMeshes(scene, *node, scale_unit * transform, &out);
+    appendNodeMeshes(scene, *node, scale_unit * transform, path, &collector, &out);
   }
   if (out.triangles.empty()) {
     throw SceneLoadError("it has no triangles (an empty mesh, or only points or lines)");
   }
+  out.surface = finishSurface(&collector);
   return out;
 }
 
@@ -177,7 +318,8 @@ MeshData importMeshInProcess(const std::string& path, const Eigen::Vector3d& sca
   checkVertices(readScene(&importer, path));
   const aiScene& scene = postProcess(&importer);
   const double unit = isCollada(scene, path) ? colladaUnit(path) : 1.0;
-  return collectTriangles(scene, Eigen::Affine3d(Eigen::Scaling(Eigen::Vector3d(scale * unit))));
+  return collectTriangles(scene, Eigen::Affine3d(Eigen::Scaling(Eigen::Vector3d(scale * unit))),
+                          path);
 }
 
 }  // namespace mesh_file

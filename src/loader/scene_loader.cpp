@@ -76,6 +76,7 @@ struct Element {
   std::string name;
   urdf::Pose origin;
   urdf::GeometrySharedPtr geometry;
+  urdf::MaterialSharedPtr material = nullptr;  // a visual's <material>, if any
 };
 
 std::string describe(const std::string& source, const std::string& link, const Element& e) {
@@ -176,7 +177,8 @@ LinkElements linkElements(const urdf::Link& link, GeometrySource geometry,
                           (!link.visual_array.empty() || dropped.count({link.name, "visual"}));
   if (use_visual) {
     for (const urdf::VisualSharedPtr& v : link.visual_array) {
-      out.elements.push_back({"visual", out.elements.size() + 1, v->name, v->origin, v->geometry});
+      out.elements.push_back(
+          {"visual", out.elements.size() + 1, v->name, v->origin, v->geometry, v->material});
     }
   } else {
     for (const urdf::CollisionSharedPtr& c : link.collision_array) {
@@ -241,7 +243,22 @@ struct PendingBody {
   core::Shape shape;
   std::string frame, label;
   Eigen::Isometry3d frame_from_body;
+  bool has_color = false;
+  Eigen::Vector3d color = Eigen::Vector3d::Zero();
 };
+
+// The colour of a visual's <material>: its <color>'s RGB. A material with only a <texture> has
+// none (urdfdom reports an absent <color> as opaque black; the texture is not read).
+bool materialColor(const urdf::Material* material, Eigen::Vector3d* color) {
+  if (!material) return false;
+  const urdf::Color& c = material->color;
+  const bool black = c.r == 0 && c.g == 0 && c.b == 0;
+  if (black && !material->texture_filename.empty()) return false;
+  *color = Eigen::Vector3d(c.r, c.g, c.b);
+  if (!color->allFinite()) return false;
+  *color = color->cwiseMax(0.0).cwiseMin(1.0);
+  return true;
+}
 
 // One element of a link as a body on the link's merged frame. Throws SceneLoadError with the
 // problem.
@@ -253,8 +270,10 @@ PendingBody elementBody(const Element& element, const std::string& link,
   if (!core::isValidPose(link_from_body)) {
     throw SceneLoadError("its origin is not a finite rigid transform");
   }
-  return {shapeOf(*element.geometry, load_mesh), placement.first, link,
-          placement.second * link_from_body};
+  PendingBody body{shapeOf(*element.geometry, load_mesh), placement.first, link,
+                   placement.second * link_from_body};
+  body.has_color = materialColor(element.material.get(), &body.color);
+  return body;
 }
 
 // The bodies of every link that is not ignored. A problem is an error, or under skip_bad_geometry
@@ -297,6 +316,8 @@ void commitBodies(std::vector<PendingBody> pending, const std::string& prefix,
     b.frame = scene->addFrame(prefix + body.frame);
     b.label = scene->addLabel(prefix + body.label);
     b.frame_from_body = body.frame_from_body;
+    b.has_color = body.has_color;
+    b.color = body.color;
     try {
       scene->addBody(std::move(b));
     } catch (const std::invalid_argument& e) {
@@ -395,8 +416,10 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
     const Clock::time_point start = Clock::now();
     std::shared_ptr<const core::Mesh> mesh;
     try {
-      mesh = std::make_shared<const core::Mesh>(std::move(data.vertices), std::move(data.triangles),
-                                                bvh);
+      auto built = std::make_shared<core::Mesh>(std::move(data.vertices),
+                                                std::move(data.triangles), bvh);
+      built->setSurface(std::move(data.surface));
+      mesh = std::move(built);
     } catch (const std::invalid_argument& e) {
       throw SceneLoadError(e.what());
     }

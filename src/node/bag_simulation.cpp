@@ -165,6 +165,7 @@ class Simulation {
   NodeParams params_;
   core::Scene scene_;
   std::vector<double> reflectivity_;
+  std::vector<char> reflectivity_fixed_;
   rosbag::Bag in_, out_;
   bool writing_ = false;
   TfSurvey survey_;
@@ -184,6 +185,7 @@ void Simulation::loadModels() {
   const auto no_param = [](const std::string&, std::string*, std::string*) { return false; };
   const std::string error = loadScene(params_, no_param, &scene_, &reflectivity_);
   if (!error.empty()) throw BagSimulationError(Kind::kScene, error);
+  reflectivity_fixed_ = labelReflectivityFixed(params_, scene_);
 }
 
 void Simulation::openBags() {
@@ -225,6 +227,7 @@ void Simulation::makeSensors() {
   JobCaster::Context context;
   context.scene = &scene_;
   context.reflectivity = &reflectivity_;
+  context.reflectivity_fixed = &reflectivity_fixed_;
   context.tf = &tf_;
   context.sensors = &sensors_;
   context.fixed_frame = params_.fixed_frame;

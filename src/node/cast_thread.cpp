@@ -19,6 +19,7 @@ void CastThread::takeScene() {
   JobCaster::Context context;
   context.scene = &scene->scene;
   context.reflectivity = &scene->reflectivity;
+  context.reflectivity_fixed = &scene->reflectivity_fixed;
   context.tf = context_.tf;
   context.sensors = context_.sensors;
   context.fixed_frame = context_.fixed_frame;

@@ -107,8 +107,8 @@ void JobCaster::castSensor(Sensor& sensor, const ScanJob& job) {
   const LinkPosesAt links = link_poses_.at(job.times);
   sensor.monitor().lookupFailures(links.failures);
   if (!acceptMissing(sensor, job, quiet, links)) return;
-  sensor.castAndPublish(*context_.scene, *context_.reflectivity, job.times, links.frames, poses,
-                        links.missing.size());
+  sensor.castAndPublish(*context_.scene, *context_.reflectivity, *context_.reflectivity_fixed,
+                        job.times, links.frames, poses, links.missing.size());
 }
 
 }  // namespace laser_raycast

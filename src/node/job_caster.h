@@ -29,6 +29,7 @@ class JobCaster {
   struct Context {
     const core::Scene* scene = nullptr;
     const std::vector<double>* reflectivity = nullptr;  // by label
+    const std::vector<char>* reflectivity_fixed = nullptr;  // by label (scene_source.h)
     const TfSource* tf = nullptr;
     std::vector<std::unique_ptr<Sensor>>* sensors = nullptr;
     std::string fixed_frame;

@@ -115,6 +115,7 @@ bool MapTopics::rebuild(std::size_t changed) {
     }
   }
   next->reflectivity = labelReflectivity(params_, next->scene);
+  next->reflectivity_fixed = labelReflectivityFixed(params_, next->scene);
   scene_->set(std::move(next));
   const Entry& e = entries_[changed];
   ROS_INFO(

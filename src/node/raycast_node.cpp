@@ -41,6 +41,7 @@ bool RaycastNode::init() {
     ROS_FATAL_STREAM(error);
     return false;
   }
+  base->reflectivity_fixed = labelReflectivityFixed(params_, base->scene);
   scene_ = std::make_unique<SharedScene>();
   scene_->set(base);
 

@@ -163,4 +163,10 @@ std::vector<double> labelReflectivity(const NodeParams& params, const core::Scen
   return reflectivity;
 }
 
+std::vector<char> labelReflectivityFixed(const NodeParams& params, const core::Scene& scene) {
+  std::vector<char> fixed;
+  for (const std::string& label : scene.labels()) fixed.push_back(params.reflectivity.count(label));
+  return fixed;
+}
+
 }  // namespace laser_raycast

@@ -28,5 +28,8 @@ std::string loadScene(const NodeParams& params, const UrdfParam& urdf_param, cor
 // The reflectivity of each of scene's labels: ~reflectivity's for those it names, else
 // ~default_reflectivity.
 std::vector<double> labelReflectivity(const NodeParams& params, const core::Scene& scene);
+// Per label, 1 where ~reflectivity names it: that value then takes precedence over the colours of
+// its meshes (core::sampleSurfaces).
+std::vector<char> labelReflectivityFixed(const NodeParams& params, const core::Scene& scene);
 
 }  // namespace laser_raycast

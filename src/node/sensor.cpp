@@ -101,6 +101,7 @@ bool Sensor::poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* p
 }
 
 void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>& reflectivity,
+                            const std::vector<char>& reflectivity_fixed,
                             const std::vector<ros::Time>& times,
                             const std::vector<core::FramePoses>& frames,
                             const std::vector<Eigen::Isometry3d>& poses,
@@ -121,7 +122,24 @@ void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>&
   }
   const double cast_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  measurement_model_.measure(scene, *result, reflectivity, &measured_);
+  const core::MeasurementConfig& output = cast_params_.scan.output;
+  if (cast_params_.returns.beam_samples > 1) {
+    // Divergent beams: the mode's single return (dual: the strongest), cast from the scan's first
+    // pose (a sweep's motion is not applied to them).
+    core::castReturns(&caster_, scene, frames.front(), poses.front(), cast_params_.scan.fan,
+                      cast_params_.scan.ringElevations(), cast_config_, cast_params_.returns,
+                      reflectivity, reflectivity_fixed, output.reflectance_from_color,
+                      output.surface_reflectance, &returns_);
+    measurement_model_.measure(scene, returns_.first, reflectivity, &measured_,
+                               &returns_.first_surface);
+  } else if (output.needsIncidence() && output.surface_reflectance) {
+    // A sweep's surfaces are sampled from its first pose (sampleSurfaces).
+    core::sampleSurfaces(scene, frames.front(), poses.front(), pattern_, *result,
+                         output.reflectance_from_color, reflectivity_fixed, &surface_);
+    measurement_model_.measure(scene, *result, reflectivity, &measured_, &surface_);
+  } else {
+    measurement_model_.measure(scene, *result, reflectivity, &measured_);
+  }
   if (cast_params_.planar()) {
     publishScan(times.front());
   } else {

@@ -66,8 +66,10 @@ class Sensor {
   bool poseAt(const ros::Time& t, const TfSource& tf, Eigen::Isometry3d* pose, std::string* why,
               bool* from_tf, std::uint64_t* tf_failures);
   // Casts the scan whose pose samples are at `times`, from the frames and sensor poses at each,
-  // and sends it to its output. missing_links: link transforms left out of it.
+  // and sends it to its output. missing_links: link transforms left out of it. reflectivity and
+  // reflectivity_fixed are by label (scene_source.h).
   void castAndPublish(const core::Scene& scene, const std::vector<double>& reflectivity,
+                      const std::vector<char>& reflectivity_fixed,
                       const std::vector<ros::Time>& times,
                       const std::vector<core::FramePoses>& frames,
                       const std::vector<Eigen::Isometry3d>& poses, std::size_t missing_links);
@@ -95,6 +97,8 @@ class Sensor {
   core::Caster caster_;
   core::MeasurementModel measurement_model_;
   core::MeasuredScan measured_;
+  core::PulseReturns returns_;    // with divergent beams (beam_samples > 1)
+  core::SurfaceSamples surface_;  // the surfaces' reflectance and incidence, when intensity is on
   std::vector<double> column_times_;  // s after the stamp, per azimuth column (rotating)
 
   std::unique_ptr<ScanOutput> output_;

@@ -88,11 +88,25 @@ void readOutput(ParamReader* r, core::ScanSpec* scan) {
   if (seed < 0) r->fail("noise_seed", "must be >= 0, got " + std::to_string(seed));
   out.noise_seed = static_cast<std::uint64_t>(std::max(seed, 0));
   out.intensity = r->choice("intensity", out.intensity, kIntensityNames);
+  out.surface_reflectance = r->boolean("surface_reflectance", out.surface_reflectance);
+  out.reflectance_from_color = r->number("reflectance_from_color", out.reflectance_from_color, "");
+  out.detection_range = r->number("detection_range", out.detection_range, "m");
+  out.detection_reflectivity =
+      r->number("detection_reflectivity", out.detection_reflectivity, "");
   out.range_bias = r->number("range_bias", out.range_bias, "m");
   out.range_resolution = r->number("range_resolution", out.range_resolution, "m");
   out.dropout_probability = r->number("dropout_probability", out.dropout_probability, "");
   scan->method = r->choice("method", scan->method, core::kTriangleMethodNames);
   scan->cull_backfaces = r->boolean("cull_backfaces", scan->cull_backfaces);
+}
+
+// Beam divergence and returns (core/returns.h).
+void readReturns(ParamReader* r, core::ReturnsConfig* returns) {
+  returns->beam_divergence = r->number("beam_divergence", returns->beam_divergence, "rad");
+  returns->beam_samples = r->integer("beam_samples", returns->beam_samples, "");
+  returns->return_mode = r->choice("return_mode", returns->return_mode, core::kReturnModeNames);
+  returns->min_return_separation =
+      r->number("min_return_separation", returns->min_return_separation, "m");
 }
 
 void readRate(ParamReader* r, SensorParams* s) {
@@ -184,6 +198,7 @@ void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::st
   const char* beams_from = readFan(r, &s->scan.fan);
   readElevations(r, &s->scan);
   readOutput(r, &s->scan);
+  readReturns(r, &s->returns);
   readRate(r, s);
   readSweep(r, s, warnings);
   readPoseSource(r, s);
@@ -193,6 +208,11 @@ void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::st
       s->scan.validate();
     } catch (const std::invalid_argument& e) {
       failWithCoreMessage(r, e.what(), beams_from);
+    }
+    try {
+      s->returns.validate();
+    } catch (const std::invalid_argument& e) {
+      r->failWith(r->prefix() + e.what());
     }
   }
   // The layout's integer fields must hold every ring number and point time of the scan.

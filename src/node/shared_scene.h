@@ -17,6 +17,7 @@ namespace laser_raycast {
 struct CastScene {
   core::Scene scene;
   std::vector<double> reflectivity;  // by label
+  std::vector<char> reflectivity_fixed;  // by label: labelReflectivityFixed (scene_source.h)
 };
 
 class SharedScene {

@@ -18,6 +18,7 @@
 #include "command_line.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/measurement_model.h"
+#include "laser_raycast/core/returns.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/kinematics.h"
 #include "laser_raycast/loader/map_file.h"
@@ -53,6 +54,11 @@ struct Args {
   int repeat = 0;
   int threads = core::CastConfig().threads;  // 0: every core
   bool rings = false;  // --elevations given: one fan per elevation, and the ring columns
+  core::ReturnsConfig returns;  // divergent beams (core/returns.h); 1 sample: the ideal ray
+  // Dual returns: a second row for a beam's last return, and the return column.
+  bool dual() const {
+    return returns.beam_samples > 1 && returns.return_mode == core::ReturnMode::kDual;
+  }
 };
 
 std::string formatNumber(double value) {
@@ -189,6 +195,24 @@ po::options_description flags(Args* args) {
       repeated("NAME=VALUE ...", [args](const std::string& v) { parseJoint(v, &args->joints); })
           ->multitoken(),
       "joint values (rad or m; 0 if not given): several after one --joint, or one each");
+  add("beam-divergence", number("--beam-divergence", "RAD", &args->returns.beam_divergence),
+      "full angle of a beam's footprint (with --beam-samples > 1)");
+  add("beam-samples", count("--beam-samples", &args->returns.beam_samples),
+      "sub-rays a beam (default 1: the ideal ray)");
+  add("return-mode",
+      single("NAME",
+             [args](const std::string& v) {
+               if (!core::kReturnModeNames.parse(v, &args->returns.return_mode)) {
+                 throw ArgError("--return-mode: " + core::kReturnModeNames.notOneOf(v));
+               }
+             }),
+      ("one of " + core::kReturnModeNames.list() +
+       " (default strongest); dual prints a beam's last return as a second row, with a return "
+       "column (1 strongest, 2 last)")
+          .c_str());
+  add("min-return-separation",
+      number("--min-return-separation", "M", &args->returns.min_return_separation),
+      "sub-ray hits closer in range merge into one return (default 0 m)");
   add("repeat", count("--repeat", &args->repeat),
       "cast N more times after loading (the whole path) and print the median cast time of a "
       "scan to stderr, after the load's times and the meshes' memory per triangle");
@@ -244,6 +268,11 @@ Args parseArgs(int argc, char** argv, bool* help) {
     args.mesh_import.validate("--mesh-import-max-memory-mb:", "--mesh-import-timeout:");
   } catch (const std::invalid_argument& e) {
     throw ArgError(e.what());
+  }
+  try {
+    args.returns.validate();
+  } catch (const std::invalid_argument& e) {
+    throw ArgError(underItsFlag(e.what(), ""));
   }
   laser_raycast::tools::checkSweepTimes(args.path, args.scan.fan);
   return args;
@@ -397,6 +426,7 @@ struct Casting {
   core::CastConfig config;
   core::Caster caster;
   double time_increment;  // s between two azimuth columns: > 0 for a rotating sweep
+  core::PulseReturns returns;  // with --beam-samples > 1
 };
 
 // The scan from sensor, at once or as a rotating sweep starting there; *ns, if given, the time of
@@ -409,6 +439,15 @@ const core::ScanResult& castFrom(const Args& args, const LoadedScene& loaded,
     samples = laser_raycast::tools::sweepSamples(args.path, sensor, loaded.poses, casting->pattern);
   }
   const auto t0 = std::chrono::steady_clock::now();
+  if (args.returns.beam_samples > 1) {
+    // Divergent beams, from the scan's first pose (a sweep's motion is not applied to them).
+    core::castReturns(&casting->caster, loaded.scene, loaded.poses, sensor, args.scan.fan,
+                      args.scan.ringElevations(), casting->config, args.returns, {}, {}, 1.0, true,
+                      &casting->returns);
+    const auto t1 = std::chrono::steady_clock::now();
+    if (ns) *ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
+    return casting->returns.first;
+  }
   const core::ScanResult& result =
       rotating ? casting->caster.castSweep(loaded.scene, samples, casting->pattern, casting->config,
                                            casting->time_increment)
@@ -461,7 +500,7 @@ void reportLoad(const LoadedScene& loaded) {
 std::string csvHeader(const Args& args, const Casting& casting) {
   return std::string(args.path.pose_column ? "pose," : "") +
          (args.rings ? "index,ring,elevation,angle,range,link" : "index,angle,range,link") +
-         (casting.time_increment > 0 ? ",time\n" : "\n");
+         (casting.time_increment > 0 ? ",time" : "") + (args.dual() ? ",return\n" : "\n");
 }
 
 // One CSV row per beam of the scan from the path's pose number `pose`, in beam order
@@ -471,7 +510,12 @@ std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& 
   std::string out;
   const core::ScanPattern& pattern = casting.pattern;
   const int azimuths = pattern.azimuthCount();
-  for (int i = 0; i < pattern.size(); ++i) {
+  for (int row = 0; row < (args.dual() ? 2 : 1) * pattern.size(); ++row) {
+    // Dual: each beam's strongest return, then its last where that is another.
+    const int i = args.dual() ? row / 2 : row;
+    const bool second = args.dual() && row % 2 == 1;
+    const core::ScanResult& beams = second ? casting.returns.second : result;
+    if (second && beams.body[i] < 0) continue;
     const int ring = i / azimuths;
     if (args.path.pose_column) out += std::to_string(pose) + ",";
     out += std::to_string(i) + ",";
@@ -479,14 +523,15 @@ std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& 
       out += std::to_string(ring) + "," + formatNumber(pattern.elevations()[ring]) + ",";
     }
     out += formatNumber(pattern.azimuth(i % azimuths)) + "," +
-           formatNumber(core::classifyRange(result.range[i], args.scan.output)) + ",";
-    if (result.body[i] >= 0) {
-      const std::string& label = loaded.scene.labels()[loaded.scene.bodies()[result.body[i]].label];
+           formatNumber(core::classifyRange(beams.range[i], args.scan.output)) + ",";
+    if (beams.body[i] >= 0) {
+      const std::string& label = loaded.scene.labels()[loaded.scene.bodies()[beams.body[i]].label];
       out += loaded.prefixed ? label.substr(label.find('/') + 1) : label;
     }
     if (casting.time_increment > 0) {
       out += "," + formatNumber(i % azimuths * casting.time_increment);  // castSweep's column time
     }
+    if (args.dual()) out += second ? ",2" : ",1";
     out += "\n";
   }
   return out;
@@ -512,7 +557,7 @@ int main(int argc, char** argv) {
     return kExitBadArguments;
   }
   Casting casting{args.scan.pattern(), args.scan.castConfig(), core::Caster(),
-                  laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment())};
+                  laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment()), {}};
   casting.config.threads = args.threads;
   // The path in order, each scan printed before the next is cast (the result is the caster's).
   print(csvHeader(args, casting));

@@ -459,5 +459,44 @@ TEST(CastScan, CorruptMeshExitsThreeAtTheMemoryBound) {
   expectBadScene(kData + "corrupt_mesh.urdf", "memory bound of 512 MB");
 }
 
+// A beam aimed just past a box edge 2 m in front of a wall 3 m away (test/data/surfaces/edge.urdf),
+// as seven sub-rays of 0.03 rad, and a second beam backwards that meets nothing.
+const std::string kStraddle = "--urdf " + kData +
+                              "surfaces/edge.urdf --sensor 0,0,0,0,0,0 --angle-min 0.002 "
+                              "--angle-max 3.002 --samples 2 --beam-divergence 0.03 "
+                              "--beam-samples 7 --return-mode dual";
+
+TEST(CastScan, DualReturnsAreTwoRowsWithTheReturnColumn) {
+  const CliRun run = runCli(kStraddle + " --min-return-separation 0.5");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = csvRows(run.out, "index,angle,range,link,return");
+  ASSERT_EQ(rows.size(), 3u) << run.out;
+  EXPECT_EQ(rows[0][0], "0");
+  EXPECT_NEAR(std::stod(rows[0][2]), 2.0, 1e-3);  // the box: the strongest
+  EXPECT_EQ(rows[0][3], "box");
+  EXPECT_EQ(rows[0][4], "1");
+  EXPECT_EQ(rows[1][0], "0");
+  EXPECT_NEAR(std::stod(rows[1][2]), 3.0, 1e-3);  // the wall: the last
+  EXPECT_EQ(rows[1][3], "base");
+  EXPECT_EQ(rows[1][4], "2");
+  EXPECT_EQ(rows[2][0], "1");
+  EXPECT_EQ(rows[2][2], "inf");
+}
+
+TEST(CastScan, ReturnsCloserThanTheSeparationAreOneMixedRow) {
+  const CliRun run = runCli(kStraddle + " --min-return-separation 1.5");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = csvRows(run.out, "index,angle,range,link,return");
+  ASSERT_EQ(rows.size(), 2u) << run.out;
+  EXPECT_GT(std::stod(rows[0][2]), 2.1);
+  EXPECT_LT(std::stod(rows[0][2]), 2.9);
+}
+
+TEST(CastScan, BadReturnSettingsNameTheirFlag) {
+  const CliRun run = runCli(kStraddle + " --min-return-separation -1");
+  EXPECT_NE(run.status, 0);
+  EXPECT_NE(run.err.find("--min-return-separation"), std::string::npos) << run.err;
+}
+
 }  // namespace
 }  // namespace laser_raycast_test

@@ -102,6 +102,7 @@ const std::map<std::string, std::string>& publicHeaderLayers() {
       {"mesh.h", "scene"},
       {"scene.h", "scene"},
       {"pose_samples.h", "scene"},
+      {"surface.h", "scene"},
       {"scan_pattern.h", "beams"},
       {"cast_config.h", "beams"},
       {"scan_result.h", "beams"},
@@ -109,6 +110,8 @@ const std::map<std::string, std::string>& publicHeaderLayers() {
       {"measurement_model.h", "measurement"},
       {"scan_spec.h", "measurement"},
       {"sensor_model.h", "measurement"},
+      {"surface_reflectance.h", "measurement"},
+      {"returns.h", "measurement"},
   };
   return kTable;
 }

@@ -276,7 +276,7 @@ class FakeImporter {
 };
 
 // The reply header (import_protocol.h) and status, as printf escapes (little-endian u32s).
-const std::string kReply = "printf 'LRMI\\001\\000\\000\\000";
+const std::string kReply = "printf 'LRMI\\002\\000\\000\\000";
 const std::string kMeshStatus = "\\000\\000\\000\\000";
 const std::string kZero64 = "\\000\\000\\000\\000\\000\\000\\000\\000";
 
@@ -337,24 +337,24 @@ TEST(MeshImportProcess, AMalformedReplyIsAnError) {
     std::string script;
     std::string error;
   };
-  // 3 vertices (72 zero bytes) and one triangle.
+  // 3 vertices (72 zero bytes), one triangle and no surface attributes.
   const std::string three_vertices =
       kReply + kMeshStatus +
-      "\\003\\000\\000\\000\\000\\000\\000\\000\\001\\000\\000\\000\\000\\000\\000\\000'; "
-      "head -c 72 /dev/zero; printf '";
+      "\\003\\000\\000\\000\\000\\000\\000\\000\\001\\000\\000\\000\\000\\000\\000\\000" +
+      kZero64 + "'; head -c 72 /dev/zero; printf '";
   const std::vector<Case> cases = {
       {"garbage", "printf 'garbage follows'", "does not start with its magic number"},
       {"nothing", "exit 0", "ended without a reply (exit status 0)"},
       {"nothing, status 7", "exit 7", "ended without a reply (exit status 7)"},
-      {"another version", "printf 'LRMI\\002\\000\\000\\000\\000\\000\\000\\000'",
-       "speaks version 2"},
+      {"another version", "printf 'LRMI\\003\\000\\000\\000\\000\\000\\000\\000'",
+       "speaks version 3"},
       {"an unknown status", kReply + "\\011\\000\\000\\000'", "unknown status 9"},
       {"truncated", kReply + kMeshStatus + "\\001\\000\\000'", "ended without a reply"},
       {"index out of range",
        three_vertices + "\\000\\000\\000\\000\\001\\000\\000\\000\\003\\000\\000\\000'",
        "vertex index out of range"},
       {"more than the bound (2^40 vertices)",
-       kReply + kMeshStatus + "\\000\\000\\000\\000\\000\\001\\000\\000" + kZero64 + "'",
+       kReply + kMeshStatus + "\\000\\000\\000\\000\\000\\001\\000\\000" + kZero64 + kZero64 + "'",
        "bound: "},
   };
   for (const Case& c : cases) {

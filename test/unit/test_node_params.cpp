@@ -75,6 +75,14 @@ const std::vector<std::string> kReadmeParameters = {"frame_id",
                                                     "range_bias",
                                                     "range_resolution",
                                                     "dropout_probability",
+                                                    "surface_reflectance",
+                                                    "reflectance_from_color",
+                                                    "detection_range",
+                                                    "detection_reflectivity",
+                                                    "beam_divergence",
+                                                    "beam_samples",
+                                                    "return_mode",
+                                                    "min_return_separation",
                                                     "sensors"};
 
 TEST(NodeParams, TheNodeReadsExactlyTheDocumentedParameters) {

@@ -9,6 +9,7 @@
 
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/enum_names.h"
+#include "laser_raycast/core/surface_reflectance.h"
 
 namespace laser_raycast {
 namespace core {
@@ -35,10 +36,23 @@ struct MeasurementConfig {
   // Seed of the random draws (noise and dropout): equal seeds give equal sequences.
   std::uint64_t noise_seed = 0;
   bool intensity = false;  // fill intensities: reflectivity of the link hit x cos(incidence angle)
+  // With intensity: the reflectance and incidence come from the mesh hit where it has colours, a
+  // texture, a material colour or vertex normals (surface_reflectance.h), unless the link's
+  // reflectivity is set explicitly.
+  bool surface_reflectance = true;
+  double reflectance_from_color = 1.0;  // >= 0: the reflectance of a white surface
   // Range realism, off by default; like the noise, only valid returns get it (see MeasurementModel).
   double range_bias = 0.0;        // m, finite: added to every valid range (a calibration offset)
   double range_resolution = 0.0;  // m, >= 0: valid ranges are rounded to a multiple of it; 0: off
   double dropout_probability = 0.0;  // in [0, 1]: chance that a valid return is lost (+Inf)
+  // The radiometric range limit (detected()), off while detection_range is 0: a datasheet's
+  // "range R at reflectivity rho", a Lambertian target of reflectivity detection_reflectivity
+  // seen head-on being detected up to detection_range and no farther.
+  double detection_range = 0.0;        // m, >= 0; 0: every hit is detected
+  double detection_reflectivity = 0.1;  // > 0
+
+  // Whether the measurement needs each hit's reflectance and incidence.
+  bool needsIncidence() const { return intensity || detection_range > 0; }
 
   // Throws std::invalid_argument naming the field and its value.
   void validate() const;
@@ -62,8 +76,16 @@ struct MeasuredScan {
   std::vector<int> labels;         // label index of the body hit (also when too close), -1 for none
 };
 
+// Whether a return of reflectance rho at range r (m) and incidence cos_incidence is strong enough
+// to be detected: the received power of a Lambertian target filling the beam goes as
+// rho cos(theta) / r^2 (no atmosphere, no specular part, no near-field or saturation effects, no
+// dependence on the beam's footprint), and the threshold is that of the datasheet's target:
+// detection_reflectivity / detection_range^2. True when detection_range is 0.
+bool detected(double rho, double cos_incidence, double r, const MeasurementConfig& config);
+
 // Each beam's range is classified (classifyRange, on the noise-free range, so validity follows the
-// geometry). A valid one then becomes
+// geometry); a valid one that is not detected() (on its noise-free range) reports no return: +Inf,
+// label -1, intensity 0, and draws nothing. A valid and detected one then becomes
 //   r = quantizeRange(clamp(range + range_bias + noise_stddev * N(0, 1), range_min, range_max))
 // and is lost with probability dropout_probability; it is rounded once to float. Bias, noise and
 // quantisation never make a valid return invalid; invalid returns (+-Inf, NaN) get none of them.
@@ -87,9 +109,10 @@ class MeasurementModel {
   void setConfig(const MeasurementConfig& config);
 
   // reflectivity is indexed by label (missing entries count as 1); intensity needs
-  // result.cos_incidence.
+  // result.cos_incidence. With surface (sampleSurfaces, same scan), a beam's reflectance is the
+  // surface's where it gives one (else the label's), and its incidence is the surface's.
   void measure(const Scene& scene, const ScanResult& result, const std::vector<double>& reflectivity,
-              MeasuredScan* out);
+               MeasuredScan* out, const SurfaceSamples* surface = nullptr);
 
  private:
   void seed(std::uint64_t seed);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
+#include "laser_raycast/core/surface.h"
 
 namespace laser_raycast {
 namespace core {
@@ -56,6 +57,11 @@ class Mesh {
   std::size_t degenerateTriangleCount() const {
     return triangles_.size() - bvh_.triangleIds().size();
   }
+  // Colours, texture coordinates, vertex normals and materials (surface.h); null if none.
+  const SurfaceAttributes* surface() const { return surface_.get(); }
+  // Throws std::invalid_argument if surface does not fit this mesh (SurfaceAttributes::validate).
+  // Set it before the mesh is shared.
+  void setSurface(std::shared_ptr<const SurfaceAttributes> surface);
   // Geometric unit normal of a triangle, (b - a) x (c - a) normalised (the front face's side).
   Eigen::Vector3d normal(std::uint32_t triangle) const;
 
@@ -75,6 +81,7 @@ class Mesh {
   bool has_closed_ = false;
   Bvh bvh_;
   std::unique_ptr<const WideBvh> wide_;  // refers to bvh_
+  std::shared_ptr<const SurfaceAttributes> surface_;
 };
 
 // Whether the triangle in BVH slot `slot` is a back face of a closed component (slotFacing) as seen

@@ -26,6 +26,10 @@ struct Body {
       0;  // index into Scene::labels(): what a hit on this body reports (e.g. its URDF link)
   Eigen::Isometry3d frame_from_body =
       Eigen::Isometry3d::Identity();  // the body's pose in its frame
+  // Its colour (e.g. the URDF <material>'s), RGB in [0, 1], for the reflectance of hits on it
+  // where its mesh gives none (surface_reflectance.h).
+  bool has_color = false;
+  Eigen::Vector3d color = Eigen::Vector3d::Zero();
 };
 
 class Scene {

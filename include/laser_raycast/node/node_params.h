@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "laser_raycast/core/enum_names.h"
+#include "laser_raycast/core/returns.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/map_walls.h"
 #include "laser_raycast/loader/scene_loader.h"
@@ -79,6 +80,8 @@ struct SensorParams {
   // Beams, range limits, min-range policy, noise, intensity, triangle test. fan.samples is 0 here:
   // the parser sets core::FanSpec::kDefaultSamples when neither it nor angle_increment is given.
   core::ScanSpec scan;
+  // Beam divergence and the return mode (core/returns.h); beam_samples 1: the ideal ray.
+  core::ReturnsConfig returns;
   double rate = 10.0;  // Hz, in (0, kMaxRate]
   Sweep sweep = Sweep::kInstant;
   double scan_time = 0;    // s, in (0, 1 / rate]: one turn of a rotating head; 0: 1 / rate

@@ -28,6 +28,12 @@ void MeasurementConfig::validate() const {
     msg << "range_resolution must be finite and >= 0, got " << range_resolution;
   } else if (!(dropout_probability >= 0 && dropout_probability <= 1)) {
     msg << "dropout_probability must be in [0, 1], got " << dropout_probability;
+  } else if (!(std::isfinite(detection_range) && detection_range >= 0)) {
+    msg << "detection_range must be finite and >= 0 m, got " << detection_range;
+  } else if (!(std::isfinite(detection_reflectivity) && detection_reflectivity > 0)) {
+    msg << "detection_reflectivity must be finite and > 0, got " << detection_reflectivity;
+  } else if (!(std::isfinite(reflectance_from_color) && reflectance_from_color >= 0)) {
+    msg << "reflectance_from_color must be finite and >= 0, got " << reflectance_from_color;
   } else {
     return;
   }
@@ -55,6 +61,13 @@ double quantizeRange(double range, const MeasurementConfig& config) {
   const double step = config.range_resolution;
   if (!(step > 0)) return range;
   return std::clamp(std::round(range / step) * step, config.range_min, config.range_max);
+}
+
+bool detected(double rho, double cos_incidence, double r, const MeasurementConfig& config) {
+  if (config.detection_range == 0) return true;
+  // rho cos / r^2 >= rho_d / R^2, multiplied out (no division by a zero range).
+  const double R = config.detection_range;
+  return rho * cos_incidence * R * R >= config.detection_reflectivity * r * r;
 }
 
 MeasurementModel::MeasurementModel(const MeasurementConfig& config) : config_(config), noise_(0.0, 1.0) {
@@ -89,33 +102,55 @@ bool MeasurementModel::degrade(double* range) {
 }
 
 void MeasurementModel::measure(const Scene& scene, const ScanResult& result,
-                         const std::vector<double>& reflectivity, MeasuredScan* out) {
+                         const std::vector<double>& reflectivity, MeasuredScan* out,
+                         const SurfaceSamples* surface) {
   const std::size_t n = result.range.size();
   out->ranges.resize(n);
   out->labels.resize(n);
-  if (config_.intensity) {
+  const bool radiometry = config_.needsIncidence();
+  if (radiometry) {
     if (result.cos_incidence.size() != n) {
-      throw std::invalid_argument("intensity needs the cast's cos_incidence (compute_incidence)");
+      throw std::invalid_argument(
+          "intensity and the detection range need the cast's cos_incidence (compute_incidence)");
     }
+    if (surface && (surface->reflectance.size() != n || surface->cos_incidence.size() != n)) {
+      throw std::invalid_argument("the surface samples are not of this scan");
+    }
+  }
+  if (config_.intensity) {
     out->intensities.assign(n, 0.0f);
   } else {
     out->intensities.clear();
   }
+  constexpr double kNoReturn = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
     const int body = result.body[i];
     const int label = body >= 0 ? scene.bodies()[body].label : -1;
     out->labels[i] = label;
     double r = classifyRange(result.range[i], config_);
     bool valid = std::isfinite(r);
-    if (valid && !degrade(&r)) {
+    // The hit's reflectance and incidence: the surface's where it gives them, else the label's.
+    double rho = 0, cos_incidence = 0;
+    if (radiometry && label >= 0) {
+      rho = label < static_cast<int>(reflectivity.size()) ? reflectivity[label] : 1.0;
+      cos_incidence = result.cos_incidence[i];
+      if (surface) {
+        if (!std::isnan(surface->reflectance[i])) rho = surface->reflectance[i];
+        cos_incidence = surface->cos_incidence[i];
+      }
+    }
+    if (valid && !detected(rho, cos_incidence, result.range[i], config_)) {
+      valid = false;  // too weak: no return, and no random draws
+      r = kNoReturn;
+      out->labels[i] = -1;
+    } else if (valid && !degrade(&r)) {
       valid = false;
-      r = std::numeric_limits<double>::infinity();  // lost: no return
+      r = kNoReturn;  // lost: no return
       out->labels[i] = -1;
     }
     out->ranges[i] = static_cast<float>(r);  // the one rounding to float
     if (config_.intensity && valid && label >= 0) {
-      const double rho = label < static_cast<int>(reflectivity.size()) ? reflectivity[label] : 1.0;
-      out->intensities[i] = static_cast<float>(rho * result.cos_incidence[i]);
+      out->intensities[i] = static_cast<float>(rho * cos_incidence);
     }
   }
 }

@@ -55,7 +55,7 @@ CastConfig ScanSpec::castConfig() const {
   config.cull_backfaces = cull_backfaces;
   config.tmin = output.min_range_policy == MinRangePolicy::kPassThrough ? output.range_min : 0.0;
   config.tmax = output.range_max;
-  config.compute_incidence = output.intensity;
+  config.compute_incidence = output.needsIncidence();
   return config;
 }
 

@@ -138,5 +138,10 @@ Eigen::Vector3d Mesh::normal(std::uint32_t triangle) const {
   return (vertices_[t[1]] - vertices_[t[0]]).cross(vertices_[t[2]] - vertices_[t[0]]).normalized();
 }
 
+void Mesh::setSurface(std::shared_ptr<const SurfaceAttributes> surface) {
+  if (surface) surface->validate(vertices_.size(), triangles_.size());
+  surface_ = std::move(surface);
+}
+
 }  // namespace core
 }  // namespace laser_raycast

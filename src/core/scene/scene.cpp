@@ -83,6 +83,9 @@ int Scene::addBody(Body body) {
   } else if (const auto* mesh = std::get_if<std::shared_ptr<const Mesh>>(&body.shape);
              mesh && !*mesh) {
     msg << "body in frame '" << frames_[body.frame] << "' has a null mesh";
+  } else if (body.has_color && !(body.color.allFinite() && body.color.minCoeff() >= 0 &&
+                                 body.color.maxCoeff() <= 1)) {
+    msg << "body colour in frame '" << frames_[body.frame] << "' is not RGB in [0, 1]";
   }
   if (!msg.str().empty()) throw std::invalid_argument(msg.str());
   if (const auto* box = std::get_if<Box>(&body.shape)) validate(*box);
