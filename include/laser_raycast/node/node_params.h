@@ -6,10 +6,12 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "laser_raycast/core/enum_names.h"
+#include "laser_raycast/core/pattern_file.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/map_walls.h"
 #include "laser_raycast/loader/scene_loader.h"
@@ -89,9 +91,17 @@ struct SensorParams {
   // s, > 0: a topic pose older than this at a scan's time is stale (the scan is skipped). Pose
   // sources run at 10 to 100 Hz: this is five periods of the slowest.
   double pose_timeout = 0.5;
+  // ~pattern_file: the beams from a scan pattern CSV (core::PatternFile) instead of the fan, each
+  // scan the file's next points_per_scan rows (0: all of them), point k at k / point_rate s.
+  std::string pattern_file;
+  std::shared_ptr<const core::PatternFile> pattern;  // loaded from pattern_file
+  int points_per_scan = 0;
+  double point_rate = 0;  // Hz, > 0 with a pattern file
 
-  // A single ring at elevation 0: a LaserScan (otherwise a PointCloud2).
-  bool planar() const { return scan.elevations.size() == 1 && scan.elevations[0] == 0.0; }
+  // A single ring at elevation 0 and no pattern file: a LaserScan (otherwise a PointCloud2).
+  bool planar() const {
+    return !pattern && scan.elevations.size() == 1 && scan.elevations[0] == 0.0;
+  }
   double scanTime() const { return scan_time > 0 ? scan_time : 1.0 / rate; }
   // s between beam columns: angle_increment * scan_time / 2 pi when rotating, else 0.
   double timeIncrement() const;
