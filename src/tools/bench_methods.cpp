@@ -243,8 +243,8 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
   w.pattern = std::make_unique<core::ScanPattern>(workload.fan, workload.elevations);
   w.tmax = tmax;
   if (!workload.pattern_file.empty()) {
-    const core::PatternFile file =
-        core::PatternFile::load(std::string(LASER_RAYCAST_SOURCE_DIR "/config/patterns/") + workload.pattern_file);
+    const core::PatternFile file = core::PatternFile::load(
+        std::string(LASER_RAYCAST_SOURCE_DIR "/config/patterns/") + workload.pattern_file);
     w.beams = file.scan(0, file.size(), 1.0);
     w.beams.times.clear();
     w.beams.lines.clear();

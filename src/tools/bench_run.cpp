@@ -91,8 +91,8 @@ References computeReferences(const BenchScene& scene, const SceneGeometry& geome
   // angles to recompute them from in long double.
   refs.pipeline = referenceBodies(
       scene, rays.offGrid() ? pipelineInputRays(rays)
-                            : pipelineRays(rays.poses, workload.fan, workload.elevations,
-                                           rays.tmax, !rays.sweeps.empty()));
+                            : pipelineRays(rays.poses, workload.fan, workload.elevations, rays.tmax,
+                                           !rays.sweeps.empty()));
   std::cerr << "  " << workload.name << ": " << rays.rays.size() << " rays from " << rays.scans()
             << (rays.sweeps.empty() ? " poses" : " rotating scans") << "; the reference hits "
             << countHits(refs.soup) << " (soup) and " << countHits(refs.pipeline)

@@ -8,6 +8,7 @@
 // does. Each beam keeps the hit that goes first by hit_order.h, so a beam's result depends on
 // nothing but its own ray: the same for any thread count and any order of the trees.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -56,6 +57,31 @@ void placeGroupsAt(const SceneIndex& index, const Eigen::Isometry3d& world_from_
   }
 }
 
+// Whether the ray can meet the box centre +- half (its frame's coordinates) within [tmin, tmax]:
+// a slab test on the box widened by a relative margin far above double rounding, so it only culls
+// bodies every hit on which lies outside their box, never a hit (a leaf of a frame's tree holds
+// several bodies, each otherwise tested exactly).
+bool mayEnterBox(const Ray& ray, const Eigen::Vector3d& center, const Eigen::Vector3d& half) {
+  const double margin =
+      1e-9 * (center.cwiseAbs().maxCoeff() + half.maxCoeff() + ray.origin.cwiseAbs().maxCoeff()) +
+      1e-12;
+  double lo = ray.tmin, hi = ray.tmax;
+  for (int k = 0; k < 3; ++k) {
+    const double o = ray.origin[k] - center[k], h = half[k] + margin, d = ray.dir[k];
+    if (d == 0) {
+      if (std::abs(o) > h) return false;
+      continue;
+    }
+    const double inv = 1 / d;
+    double t0 = (-h - o) * inv, t1 = (h - o) * inv;
+    if (t0 > t1) std::swap(t0, t1);
+    lo = std::max(lo, t0 - margin);
+    hi = std::min(hi, t1 + margin);
+    if (lo > hi) return false;
+  }
+  return true;
+}
+
 // The nearest hit of one beam so far, over every body.
 struct BeamHit {
   double t = kInf;
@@ -68,10 +94,21 @@ template <TriangleMethod M>
 class BeamTracer {
  public:
   BeamTracer(const Scene& scene, const SceneIndex& index, const CastConfig& config)
-      : scene_(scene), index_(index), config_(config) {}
+      : scene_(scene),
+        index_(index),
+        config_(config),
+        placed_(scene.bodies().size()),
+        placed_stamp_(scene.bodies().size(), 0) {}
 
-  // One beam from origin o along unit d (sensor frame) with the frames placed by poses.
-  BeamHit trace(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const GroupPoses& poses) {
+  // The frames' poses for the beams traced next: each body is placed again when first met.
+  void setPoses(const GroupPoses& poses) {
+    poses_ = &poses;
+    ++stamp_;
+  }
+
+  // One beam from origin o along unit d (sensor frame) with the frames placed by setPoses.
+  BeamHit trace(const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+    const GroupPoses& poses = *poses_;
     BeamHit hit;
     const auto& groups = index_.groups();
     for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -88,7 +125,7 @@ class BeamTracer {
       double tmax = std::min(config_.tmax, hit.t);
       traceWide(group.wide, group.wide.root(), box_ray, &tmax, [&](std::uint32_t slot) {
         const int body = group.bodies[group.tree.triangleIds()[slot]];
-        castBody(body, sensor_from_frame, o, d, &hit);
+        castBody(body, placedBody(body, sensor_from_frame), o, d, &hit);
         tmax = std::min(config_.tmax, hit.t);
       });
     }
@@ -96,19 +133,57 @@ class BeamTracer {
   }
 
  private:
-  void castBody(int body, const Eigen::Isometry3d& sensor_from_frame, const Eigen::Vector3d& o,
-                const Eigen::Vector3d& d, BeamHit* hit) const {
-    // As placeBody (placed_body.h) places it for the grid's walks: the same bits.
+  // A body relative to the sensor, as placeBody and placeSensorInBody (placed_body.h) place it for
+  // the grid's walks: the same bits.
+  struct Placed {
+    Eigen::Matrix3d rot;  // sensor_from_body
+    Eigen::Vector3d trans;
+    Eigen::Matrix3d body_rot;  // its transpose: sensor-frame directions into the body frame
+    Eigen::Vector3d sensor_in_body;
+  };
+
+  // A triangle slot moved into the sensor frame, as the mesh walk moves it (the same bits), through
+  // a direct-mapped cache: consecutive beams of a pattern meet the same triangles.
+  struct SensorTriangle {
+    Eigen::Vector3d a, b, c;
+  };
+  const SensorTriangle& sensorTriangle(int body, std::uint32_t slot,
+                                       const std::array<Eigen::Vector3d, 3>& v,
+                                       const Eigen::Matrix3d& rot, const Eigen::Vector3d& trans) {
+    const std::uint32_t key = (slot * 2654435761u) ^ (static_cast<std::uint32_t>(body) * 40503u);
+    CachedTriangle& e = triangles_[(key >> 20) & (kTriangleCache - 1)];
+    if (e.stamp != stamp_ || e.body != body || e.slot != slot) {
+      e.stamp = stamp_;
+      e.body = body;
+      e.slot = slot;
+      e.t = SensorTriangle{rot * v[0] + trans, rot * v[1] + trans, rot * v[2] + trans};
+    }
+    return e.t;
+  }
+
+  const Placed& placedBody(int body, const Eigen::Isometry3d& sensor_from_frame) {
+    Placed& p = placed_[body];
+    if (placed_stamp_[body] == stamp_) return p;
+    placed_stamp_[body] = stamp_;
     const Eigen::Isometry3d sensor_from_body =
         sensor_from_frame * scene_.bodies()[body].frame_from_body;
-    const Eigen::Matrix3d& rot = sensor_from_body.linear();
-    const Eigen::Vector3d& trans = sensor_from_body.translation();
-    const Eigen::Matrix3d body_rot = rot.transpose();
+    p.rot = sensor_from_body.linear();
+    p.trans = sensor_from_body.translation();
+    p.body_rot = p.rot.transpose();
+    p.sensor_in_body = -(p.body_rot * p.trans);
+    return p;
+  }
+
+  void castBody(int body, const Placed& p, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                BeamHit* hit) {
+    const Eigen::Matrix3d& rot = p.rot;
+    const Eigen::Vector3d& trans = p.trans;
     Ray body_ray;
-    body_ray.origin = body_rot * (o - trans);
-    body_ray.dir = body_rot * d;
+    body_ray.origin = o.isZero() ? p.sensor_in_body : Eigen::Vector3d(p.body_rot * (o - trans));
+    body_ray.dir = p.body_rot * d;
     body_ray.tmin = config_.tmin;
     body_ray.tmax = std::min(config_.tmax, hit->t);
+    if (!mayEnterBox(body_ray, scene_.boxCenter(body), scene_.boxHalf(body))) return;
     const Shape& shape = scene_.bodies()[body].shape;
     if (const auto* mesh_ptr = std::get_if<std::shared_ptr<const Mesh>>(&shape)) {
       castMesh(**mesh_ptr, body, rot, trans, body_ray, o, d, hit);
@@ -132,7 +207,7 @@ class BeamTracer {
   // the sensor frame and tested against the beam's sensor-frame ray, as the mesh walk tests it.
   void castMesh(const Mesh& mesh, int body, const Eigen::Matrix3d& rot,
                 const Eigen::Vector3d& trans, const Ray& body_ray, const Eigen::Vector3d& o,
-                const Eigen::Vector3d& d, BeamHit* hit) const {
+                const Eigen::Vector3d& d, BeamHit* hit) {
     const WideBvh& wide = mesh.wideBvh();
     if (wide.empty()) return;
     const auto& slots = mesh.bvh().triangleVertices();
@@ -147,9 +222,8 @@ class BeamTracer {
     double best_t = kInf;
     std::uint32_t best_triangle = std::numeric_limits<std::uint32_t>::max();
     traceWide(wide, wide.root(), box_ray, &tmax, [&](std::uint32_t slot) {
-      const auto& v = slots[slot];
-      const Eigen::Vector3d a = rot * v[0] + trans, b = rot * v[1] + trans, c = rot * v[2] + trans;
-      const auto h = ray.intersect(a, b, c, tmax);
+      const SensorTriangle& s = sensorTriangle(body, slot, slots[slot], rot, trans);
+      const auto h = ray.intersect(s.a, s.b, s.c, tmax);
       if (h && hitBefore(h->t, ids[slot], best_t, best_triangle)) {
         best_t = h->t;
         best_triangle = ids[slot];
@@ -166,6 +240,18 @@ class BeamTracer {
   const Scene& scene_;
   const SceneIndex& index_;
   const CastConfig& config_;
+  const GroupPoses* poses_ = nullptr;
+  std::vector<Placed> placed_;  // by body, valid where placed_stamp_ is stamp_
+  std::vector<std::uint32_t> placed_stamp_;
+  std::uint32_t stamp_ = 0;
+  static constexpr std::uint32_t kTriangleCache = 2048;
+  struct CachedTriangle {
+    std::uint32_t stamp = 0;  // 0: empty (stamps start at 1)
+    int body = -1;
+    std::uint32_t slot = 0;
+    SensorTriangle t;
+  };
+  std::vector<CachedTriangle> triangles_ = std::vector<CachedTriangle>(kTriangleCache);
 };
 
 }  // namespace
@@ -250,13 +336,14 @@ void castBeamList(CasterState& state, const Scene& scene, const BeamList& beams,
         const double t = beams.time(i);
         if (!(t == placed_time)) {
           posesAt(t, &poses);
+          tracer.setPoses(poses);
           placed_time = t;
         }
         if (!poses.sensor_ok) {
           result->range[i] = std::numeric_limits<double>::quiet_NaN();
           continue;
         }
-        const BeamHit hit = tracer.trace(beams.origin(i), beams.directions[i], poses);
+        const BeamHit hit = tracer.trace(beams.origin(i), beams.directions[i]);
         result->range[i] = hit.t;
         result->body[i] = hit.body;
         result->triangle[i] = hit.triangle;
