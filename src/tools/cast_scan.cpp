@@ -25,6 +25,7 @@
 #include "laser_raycast/loader/map_file.h"
 #include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
+#include "laser_raycast/loader/velodyne_calibration.h"
 
 namespace {
 
@@ -60,6 +61,11 @@ struct Args {
   std::optional<core::PatternFile> pattern_file;
   int points_per_scan = 0;  // 0: the file's row count
   double point_rate = 0;    // Hz, > 0 with --pattern-file
+  // --calibration: a Velodyne head's beams, one turn (the same every scan).
+  std::string calibration_path;
+  std::optional<core::BeamList> calibrated;
+  // Beams off any grid: a pattern file's or a calibrated head's.
+  bool offGrid() const { return pattern_file || calibrated; }
 };
 
 std::string formatNumber(double value) {
@@ -192,10 +198,12 @@ po::options_description flags(Args* args) {
                args->rings = true;
              }),
       "one fan of azimuths per elevation (rad, up positive, any order); ring r is the r-th lowest");
-  add("pattern-file",
-      single("FILE", [args](const std::string& v) { args->pattern_path = v; }),
+  add("pattern-file", single("FILE", [args](const std::string& v) { args->pattern_path = v; }),
       "a scan pattern CSV 'Time/s,Azimuth/deg,Zenith/deg[,Line]' read as a loop: each scan takes "
       "its next --points-per-scan rows instead of a fan");
+  add("calibration", single("FILE", [args](const std::string& v) { args->calibration_path = v; }),
+      "a Velodyne calibration YAML (velodyne_pointcloud's): each laser's beam, origin and firing "
+      "time over one turn (--scan-time with --sweep rotating, else 0.1 s) instead of a fan");
   add("points-per-scan", count("--points-per-scan", &args->points_per_scan),
       "rows of --pattern-file a scan takes (default: all of them)");
   add("point-rate", number("--point-rate", "HZ", &args->point_rate),
@@ -232,11 +240,31 @@ std::string underItsFlag(const std::string& message, const std::string& beams_fr
   return flag.empty() ? message : "--" + flag + ": " + message;
 }
 
-// --pattern-file and its flags; loads the file. Throws ArgError.
+// The turn of a calibrated head cast at once (no --scan-time): 10 Hz, the models' default.
+constexpr double kCalibratedScanTime = 0.1;  // s
+
+// --pattern-file and its flags, or --calibration; loads the file. Throws ArgError.
 void checkPatternFlags(const po::variables_map& values, Args* args) {
+  if (!args->calibration_path.empty()) {
+    if (!args->pattern_path.empty())
+      throw ArgError("give --calibration or --pattern-file, not both");
+    for (const char* flag :
+         {"elevations", "samples", "angle-increment", "angle-min", "angle-max"}) {
+      if (values.count(flag)) throw ArgError(std::string("--") + flag + ": not with --calibration");
+    }
+    try {
+      const core::VelodyneHead head =
+          laser_raycast::loadVelodyneCalibration(args->calibration_path);
+      const bool rotating = args->path.sweep == laser_raycast::tools::Sweep::kRotating;
+      args->calibrated = head.scan(rotating ? args->path.scan_time : kCalibratedScanTime);
+    } catch (const std::invalid_argument& e) {
+      throw ArgError(std::string("--calibration: ") + e.what());
+    }
+  }
   if (args->pattern_path.empty()) {
     for (const char* flag : {"points-per-scan", "point-rate"}) {
-      if (values.count(flag)) throw ArgError(std::string("--") + flag + ": only with --pattern-file");
+      if (values.count(flag))
+        throw ArgError(std::string("--") + flag + ": only with --pattern-file");
     }
     return;
   }
@@ -319,6 +347,7 @@ std::string synopsis() {
       << indent << "[--method " << choices(core::kTriangleMethodNames) << "]\n"
       << indent << "[--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n"
       << indent << "[--pattern-file FILE --point-rate HZ [--points-per-scan N]]\n"
+      << indent << "[--calibration FILE]\n"
       << indent << "[--threads N] [--mesh-import-max-memory-mb MB] [--mesh-import-timeout S]\n";
   return out.str();
 }
@@ -333,8 +362,9 @@ std::string notes() {
       << "'index,ring,elevation,angle,range,link' (ring 0 the lowest). With --poses, a scan\n"
       << "from each pose of FILE in turn, its rows led by 'pose' (0: the file's first pose line).\n"
       << "With --sweep rotating, each row ends with 'time', s after the scan's first beam.\n"
-      << "With --pattern-file, 'index,line,azimuth,elevation,time,range,link' (rad; time k / HZ\n"
-      << "s; with --sweep rotating each beam is cast from the pose at its time).\n"
+      << "With --pattern-file or --calibration, 'index,line,azimuth,elevation,time,range,link'\n"
+      << "(rad; time k / HZ s, or the laser's firing time; with --sweep rotating each beam is\n"
+      << "cast from the pose at its time; line: the file's Line, or the laser's ring).\n"
       << "Defaults: angles " << formatAngle(scan.fan.angle_min) << ".."
       << formatAngle(scan.fan.angle_max) << ", " << core::FanSpec::kDefaultSamples
       << " samples, ranges " << formatNumber(scan.output.range_min) << ".."
@@ -445,6 +475,7 @@ struct Casting {
 // A pattern file's beams of the path's scan number `pose` into casting->beams: its rows from
 // pose * points_per_scan on.
 void patternScan(const Args& args, std::size_t pose, Casting* casting) {
+  if (args.calibrated) casting->beams = *args.calibrated;
   if (!args.pattern_file) return;
   casting->beams = args.pattern_file->scan(static_cast<std::int64_t>(pose) * args.points_per_scan,
                                            args.points_per_scan, args.point_rate);
@@ -459,18 +490,18 @@ const core::ScanResult& castFrom(const Args& args, const LoadedScene& loaded,
   core::Caster& caster = casting->caster;
   const core::CastConfig& config = casting->config;
   core::PoseSamples samples;
-  if (rotating && args.pattern_file) {
-    samples = laser_raycast::tools::sweepSamplesAt(args.path, sensor, loaded.poses,
-                                                   casting->beams.times);
+  if (rotating && args.offGrid()) {
+    samples =
+        laser_raycast::tools::sweepSamplesAt(args.path, sensor, loaded.poses, casting->beams.times);
   } else if (rotating) {
     samples = laser_raycast::tools::sweepSamples(args.path, sensor, loaded.poses, casting->pattern);
   }
   const auto t0 = std::chrono::steady_clock::now();
   const core::ScanResult* result;
-  if (args.pattern_file) {
-    result = rotating ? &caster.castBeamsSweep(loaded.scene, samples, casting->beams, config)
-                      : &caster.castBeams(loaded.scene, loaded.poses, sensor, casting->beams,
-                                          config);
+  if (args.offGrid()) {
+    result = rotating
+                 ? &caster.castBeamsSweep(loaded.scene, samples, casting->beams, config)
+                 : &caster.castBeams(loaded.scene, loaded.poses, sensor, casting->beams, config);
   } else {
     result = rotating ? &caster.castSweep(loaded.scene, samples, casting->pattern, config,
                                           casting->time_increment)
@@ -523,7 +554,7 @@ void reportLoad(const LoadedScene& loaded) {
 // The CSV's header: with --poses, the pose's number first; with a rotating sweep, the beam's time
 // last.
 std::string csvHeader(const Args& args, const Casting& casting) {
-  if (args.pattern_file) {
+  if (args.offGrid()) {
     return std::string(args.path.pose_column ? "pose," : "") +
            "index,line,azimuth,elevation,time,range,link\n";
   }
@@ -544,7 +575,7 @@ std::string bodyLabel(const LoadedScene& loaded, int body) {
 std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& casting,
                     const core::ScanResult& result, std::size_t pose) {
   std::string out;
-  if (args.pattern_file) {
+  if (args.offGrid()) {
     const core::BeamList& beams = casting.beams;
     for (int i = 0; i < beams.size(); ++i) {
       const Eigen::Vector3d& d = beams.directions[i];
@@ -597,8 +628,11 @@ int main(int argc, char** argv) {
     std::cerr << "cast_scan: " << e.what() << "\n";
     return kExitBadArguments;
   }
-  Casting casting{args.scan.pattern(), args.scan.castConfig(), core::Caster(),
-                  laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment()), {}};
+  Casting casting{args.scan.pattern(),
+                  args.scan.castConfig(),
+                  core::Caster(),
+                  laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment()),
+                  {}};
   casting.config.threads = args.threads;
   // The path in order, each scan printed before the next is cast (the result is the caster's).
   print(csvHeader(args, casting));
