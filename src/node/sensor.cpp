@@ -108,7 +108,7 @@ void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>&
   applyLive();
   const auto start = std::chrono::steady_clock::now();
   const core::ScanResult* result;
-  if (cast_params_.pattern) {
+  if (cast_params_.offGrid()) {
     result = castPattern(scene, times, frames, poses);
   } else if (times.size() == 1) {
     result = &caster_.cast(scene, frames.front(), poses.front(), pattern_, cast_config_);
@@ -145,9 +145,13 @@ const core::ScanResult* Sensor::castPattern(const core::Scene& scene,
                                             const std::vector<ros::Time>& times,
                                             const std::vector<core::FramePoses>& frames,
                                             const std::vector<Eigen::Isometry3d>& poses) {
-  const core::PatternFile& file = *cast_params_.pattern;
-  beams_ = file.scan(next_row_, cast_params_.points_per_scan, cast_params_.point_rate);
-  next_row_ = (next_row_ + cast_params_.points_per_scan) % file.size();
+  if (cast_params_.pattern) {
+    const core::PatternFile& file = *cast_params_.pattern;
+    beams_ = file.scan(next_row_, cast_params_.points_per_scan, cast_params_.point_rate);
+    next_row_ = (next_row_ + cast_params_.points_per_scan) % file.size();
+  } else if (beams_.size() != cast_params_.calibrated->size()) {
+    beams_ = *cast_params_.calibrated;  // the same every scan
+  }
   // An instant scan casts every point from the stamp's poses; the points keep their times.
   if (cast_params_.sweep != Sweep::kRotating) {
     return &caster_.castBeams(scene, frames.front(), poses.front(), beams_, cast_config_);
@@ -184,7 +188,7 @@ void Sensor::publishCloud(const ros::Time& stamp) {
   options.organized = cast_params_.organized;
   options.layout = cast_params_.point_layout;
   sensor_msgs::PointCloud2 cloud;
-  if (cast_params_.pattern) {
+  if (cast_params_.offGrid()) {
     buildBeamCloud(beams_, measured_, header, options, &cloud);
   } else {
     buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud);

@@ -17,6 +17,7 @@
 
 #include "driver_layouts.h"
 #include "laser_raycast/core/pattern_file.h"
+#include "laser_raycast/loader/velodyne_calibration.h"
 #include "sensors_rig.h"
 #include "sensors_room.h"
 
@@ -91,6 +92,50 @@ TEST(NodePattern, EachScanIsTheFilesNextRowsOnTheRoom) {
       EXPECT_NEAR(fieldValue<double>(*cloud, k, "timestamp"), stamp_ns + k / kPointRate * 1e9, 512)
           << "point " << k;
     }
+  }
+}
+
+// The VLP-16 of test/data/vlp16_calibration.yaml: one turn of 1808 firing sequences of 16 lasers,
+// beam b the laser b % 16 of sequence b / 16, fired at the manual's time, its point where the
+// calibration's laser puts it (core::VelodyneHead, checked against the driver's formulas in
+// test_velodyne_calibration) on the room's faces, its ring the laser's by ascending elevation.
+TEST(NodePattern, CalibratedVelodyne) {
+  const core::VelodyneHead head = laser_raycast::loadVelodyneCalibration(
+      ros::package::getPath("laser_raycast") + "/test/data/vlp16_calibration.yaml");
+  const core::BeamList beams = head.scan(0.1);
+  ros::NodeHandle nh;
+  tf2_ros::StaticTransformBroadcaster statics;
+  statics.sendTransform(transform(ros::Time::now(), "lidar", kSensor, 0));
+  std::mutex mutex;
+  sensor_msgs::PointCloud2::ConstPtr cloud;
+  const ros::Subscriber sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      "/velodyne/points", 1, [&](const sensor_msgs::PointCloud2::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!cloud) cloud = m;
+      });
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(30.0);
+  while (ros::ok() && ros::WallTime::now() < give_up) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (cloud) break;
+    }
+    ros::WallDuration(0.01).sleep();
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_TRUE(cloud);
+  expectDriverLayout(*cloud, laser_raycast::PointLayout::kVelodyne);
+  ASSERT_EQ(cloud->width * cloud->height, 1808u * 16u);
+  const int rings[16] = {0, 8, 1, 9, 2, 10, 3, 11, 4, 12, 5, 13, 6, 14, 7, 15};
+  for (int b = 0; b < beams.size(); ++b) {
+    const int s = b / 16, i = b % 16;
+    const Eigen::Vector3d o = kSensor + beams.origins[b], d = beams.directions[b];
+    const Eigen::Vector3d expected = beams.origins[b] + roomDistance(o, d) * d;
+    const Eigen::Vector3d p(fieldValue<float>(*cloud, b, "x"), fieldValue<float>(*cloud, b, "y"),
+                            fieldValue<float>(*cloud, b, "z"));
+    EXPECT_LT((p - expected).norm(), kTolerance) << "point " << b;
+    EXPECT_EQ(fieldValue<std::uint16_t>(*cloud, b, "ring"), rings[i]) << "point " << b;
+    EXPECT_NEAR(fieldValue<float>(*cloud, b, "time"), s * 55.296e-6 + i * 2.304e-6, 1e-7)
+        << "point " << b;
   }
 }
 

@@ -97,10 +97,16 @@ struct SensorParams {
   std::shared_ptr<const core::PatternFile> pattern;  // loaded from pattern_file
   int points_per_scan = 0;
   double point_rate = 0;  // Hz, > 0 with a pattern file
+  // ~calibration_file: a Velodyne calibration YAML; its head's beams over one turn of scanTime(),
+  // the same every scan (core::VelodyneHead::scan).
+  std::string calibration_file;
+  std::shared_ptr<const core::BeamList> calibrated;
+  // Beams off any grid (a pattern file's or a calibrated head's): a PointCloud2 of one row.
+  bool offGrid() const { return pattern || calibrated; }
 
   // A single ring at elevation 0 and no pattern file: a LaserScan (otherwise a PointCloud2).
   bool planar() const {
-    return !pattern && scan.elevations.size() == 1 && scan.elevations[0] == 0.0;
+    return !offGrid() && scan.elevations.size() == 1 && scan.elevations[0] == 0.0;
   }
   double scanTime() const { return scan_time > 0 ? scan_time : 1.0 / rate; }
   // s between beam columns: angle_increment * scan_time / 2 pi when rotating, else 0.
