@@ -10,6 +10,7 @@
 
 #include "bench_paths.h"
 #include "laser_raycast/core/pattern_file.h"
+#include "laser_raycast/core/velodyne_beams.h"
 
 namespace laser_raycast {
 namespace bench {
@@ -231,6 +232,11 @@ const std::vector<Workload>& workloads() {
     rosette.name = "pattern_rosette";
     rosette.pattern_file = "rosette_4line.csv";
     all.push_back(rosette);
+    Workload vlp16 = rosette;
+    vlp16.name = "vlp16_calibrated";
+    vlp16.pattern_file.clear();
+    vlp16.calibrated_vlp16 = true;
+    all.push_back(vlp16);
     return all;
   }();
   return list;
@@ -246,6 +252,11 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
     const core::PatternFile file = core::PatternFile::load(
         std::string(LASER_RAYCAST_SOURCE_DIR "/config/patterns/") + workload.pattern_file);
     w.beams = file.scan(0, file.size(), 1.0);
+    w.beams.times.clear();
+    w.beams.lines.clear();
+  }
+  if (workload.calibrated_vlp16) {
+    w.beams = core::nominalVlp16().scan(0.1);
     w.beams.times.clear();
     w.beams.lines.clear();
   }

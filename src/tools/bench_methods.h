@@ -36,6 +36,9 @@ struct Workload {
   // Beams off any grid: every row of this scan pattern file (config/patterns/, core::PatternFile)
   // from each sensor pose, cast by Caster::castBeams; "" for the fan and elevations above.
   std::string pattern_file;
+  // Beams off any grid: a VLP-16 with its published per-laser elevations, each laser at its own
+  // azimuth and firing time (core::nominalVlp16(), one 0.1 s turn), by Caster::castBeams.
+  bool calibrated_vlp16 = false;
 };
 
 // Still, from the scene's sensor poses: fan2d, 1081 beams over 270 degrees; rings3d, 64 rings
@@ -44,7 +47,8 @@ struct Workload {
 // (a UTM-30LX), level or tilted by N(0, 0.4 degrees); rings_path, a VLP-16 (16 rings from -15 to
 // +15 degrees x 1800 azimuths) at 10 Hz; sweep_fan, a rotating 360-beam fan at 5 Hz (an LDS-01);
 // sweep_rings, a rotating VLP-16 at 10 Hz. Still, beams off any grid: pattern_rosette, the
-// 10000 points of config/patterns/rosette_4line.csv (a Livox-like rosette) from the scene's poses.
+// 10000 points of config/patterns/rosette_4line.csv (a Livox-like rosette) from the scene's poses;
+// vlp16_calibrated, a VLP-16's 1808 x 16 beams as a calibrated head fires them.
 const std::vector<Workload>& workloads();
 
 // Every beam of a workload from each sensor pose, pose-major, as the triangle methods and peers get
