@@ -75,6 +75,10 @@ const std::vector<std::string> kReadmeParameters = {"frame_id",
                                                     "range_bias",
                                                     "range_resolution",
                                                     "dropout_probability",
+                                                    "pattern_file",
+                                                    "points_per_scan",
+                                                    "point_rate",
+                                                    "calibration_file",
                                                     "sensors"};
 
 TEST(NodeParams, TheNodeReadsExactlyTheDocumentedParameters) {
