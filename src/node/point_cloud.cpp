@@ -124,11 +124,14 @@ void checkSizes(const core::ScanPattern& pattern, const core::MeasuredScan& scan
 
 }  // namespace
 
-void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
-                     const std::vector<double>& column_times, const std_msgs::Header& header,
-                     const CloudOptions& options, sensor_msgs::PointCloud2* cloud) {
-  checkSizes(pattern, scan, column_times, options.layout);
-  const int beams = pattern.size(), azimuths = pattern.azimuthCount();
+namespace {
+
+// The cloud of `beams` beams as height x width (organized) or one row of the valid returns: beam b
+// with a valid range r is the point at(b, r), with ring ring(b) and time time(b).
+template <class At, class Ring, class Time>
+void fillCloud(int beams, int height, int width, const core::MeasuredScan& scan,
+               const std_msgs::Header& header, const CloudOptions& options, At&& at, Ring&& ring,
+               Time&& time, sensor_msgs::PointCloud2* cloud) {
   int points = beams;
   if (!options.organized) {
     points = 0;
@@ -136,8 +139,8 @@ void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan&
   }
 
   cloud->header = header;
-  cloud->height = options.organized ? pattern.ringCount() : 1;
-  cloud->width = options.organized ? azimuths : points;
+  cloud->height = options.organized ? height : 1;
+  cloud->width = options.organized ? width : points;
   cloud->is_bigendian = hostIsBigEndian();
   cloud->fields.clear();
   withPointLayout(options.layout, [&](auto ref) {
@@ -169,10 +172,10 @@ void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan&
       all_valid = all_valid && valid;
       if (!valid && !options.organized) continue;
       Beam beam;
-      beam.ring = b / azimuths;
-      beam.time = column_times.empty() ? 0.0 : column_times[b % azimuths];
+      beam.ring = ring(b);
+      beam.time = time(b);
       if (valid) {
-        beam.xyz = (pattern.directions()[b] * static_cast<double>(range)).cast<float>();
+        beam.xyz = at(b, static_cast<double>(range)).template cast<float>();
         beam.intensity = scan.intensities.empty() ? 0.0f : scan.intensities[b];
         beam.range = range;
       } else {
@@ -185,6 +188,50 @@ void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan&
     }
   });
   cloud->is_dense = !options.organized || all_valid;
+}
+
+}  // namespace
+
+void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
+                     const std::vector<double>& column_times, const std_msgs::Header& header,
+                     const CloudOptions& options, sensor_msgs::PointCloud2* cloud) {
+  checkSizes(pattern, scan, column_times, options.layout);
+  const int azimuths = pattern.azimuthCount();
+  fillCloud(
+      pattern.size(), pattern.ringCount(), azimuths, scan, header, options,
+      [&](int b, double range) -> Eigen::Vector3d { return pattern.directions()[b] * range; },
+      [&](int b) { return b / azimuths; },
+      [&](int b) { return column_times.empty() ? 0.0 : column_times[b % azimuths]; }, cloud);
+}
+
+void buildBeamCloud(const core::BeamList& beams, const core::MeasuredScan& scan,
+                    const std_msgs::Header& header, const CloudOptions& options,
+                    sensor_msgs::PointCloud2* cloud) {
+  const std::size_t n = beams.size();
+  std::string problem;
+  if (scan.ranges.size() != n) {
+    problem = "the scan has " + std::to_string(scan.ranges.size()) + " ranges";
+  } else if (!scan.intensities.empty() && scan.intensities.size() != n) {
+    problem = "the scan has " + std::to_string(scan.intensities.size()) + " intensities";
+  } else {
+    int lines = 1;
+    double last_time = 0;
+    for (int b = 0; b < beams.size(); ++b) {
+      lines = std::max(lines, beams.line(b) + 1);
+      last_time = std::max(last_time, beams.time(b));
+    }
+    problem = pointLayoutLimit(options.layout, lines, last_time);
+  }
+  if (!problem.empty()) {
+    throw std::invalid_argument("buildBeamCloud: " + problem + " for " + std::to_string(n) +
+                                " beams");
+  }
+  fillCloud(
+      beams.size(), 1, beams.size(), scan, header, options,
+      [&](int b, double range) -> Eigen::Vector3d {
+        return beams.origin(b) + beams.directions[b] * range;
+      },
+      [&](int b) { return beams.line(b); }, [&](int b) { return beams.time(b); }, cloud);
 }
 
 std::vector<double> rotatingColumnTimes(int azimuths, double time_increment) {

@@ -87,11 +87,17 @@ bool RaycastNode::init() {
       updateCapacity();
     }));
     startTimer(index);
+    const std::string beams =
+        s.pattern
+            ? std::to_string(s.points_per_scan) + " points a scan from '" + s.pattern_file + "'"
+        : s.calibrated ? std::to_string(s.calibrated->size()) + " beams a turn from '" +
+                             s.calibration_file + "'"
+                       : std::to_string(s.scan.pattern().size()) + " beams (" +
+                             std::to_string(s.scan.elevations.size()) + " rings)";
     ROS_INFO(
-        "sensor '%s': %d beams (%zu rings) at %g Hz, %s, in frame '%s', pose from %s; "
+        "sensor '%s': %s at %g Hz, %s, in frame '%s', pose from %s; "
         "publishing %s",
-        s.name.c_str(), s.scan.pattern().size(), s.scan.elevations.size(), s.rate,
-        kSweepNames.name(s.sweep), s.frame_id.c_str(),
+        s.name.c_str(), beams.c_str(), s.rate, kSweepNames.name(s.sweep), s.frame_id.c_str(),
         s.pose_topic.empty() ? "TF" : ("topic " + s.pose_topic).c_str(),
         nh_.resolveName(s.topic).c_str());
   }

@@ -109,7 +109,9 @@ void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>&
   applyLive();
   const auto start = std::chrono::steady_clock::now();
   const core::ScanResult* result;
-  if (times.size() == 1) {
+  if (cast_params_.offGrid()) {
+    result = castPattern(scene, times, frames, poses);
+  } else if (times.size() == 1) {
     result = &caster_.cast(scene, frames.front(), poses.front(), pattern_, cast_config_);
   } else {
     // A rotating scan: each beam column from the poses at its own time (s after the stamp).
@@ -157,6 +159,29 @@ void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>&
                      measured_.ranges.empty() ? 0.0 : double(hits) / measured_.ranges.size());
 }
 
+const core::ScanResult* Sensor::castPattern(const core::Scene& scene,
+                                            const std::vector<ros::Time>& times,
+                                            const std::vector<core::FramePoses>& frames,
+                                            const std::vector<Eigen::Isometry3d>& poses) {
+  if (cast_params_.pattern) {
+    const core::PatternFile& file = *cast_params_.pattern;
+    beams_ = file.scan(next_row_, cast_params_.points_per_scan, cast_params_.point_rate);
+    next_row_ = (next_row_ + cast_params_.points_per_scan) % file.size();
+  } else if (beams_.size() != cast_params_.calibrated->size()) {
+    beams_ = *cast_params_.calibrated;  // the same every scan
+  }
+  // An instant scan casts every point from the stamp's poses; the points keep their times.
+  if (cast_params_.sweep != Sweep::kRotating) {
+    return &caster_.castBeams(scene, frames.front(), poses.front(), beams_, cast_config_);
+  }
+  // Each point from the poses at its own time (s after the stamp).
+  core::PoseSamples samples;
+  for (const ros::Time& t : times) samples.times.push_back((t - times.front()).toSec());
+  samples.world_from_sensor = poses;
+  samples.frames = frames;
+  return &caster_.castBeamsSweep(scene, samples, beams_, cast_config_);
+}
+
 void Sensor::publishScan(const ros::Time& stamp) {
   sensor_msgs::LaserScan scan;
   scan.header.stamp = stamp;  // the first beam's time (every beam's, when instantaneous)
@@ -181,7 +206,11 @@ void Sensor::publishCloud(const ros::Time& stamp) {
   options.organized = cast_params_.organized;
   options.layout = cast_params_.point_layout;
   sensor_msgs::PointCloud2 cloud;
-  buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud);
+  if (cast_params_.offGrid()) {
+    buildBeamCloud(beams_, measured_, header, options, &cloud);
+  } else {
+    buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud);
+  }
   output_->send(cloud);
 }
 

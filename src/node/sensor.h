@@ -80,6 +80,10 @@ class Sensor {
  private:
   // Applies a pending live change (cast thread, at the start of a scan).
   void applyLive();
+  // A pattern file's next scan (beams_), at once or each point at its own time.
+  const core::ScanResult* castPattern(const core::Scene& scene, const std::vector<ros::Time>& times,
+                                      const std::vector<core::FramePoses>& frames,
+                                      const std::vector<Eigen::Isometry3d>& poses);
   void publishScan(const ros::Time& stamp);
   void publishCloud(const ros::Time& stamp);
   void publishLabels(const core::Scene& scene, const std_msgs::Header& header);
@@ -100,6 +104,9 @@ class Sensor {
   core::PulseReturns returns_;    // with divergent beams (beam_samples > 1)
   core::SurfaceSamples surface_;  // the surfaces' reflectance and incidence, when intensity is on
   std::vector<double> column_times_;  // s after the stamp, per azimuth column (rotating)
+  // A pattern file's beams: this scan's, and the row the next scan starts at (the file a loop).
+  core::BeamList beams_;
+  std::int64_t next_row_ = 0;
 
   std::unique_ptr<ScanOutput> output_;
   std::unique_ptr<PoseTopic> pose_topic_;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "laser_raycast/core/sensor_model.h"
+#include "laser_raycast/loader/velodyne_calibration.h"
 
 namespace laser_raycast {
 namespace {
@@ -160,6 +161,58 @@ void readPoseSource(ParamReader* r, SensorParams* s) {
   }
 }
 
+// ~calibration_file: a calibrated Velodyne head's beams instead of the fan.
+void readCalibration(ParamReader* r, SensorParams* s) {
+  s->calibration_file = r->text("calibration_file", s->calibration_file);
+  if (s->calibration_file.empty()) {
+    s->calibrated.reset();
+    return;
+  }
+  if (!s->pattern_file.empty()) {
+    r->fail("calibration_file", "is set and so is " + r->prefix() + "pattern_file: give one");
+    return;
+  }
+  try {
+    const core::VelodyneHead head = loadVelodyneCalibration(s->calibration_file);
+    s->calibrated = std::make_shared<const core::BeamList>(head.scan(s->scanTime()));
+  } catch (const std::invalid_argument& e) {
+    r->fail("calibration_file", e.what());
+  }
+}
+
+// ~pattern_file, ~points_per_scan, ~point_rate: beams from a scan pattern file instead of the fan.
+void readPatternFile(ParamReader* r, SensorParams* s) {
+  s->pattern_file = r->text("pattern_file", s->pattern_file);
+  s->points_per_scan = r->integer("points_per_scan", s->points_per_scan, "points");
+  s->point_rate = r->number("point_rate", s->point_rate, "Hz");
+  if (s->pattern_file.empty()) {
+    s->pattern.reset();
+    for (const char* name : {"points_per_scan", "point_rate"}) {
+      if (r->has(name))
+        r->fail(name, std::string("is set but ") + r->prefix() + "pattern_file is not");
+    }
+    return;
+  }
+  if (!(std::isfinite(s->point_rate) && s->point_rate > 0)) {
+    r->fail("point_rate", "must be > 0 Hz with a pattern_file, got " + formatNumber(s->point_rate));
+  }
+  if (s->points_per_scan < 0 || s->points_per_scan > core::FanSpec::kMaxBeams) {
+    r->fail("points_per_scan", "must be in [0, " + std::to_string(core::FanSpec::kMaxBeams) +
+                                   "] (0: the file's rows), got " +
+                                   std::to_string(s->points_per_scan));
+  }
+  if (!s->pattern || r->has("pattern_file")) {
+    try {
+      s->pattern =
+          std::make_shared<const core::PatternFile>(core::PatternFile::load(s->pattern_file));
+    } catch (const std::invalid_argument& e) {
+      r->fail("pattern_file", e.what());
+      return;
+    }
+  }
+  if (s->points_per_scan == 0) s->points_per_scan = s->pattern->size();
+}
+
 }  // namespace
 
 void checkFrame(ParamReader* r, const std::string& name, const std::string& frame, bool optional) {
@@ -202,6 +255,8 @@ void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::st
   readRate(r, s);
   readSweep(r, s, warnings);
   readPoseSource(r, s);
+  readPatternFile(r, s);
+  readCalibration(r, s);
   // The angles and beam count, elevations, ranges, noise and realism: checked once, by the core.
   if (r->error().empty()) {
     try {
@@ -217,8 +272,14 @@ void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::st
   }
   // The layout's integer fields must hold every ring number and point time of the scan.
   if (r->error().empty() && !s->planar()) {
-    const std::string limit = pointLayoutLimit(
-        s->point_layout, static_cast<int>(s->scan.elevations.size()), s->sweepDuration());
+    // A pattern file's lines (at most 256) and its points' times, even when cast at once.
+    const int rings = s->pattern      ? 256
+                      : s->calibrated ? s->calibrated->lines.empty() ? 1 : 256
+                                      : static_cast<int>(s->scan.elevations.size());
+    const double last_time = s->pattern      ? (s->points_per_scan - 1) / s->point_rate
+                             : s->calibrated ? s->calibrated->times.back()
+                                             : s->sweepDuration();
+    const std::string limit = pointLayoutLimit(s->point_layout, rings, last_time);
     if (!limit.empty()) r->fail("point_layout", limit);
   }
   const auto no_effect = [&](const char* name) {
@@ -235,6 +296,8 @@ double SensorParams::timeIncrement() const {
 }
 
 double SensorParams::sweepDuration() const {
+  if (pattern) return sweep == Sweep::kRotating ? (points_per_scan - 1) / point_rate : 0.0;
+  if (calibrated) return sweep == Sweep::kRotating ? calibrated->times.back() : 0.0;
   return sweep == Sweep::kRotating ? (scan.fan.beamCount() - 1) * timeIncrement() : 0.0;
 }
 

@@ -35,8 +35,9 @@ const char* const kSynopsis =
     "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--method NAME ...] [--list-methods]\n"
     "             [--threads N] [--list-scenes]\n";
 const char* const kNotes =
-    "Times every method on the workloads fan2d and rings3d (one pose cast again and again),\n"
-    "and the pipeline and Embree on sensors moving along a path (fan_path, fan_path_tilted,\n"
+    "Times every method on the workloads fan2d and rings3d (one pose cast again and again)\n"
+    "and on beams off any grid from the same poses (pattern_rosette: a pattern file's rosette;\n"
+    "vlp16_calibrated: a calibrated VLP-16's beams), and the pipeline and Embree on sensors moving along a path (fan_path, fan_path_tilted,\n"
     "rings_path, sweep_fan, sweep_rings), and measures each beam's error against a long\n"
     "double reference and its agreement with Embree's robust mode. Writes DIR/results.csv,\n"
     "results.md, pareto.png (one point per method) and pareto_matrix.png (every workload and\n"

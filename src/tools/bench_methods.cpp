@@ -9,6 +9,8 @@
 #include <utility>
 
 #include "bench_paths.h"
+#include "laser_raycast/core/pattern_file.h"
+#include "laser_raycast/core/velodyne_beams.h"
 
 namespace laser_raycast {
 namespace bench {
@@ -87,11 +89,13 @@ Pass pipelinePass(const BenchScene& scene, int threads, bool keep_slices) {
     config.tmax = w.tmax;
     config.threads = threads;
     config.keep_slices = keep_slices;
-    const std::size_t beams = static_cast<std::size_t>(w.pattern->size());
+    const std::size_t beams = static_cast<std::size_t>(w.beamCount());
     for (std::size_t p = 0; p < w.scans(); ++p) {
       caster->forget();
       const core::ScanResult& result =
-          w.sweeps.empty()
+          w.offGrid()
+              ? caster->castBeams(scene.scene, scene.frame_poses, w.sensors[p], w.beams, config)
+          : w.sweeps.empty()
               ? caster->cast(scene.scene, scene.frame_poses, w.sensors[p], *w.pattern, config)
               : caster->castSweep(scene.scene, w.sweeps[p], *w.pattern, config, w.time_increment);
       std::copy(result.range.begin(), result.range.end(), out->begin() + p * beams);
@@ -224,6 +228,15 @@ const std::vector<Workload>& workloads() {
     all.push_back(moving("rings_path", fullTurn(1800), vlp16Rings(), Motion::kPath, 10, 30, 2));
     all.push_back(moving("sweep_fan", fullTurn(360), {0.0}, Motion::kSweep, 5, 40, 3));
     all.push_back(moving("sweep_rings", fullTurn(1800), vlp16Rings(), Motion::kSweep, 10, 20, 1));
+    Workload rosette = stillWorkloads()[1];
+    rosette.name = "pattern_rosette";
+    rosette.pattern_file = "rosette_4line.csv";
+    all.push_back(rosette);
+    Workload vlp16 = rosette;
+    vlp16.name = "vlp16_calibrated";
+    vlp16.pattern_file.clear();
+    vlp16.calibrated_vlp16 = true;
+    all.push_back(vlp16);
     return all;
   }();
   return list;
@@ -235,6 +248,18 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
   w.workload = &workload;
   w.pattern = std::make_unique<core::ScanPattern>(workload.fan, workload.elevations);
   w.tmax = tmax;
+  if (!workload.pattern_file.empty()) {
+    const core::PatternFile file = core::PatternFile::load(
+        std::string(LASER_RAYCAST_SOURCE_DIR "/config/patterns/") + workload.pattern_file);
+    w.beams = file.scan(0, file.size(), 1.0);
+    w.beams.times.clear();
+    w.beams.lines.clear();
+  }
+  if (workload.calibrated_vlp16) {
+    w.beams = core::nominalVlp16().scan(0.1);
+    w.beams.times.clear();
+    w.beams.lines.clear();
+  }
   if (workload.motion == Motion::kPath) {
     w.poses = pathPoses(scene, soup_bvh, workload, count);
   } else if (workload.motion == Motion::kSweep) {
@@ -244,9 +269,9 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
     w.poses.assign(scene.sensor_poses.begin(), scene.sensor_poses.begin() + count);
   }
   for (const SensorPose& p : w.poses) w.sensors.push_back(toIsometry(p.exact()));
-  const auto& directions = w.pattern->directions();
+  const auto& directions = w.directions();
   for (std::size_t scan = 0; scan < w.scans(); ++scan) {
-    for (int b = 0; b < w.pattern->size(); ++b) {
+    for (int b = 0; b < w.beamCount(); ++b) {
       const Eigen::Isometry3d& sensor = w.sensors[w.poseIndex(scan, b)];
       core::Ray ray;
       ray.origin = sensor.translation();

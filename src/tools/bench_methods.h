@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bench_scenes.h"
+#include "laser_raycast/core/beam_list.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/core/scan_pattern.h"
@@ -32,6 +33,12 @@ struct Workload {
   Motion motion = Motion::kStill;
   double scan_rate = 0;   // Hz, moving workloads: scans a second (a sweep lasts 1 / scan_rate s)
   double tilt_sigma = 0;  // rad, paths: each pose's roll and pitch ~ N(0, tilt_sigma)
+  // Beams off any grid: every row of this scan pattern file (config/patterns/, core::PatternFile)
+  // from each sensor pose, cast by Caster::castBeams; "" for the fan and elevations above.
+  std::string pattern_file;
+  // Beams off any grid: a VLP-16 with its published per-laser elevations, each laser at its own
+  // azimuth and firing time (core::nominalVlp16(), one 0.1 s turn), by Caster::castBeams.
+  bool calibrated_vlp16 = false;
 };
 
 // Still, from the scene's sensor poses: fan2d, 1081 beams over 270 degrees; rings3d, 64 rings
@@ -39,7 +46,9 @@ struct Workload {
 // the scene's first sensor pose: fan_path and fan_path_tilted, the fan once per pose at 40 Hz
 // (a UTM-30LX), level or tilted by N(0, 0.4 degrees); rings_path, a VLP-16 (16 rings from -15 to
 // +15 degrees x 1800 azimuths) at 10 Hz; sweep_fan, a rotating 360-beam fan at 5 Hz (an LDS-01);
-// sweep_rings, a rotating VLP-16 at 10 Hz.
+// sweep_rings, a rotating VLP-16 at 10 Hz. Still, beams off any grid: pattern_rosette, the
+// 10000 points of config/patterns/rosette_4line.csv (a Livox-like rosette) from the scene's poses;
+// vlp16_calibrated, a VLP-16's 1808 x 16 beams as a calibrated head fires them.
 const std::vector<Workload>& workloads();
 
 // Every beam of a workload from each sensor pose, pose-major, as the triangle methods and peers get
@@ -47,7 +56,8 @@ const std::vector<Workload>& workloads();
 // times the length of the direction it was given (scale, scale_f).
 struct WorkloadRays {
   const Workload* workload = nullptr;
-  std::unique_ptr<core::ScanPattern> pattern;
+  std::unique_ptr<core::ScanPattern> pattern;  // the grid (a pattern file's workload: unused)
+  core::BeamList beams;  // a pattern file's beams (Workload::pattern_file), else empty
   std::vector<SensorPose> poses;
   std::vector<Eigen::Isometry3d> sensors;  // the poses rounded to double (what the pipeline gets)
   std::vector<core::Ray> rays;
@@ -59,6 +69,12 @@ struct WorkloadRays {
   std::vector<core::PoseSamples> sweeps;
   double time_increment = 0;
 
+  bool offGrid() const { return !beams.directions.empty(); }
+  int beamCount() const { return offGrid() ? beams.size() : pattern->size(); }
+  const std::vector<Eigen::Vector3d>& directions() const {
+    return offGrid() ? beams.directions : pattern->directions();
+  }
+  bool planar() const { return !offGrid() && pattern->planar(); }
   std::size_t scans() const { return sweeps.empty() ? sensors.size() : sweeps.size(); }
   // The pose beam b (ring-major, as in the pattern) of a scan is cast from.
   std::size_t poseIndex(std::size_t scan, int beam) const {

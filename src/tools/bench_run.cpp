@@ -61,9 +61,9 @@ void crossCheckReference(const std::string& label, const std::vector<Real>& tria
 // double directions of core::ScanPattern, composed in long double.
 std::vector<RayL> pipelineInputRays(const WorkloadRays& w) {
   std::vector<RayL> out;
-  const auto& directions = w.pattern->directions();
+  const auto& directions = w.directions();
   for (std::size_t scan = 0; scan < w.scans(); ++scan) {
-    for (int b = 0; b < w.pattern->size(); ++b) {
+    for (int b = 0; b < w.beamCount(); ++b) {
       const Eigen::Isometry3d& sensor = w.sensors[w.poseIndex(scan, b)];
       RayL ray;
       ray.origin = sensor.translation().cast<Real>();
@@ -87,8 +87,12 @@ References computeReferences(const BenchScene& scene, const SceneGeometry& geome
   References refs;
   const std::vector<RayL> exact = exactRays(rays.rays);
   refs.soup = referenceSoup(geometry.bvh, exact);
-  refs.pipeline = referenceBodies(scene, pipelineRays(rays.poses, workload.fan, workload.elevations,
-                                                      rays.tmax, !rays.sweeps.empty()));
+  // A pattern file's beams: its directions as the pipeline holds them (double), there being no
+  // angles to recompute them from in long double.
+  refs.pipeline = referenceBodies(
+      scene, rays.offGrid() ? pipelineInputRays(rays)
+                            : pipelineRays(rays.poses, workload.fan, workload.elevations, rays.tmax,
+                                           !rays.sweeps.empty()));
   std::cerr << "  " << workload.name << ": " << rays.rays.size() << " rays from " << rays.scans()
             << (rays.sweeps.empty() ? " poses" : " rotating scans") << "; the reference hits "
             << countHits(refs.soup) << " (soup) and " << countHits(refs.pipeline)
@@ -200,7 +204,7 @@ void runWorkload(const Settings& settings, int poses, const BenchScene& scene,
   const std::size_t first = rows->size();
   std::vector<Measured> measured;
   for (const Method& method : methods.rows) {
-    if (method.planar_only && !rays.pattern->planar()) continue;
+    if (method.planar_only && !rays.planar()) continue;
     if (workload.motion != Motion::kStill && !method.moving) continue;
     const std::vector<int>& used = method.brute ? subset : all;
     std::vector<double> dist = unknown();

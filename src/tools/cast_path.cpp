@@ -1,5 +1,6 @@
 #include "cast_path.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -166,9 +167,19 @@ Eigen::Isometry3d poseAfter(const Eigen::Isometry3d& start, const Twist& twist, 
 core::PoseSamples sweepSamples(const PathArgs& path, const Eigen::Isometry3d& start,
                                const core::FramePoses& frames, const core::ScanPattern& pattern) {
   const double increment = timeIncrement(path, pattern.angleIncrement());
-  core::PoseSamples samples;
+  std::vector<double> times;
   for (int c = 0; c < pattern.azimuthCount(); ++c) {
-    const double t = c * increment;  // as Caster::castSweep reckons a column's time
+    times.push_back(c * increment);  // as Caster::castSweep reckons a column's time
+  }
+  return sweepSamplesAt(path, start, frames, std::move(times));
+}
+
+core::PoseSamples sweepSamplesAt(const PathArgs& path, const Eigen::Isometry3d& start,
+                                 const core::FramePoses& frames, std::vector<double> times) {
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  core::PoseSamples samples;
+  for (const double t : times) {
     samples.times.push_back(t);
     samples.world_from_sensor.push_back(poseAfter(start, path.twist, t));
     samples.frames.push_back(frames);

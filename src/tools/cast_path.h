@@ -78,6 +78,10 @@ Eigen::Isometry3d poseAfter(const Eigen::Isometry3d& start, const Twist& twist, 
 // they are.
 core::PoseSamples sweepSamples(const PathArgs& path, const Eigen::Isometry3d& start,
                                const core::FramePoses& frames, const core::ScanPattern& pattern);
+// The same with a sample at each distinct time of `times` (s, >= 0, any order): the beams of a
+// pattern file, each cast from the pose at its own time.
+core::PoseSamples sweepSamplesAt(const PathArgs& path, const Eigen::Isometry3d& start,
+                                 const core::FramePoses& frames, std::vector<double> times);
 
 }  // namespace tools
 }  // namespace laser_raycast

@@ -9,6 +9,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -18,12 +19,14 @@
 #include "command_line.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/measurement_model.h"
+#include "laser_raycast/core/pattern_file.h"
 #include "laser_raycast/core/returns.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/kinematics.h"
 #include "laser_raycast/loader/map_file.h"
 #include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
+#include "laser_raycast/loader/velodyne_calibration.h"
 
 namespace {
 
@@ -59,6 +62,16 @@ struct Args {
   bool dual() const {
     return returns.beam_samples > 1 && returns.return_mode == core::ReturnMode::kDual;
   }
+  // --pattern-file: the beams of each scan from the file's next rows instead of a fan.
+  std::string pattern_path;
+  std::optional<core::PatternFile> pattern_file;
+  int points_per_scan = 0;  // 0: the file's row count
+  double point_rate = 0;    // Hz, > 0 with --pattern-file
+  // --calibration: a Velodyne head's beams, one turn (the same every scan).
+  std::string calibration_path;
+  std::optional<core::BeamList> calibrated;
+  // Beams off any grid: a pattern file's or a calibrated head's.
+  bool offGrid() const { return pattern_file || calibrated; }
 };
 
 std::string formatNumber(double value) {
@@ -191,6 +204,16 @@ po::options_description flags(Args* args) {
                args->rings = true;
              }),
       "one fan of azimuths per elevation (rad, up positive, any order); ring r is the r-th lowest");
+  add("pattern-file", single("FILE", [args](const std::string& v) { args->pattern_path = v; }),
+      "a scan pattern CSV 'Time/s,Azimuth/deg,Zenith/deg[,Line]' read as a loop: each scan takes "
+      "its next --points-per-scan rows instead of a fan");
+  add("calibration", single("FILE", [args](const std::string& v) { args->calibration_path = v; }),
+      "a Velodyne calibration YAML (velodyne_pointcloud's): each laser's beam, origin and firing "
+      "time over one turn (--scan-time with --sweep rotating, else 0.1 s) instead of a fan");
+  add("points-per-scan", count("--points-per-scan", &args->points_per_scan),
+      "rows of --pattern-file a scan takes (default: all of them)");
+  add("point-rate", number("--point-rate", "HZ", &args->point_rate),
+      "points a second of --pattern-file: point k of a scan at k / HZ s (required with it)");
   add("joint",
       repeated("NAME=VALUE ...", [args](const std::string& v) { parseJoint(v, &args->joints); })
           ->multitoken(),
@@ -241,6 +264,54 @@ std::string underItsFlag(const std::string& message, const std::string& beams_fr
   return flag.empty() ? message : "--" + flag + ": " + message;
 }
 
+// The turn of a calibrated head cast at once (no --scan-time): 10 Hz, the models' default.
+constexpr double kCalibratedScanTime = 0.1;  // s
+
+// --pattern-file and its flags, or --calibration; loads the file. Throws ArgError.
+void checkPatternFlags(const po::variables_map& values, Args* args) {
+  if ((!args->calibration_path.empty() || !args->pattern_path.empty()) &&
+      args->returns.beam_samples > 1) {
+    throw ArgError("--beam-samples > 1: not with --pattern-file or --calibration (divergent beams "
+                   "are cast for a fan or rings)");
+  }
+  if (!args->calibration_path.empty()) {
+    if (!args->pattern_path.empty())
+      throw ArgError("give --calibration or --pattern-file, not both");
+    for (const char* flag :
+         {"elevations", "samples", "angle-increment", "angle-min", "angle-max"}) {
+      if (values.count(flag)) throw ArgError(std::string("--") + flag + ": not with --calibration");
+    }
+    try {
+      const core::VelodyneHead head =
+          laser_raycast::loadVelodyneCalibration(args->calibration_path);
+      const bool rotating = args->path.sweep == laser_raycast::tools::Sweep::kRotating;
+      args->calibrated = head.scan(rotating ? args->path.scan_time : kCalibratedScanTime);
+    } catch (const std::invalid_argument& e) {
+      throw ArgError(std::string("--calibration: ") + e.what());
+    }
+  }
+  if (args->pattern_path.empty()) {
+    for (const char* flag : {"points-per-scan", "point-rate"}) {
+      if (values.count(flag))
+        throw ArgError(std::string("--") + flag + ": only with --pattern-file");
+    }
+    return;
+  }
+  for (const char* flag : {"elevations", "samples", "angle-increment", "angle-min", "angle-max"}) {
+    if (values.count(flag)) throw ArgError(std::string("--") + flag + ": not with --pattern-file");
+  }
+  if (!(args->point_rate > 0)) throw ArgError("--pattern-file: give --point-rate HZ (> 0)");
+  try {
+    args->pattern_file = core::PatternFile::load(args->pattern_path);
+  } catch (const std::invalid_argument& e) {
+    throw ArgError(std::string("--pattern-file: ") + e.what());
+  }
+  if (args->points_per_scan == 0) args->points_per_scan = args->pattern_file->size();
+  if (args->points_per_scan > core::FanSpec::kMaxBeams) {
+    throw ArgError("--points-per-scan: more than " + std::to_string(core::FanSpec::kMaxBeams));
+  }
+}
+
 // Throws ArgError.
 Args parseArgs(int argc, char** argv, bool* help) {
   Args args;
@@ -275,6 +346,7 @@ Args parseArgs(int argc, char** argv, bool* help) {
     throw ArgError(underItsFlag(e.what(), ""));
   }
   laser_raycast::tools::checkSweepTimes(args.path, args.scan.fan);
+  checkPatternFlags(values, &args);
   return args;
 }
 
@@ -308,6 +380,8 @@ std::string synopsis() {
       << choices(laser_raycast::kGeometrySourceNames) << "]\n"
       << indent << "[--method " << choices(core::kTriangleMethodNames) << "]\n"
       << indent << "[--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n"
+      << indent << "[--pattern-file FILE --point-rate HZ [--points-per-scan N]]\n"
+      << indent << "[--calibration FILE]\n"
       << indent << "[--threads N] [--mesh-import-max-memory-mb MB] [--mesh-import-timeout S]\n";
   return out.str();
 }
@@ -322,6 +396,9 @@ std::string notes() {
       << "'index,ring,elevation,angle,range,link' (ring 0 the lowest). With --poses, a scan\n"
       << "from each pose of FILE in turn, its rows led by 'pose' (0: the file's first pose line).\n"
       << "With --sweep rotating, each row ends with 'time', s after the scan's first beam.\n"
+      << "With --pattern-file or --calibration, 'index,line,azimuth,elevation,time,range,link'\n"
+      << "(rad; time k / HZ s, or the laser's firing time; with --sweep rotating each beam is\n"
+      << "cast from the pose at its time; line: the file's Line, or the laser's ring).\n"
       << "Defaults: angles " << formatAngle(scan.fan.angle_min) << ".."
       << formatAngle(scan.fan.angle_max) << ", " << core::FanSpec::kDefaultSamples
       << " samples, ranges " << formatNumber(scan.output.range_min) << ".."
@@ -427,15 +504,31 @@ struct Casting {
   core::Caster caster;
   double time_increment;  // s between two azimuth columns: > 0 for a rotating sweep
   core::PulseReturns returns;  // with --beam-samples > 1
+  core::BeamList beams;        // --pattern-file: this scan's beams
 };
 
-// The scan from sensor, at once or as a rotating sweep starting there; *ns, if given, the time of
-// the cast alone (not of the sweep's samples).
+// A pattern file's beams of the path's scan number `pose` into casting->beams: its rows from
+// pose * points_per_scan on.
+void patternScan(const Args& args, std::size_t pose, Casting* casting) {
+  if (args.calibrated) casting->beams = *args.calibrated;
+  if (!args.pattern_file) return;
+  casting->beams = args.pattern_file->scan(static_cast<std::int64_t>(pose) * args.points_per_scan,
+                                           args.points_per_scan, args.point_rate);
+}
+
+// The scan from sensor, at once or as a rotating sweep starting there (a pattern file's beams,
+// casting->beams, or the fan); *ns, if given, the time of the cast alone (not of the sweep's
+// samples).
 const core::ScanResult& castFrom(const Args& args, const LoadedScene& loaded,
                                  const Eigen::Isometry3d& sensor, Casting* casting, long long* ns) {
   const bool rotating = args.path.sweep == laser_raycast::tools::Sweep::kRotating;
+  core::Caster& caster = casting->caster;
+  const core::CastConfig& config = casting->config;
   core::PoseSamples samples;
-  if (rotating) {
+  if (rotating && args.offGrid()) {
+    samples =
+        laser_raycast::tools::sweepSamplesAt(args.path, sensor, loaded.poses, casting->beams.times);
+  } else if (rotating) {
     samples = laser_raycast::tools::sweepSamples(args.path, sensor, loaded.poses, casting->pattern);
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -448,14 +541,19 @@ const core::ScanResult& castFrom(const Args& args, const LoadedScene& loaded,
     if (ns) *ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
     return casting->returns.first;
   }
-  const core::ScanResult& result =
-      rotating ? casting->caster.castSweep(loaded.scene, samples, casting->pattern, casting->config,
-                                           casting->time_increment)
-               : casting->caster.cast(loaded.scene, loaded.poses, sensor, casting->pattern,
-                                      casting->config);
+  const core::ScanResult* result;
+  if (args.offGrid()) {
+    result = rotating
+                 ? &caster.castBeamsSweep(loaded.scene, samples, casting->beams, config)
+                 : &caster.castBeams(loaded.scene, loaded.poses, sensor, casting->beams, config);
+  } else {
+    result = rotating ? &caster.castSweep(loaded.scene, samples, casting->pattern, config,
+                                          casting->time_increment)
+                      : &caster.cast(loaded.scene, loaded.poses, sensor, casting->pattern, config);
+  }
   const auto t1 = std::chrono::steady_clock::now();
   if (ns) *ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
-  return result;
+  return *result;
 }
 
 // Casts every scan of the path `repeat` more times and prints the median time of a scan over all
@@ -466,7 +564,9 @@ void reportMedianCastTime(const Args& args, const LoadedScene& loaded, Casting* 
   std::vector<long long> ns(args.repeat * args.path.sensors.size());
   auto next = ns.begin();
   for (int k = 0; k < args.repeat; ++k) {
-    for (const Eigen::Isometry3d& sensor : args.path.sensors) {
+    for (std::size_t p = 0; p < args.path.sensors.size(); ++p) {
+      const Eigen::Isometry3d& sensor = args.path.sensors[p];
+      patternScan(args, p, casting);
       casting->caster.forget();  // time the cast itself, not the reuse of an unchanged scan
       castFrom(args, loaded, sensor, casting, &*next++);
     }
@@ -498,9 +598,20 @@ void reportLoad(const LoadedScene& loaded) {
 // The CSV's header: with --poses, the pose's number first; with a rotating sweep, the beam's time
 // last.
 std::string csvHeader(const Args& args, const Casting& casting) {
+  if (args.offGrid()) {
+    return std::string(args.path.pose_column ? "pose," : "") +
+           "index,line,azimuth,elevation,time,range,link\n";
+  }
   return std::string(args.path.pose_column ? "pose," : "") +
          (args.rings ? "index,ring,elevation,angle,range,link" : "index,angle,range,link") +
          (casting.time_increment > 0 ? ",time" : "") + (args.dual() ? ",return\n" : "\n");
+}
+
+// The label of the body hit ("" for none), without a model's private prefix.
+std::string bodyLabel(const LoadedScene& loaded, int body) {
+  if (body < 0) return "";
+  const std::string& label = loaded.scene.labels()[loaded.scene.bodies()[body].label];
+  return loaded.prefixed ? label.substr(label.find('/') + 1) : label;
 }
 
 // One CSV row per beam of the scan from the path's pose number `pose`, in beam order
@@ -508,6 +619,20 @@ std::string csvHeader(const Args& args, const Casting& casting) {
 std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& casting,
                     const core::ScanResult& result, std::size_t pose) {
   std::string out;
+  if (args.offGrid()) {
+    const core::BeamList& beams = casting.beams;
+    for (int i = 0; i < beams.size(); ++i) {
+      const Eigen::Vector3d& d = beams.directions[i];
+      if (args.path.pose_column) out += std::to_string(pose) + ",";
+      out += std::to_string(i) + "," + std::to_string(beams.line(i)) + "," +
+             formatNumber(std::atan2(d.y(), d.x())) + "," +
+             formatNumber(std::atan2(d.z(), std::hypot(d.x(), d.y()))) + "," +
+             formatNumber(beams.time(i)) + "," +
+             formatNumber(core::classifyRange(result.range[i], args.scan.output)) + "," +
+             bodyLabel(loaded, result.body[i]) + "\n";
+    }
+    return out;
+  }
   const core::ScanPattern& pattern = casting.pattern;
   const int azimuths = pattern.azimuthCount();
   for (int row = 0; row < (args.dual() ? 2 : 1) * pattern.size(); ++row) {
@@ -524,10 +649,7 @@ std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& 
     }
     out += formatNumber(pattern.azimuth(i % azimuths)) + "," +
            formatNumber(core::classifyRange(beams.range[i], args.scan.output)) + ",";
-    if (beams.body[i] >= 0) {
-      const std::string& label = loaded.scene.labels()[loaded.scene.bodies()[beams.body[i]].label];
-      out += loaded.prefixed ? label.substr(label.find('/') + 1) : label;
-    }
+    out += bodyLabel(loaded, beams.body[i]);
     if (casting.time_increment > 0) {
       out += "," + formatNumber(i % azimuths * casting.time_increment);  // castSweep's column time
     }
@@ -556,12 +678,17 @@ int main(int argc, char** argv) {
     std::cerr << "cast_scan: " << e.what() << "\n";
     return kExitBadArguments;
   }
-  Casting casting{args.scan.pattern(), args.scan.castConfig(), core::Caster(),
-                  laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment()), {}};
+  Casting casting{args.scan.pattern(),
+                  args.scan.castConfig(),
+                  core::Caster(),
+                  laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment()),
+                  {},
+                  {}};
   casting.config.threads = args.threads;
   // The path in order, each scan printed before the next is cast (the result is the caster's).
   print(csvHeader(args, casting));
   for (std::size_t p = 0; p < args.path.sensors.size(); ++p) {
+    patternScan(args, p, &casting);
     print(csvRows(args, loaded, casting,
                   castFrom(args, loaded, args.path.sensors[p], &casting, nullptr), p));
   }

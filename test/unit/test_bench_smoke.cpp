@@ -78,11 +78,23 @@ std::string tempDir(const std::string& name) {
   return dir;
 }
 
-// The beams of one scan of each workload: still (fan2d, rings3d) and moving.
-const std::map<std::string, long> kWorkloadBeams = {
-    {"fan2d", 1081},           {"rings3d", 64 * 1024},    {"fan_path", 1081},
-    {"fan_path_tilted", 1081}, {"rings_path", 16 * 1800}, {"sweep_fan", 360},
-    {"sweep_rings", 16 * 1800}};
+// The beams of one scan of each workload: still (fan2d, rings3d, and beams off any grid:
+// pattern_rosette, vlp16_calibrated) and moving.
+const std::map<std::string, long> kWorkloadBeams = {{"fan2d", 1081},
+                                                    {"rings3d", 64 * 1024},
+                                                    {"fan_path", 1081},
+                                                    {"fan_path_tilted", 1081},
+                                                    {"rings_path", 16 * 1800},
+                                                    {"sweep_fan", 360},
+                                                    {"sweep_rings", 16 * 1800},
+                                                    {"pattern_rosette", 10000},
+                                                    {"vlp16_calibrated", 16 * 1808}};
+
+// A workload cast from the scene's poses, every method on it.
+bool isStill(const std::string& workload) {
+  return workload == "fan2d" || workload == "rings3d" || workload == "pattern_rosette" ||
+         workload == "vlp16_calibrated";
+}
 
 bool isBruteForce(const std::string& method) {
   return method.size() > 6 && method.compare(method.size() - 6, 6, "_brute") == 0;
@@ -95,7 +107,7 @@ bool isMovingRow(const std::string& method) {
 // The rows a workload has in a run of every method (those of --list-methods).
 std::set<std::string> expectedRows(const std::string& workload,
                                    const std::vector<std::string>& methods) {
-  const bool still = workload == "fan2d" || workload == "rings3d";
+  const bool still = isStill(workload);
   std::set<std::string> rows;
   for (const std::string& m : methods) {
     if (still ? m != "pipeline_new_plane" || workload == "fan2d" : isMovingRow(m)) rows.insert(m);
@@ -114,7 +126,7 @@ void expectMovingRatios(const std::vector<std::string>& lines, bool has_embree) 
   }
   int moving = 0;
   for (const auto& [key, rows] : ns) {
-    if (key.first == "fan2d" || key.first == "rings3d") continue;
+    if (isStill(key.first)) continue;
     ++moving;
     ASSERT_EQ(rows.count("pipeline"), 1u) << key.first << ", " << key.second;
     if (!has_embree) continue;
@@ -265,8 +277,8 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  // header, 2 still workloads x 2 rows, 5 moving ones x the pipeline's row
-  ASSERT_EQ(lines.size(), 10u) << readFile(dir + "/results.csv");
+  // header, 4 still workloads x 2 rows, 5 moving ones x the pipeline's row
+  ASSERT_EQ(lines.size(), 14u) << readFile(dir + "/results.csv");
   std::multiset<std::string> rows;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const auto f = splitFields(lines[i]);
@@ -277,7 +289,9 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
   EXPECT_EQ(rows, (std::multiset<std::string>{
                       "fan2d watertight_bvh", "fan2d pipeline", "rings3d watertight_bvh",
                       "rings3d pipeline", "fan_path pipeline", "fan_path_tilted pipeline",
-                      "rings_path pipeline", "sweep_fan pipeline", "sweep_rings pipeline"}));
+                      "rings_path pipeline", "sweep_fan pipeline", "sweep_rings pipeline",
+                      "pattern_rosette watertight_bvh", "pattern_rosette pipeline",
+                      "vlp16_calibrated watertight_bvh", "vlp16_calibrated pipeline"}));
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
 }
@@ -292,8 +306,9 @@ TEST(BenchSmoke, NewPlaneRowHasThePipelinesRanges) {
       " --quick --scene forest --method pipeline pipeline_new_plane --out " + dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  // header, fan2d x 2 rows, rings3d x 1 row, then the pipeline's 5 moving rows
-  ASSERT_EQ(lines.size(), 9u) << readFile(dir + "/results.csv");
+  // header, fan2d x 2 rows, rings3d x 1 row, the pipeline's 5 moving rows, then one row each of
+  // pattern_rosette and vlp16_calibrated
+  ASSERT_EQ(lines.size(), 11u) << readFile(dir + "/results.csv");
   const auto kept = splitFields(lines[1]), fresh = splitFields(lines[2]);
   ASSERT_EQ(kept.size(), kFields);
   ASSERT_EQ(fresh.size(), kFields);
@@ -317,7 +332,7 @@ TEST(BenchSmoke, ThreadsAddsAPipelineRowWithTheSameRanges) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  ASSERT_EQ(lines.size(), 15u) << readFile(dir + "/results.csv");  // header, 7 workloads x 2
+  ASSERT_EQ(lines.size(), 19u) << readFile(dir + "/results.csv");  // header, 9 workloads x 2
   for (std::size_t i = 1; i + 1 < lines.size(); i += 2) {
     const auto one = splitFields(lines[i]), two = splitFields(lines[i + 1]);
     ASSERT_EQ(one.size(), kFields) << lines[i];
@@ -358,7 +373,7 @@ TEST(BenchSmoke, MovingRowsAreTheSameInEveryRun) {
     const auto a = splitFields(runs[0][i]), b = splitFields(runs[1][i]);
     ASSERT_EQ(a.size(), kFields) << runs[0][i];
     ASSERT_EQ(b.size(), kFields) << runs[1][i];
-    if (a[0] == "fan2d" || a[0] == "rings3d") continue;
+    if (isStill(a[0])) continue;
     ++moving;
     for (const std::size_t k : {0, 1, 2, 5, 8, 9, 10, 11, 12, 13, 14}) {
       EXPECT_EQ(a[k], b[k]) << "field " << k << ": " << runs[0][i] << " / " << runs[1][i];

@@ -83,6 +83,10 @@ const std::vector<std::string> kReadmeParameters = {"frame_id",
                                                     "beam_samples",
                                                     "return_mode",
                                                     "min_return_separation",
+                                                    "pattern_file",
+                                                    "points_per_scan",
+                                                    "point_rate",
+                                                    "calibration_file",
                                                     "sensors"};
 
 TEST(NodeParams, TheNodeReadsExactlyTheDocumentedParameters) {

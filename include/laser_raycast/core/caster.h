@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <memory>
 
+#include "laser_raycast/core/beam_list.h"
 #include "laser_raycast/core/cast_config.h"
 #include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/core/scan_pattern.h"
@@ -41,6 +42,18 @@ class Caster {
   const ScanResult& castSweep(const Scene& scene, const PoseSamples& samples,
                               const ScanPattern& pattern, const CastConfig& config,
                               double time_increment);
+
+  // Beams off any grid (beam_list.h), each cast as its own ray from its origin through the scene's
+  // trees with the exact tests the grid's walks use (src/core/caster/caster_beams.cpp): every beam
+  // from world_from_sensor. Result i is beam i; the same for any thread count. Never reused.
+  const ScanResult& castBeams(const Scene& scene, const FramePoses& poses,
+                              const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
+                              const CastConfig& config);
+  // The same with each beam from the sensor and frame poses at its own time (beams.times, s from
+  // the first sample's time), interpolated in samples as castSweep does. Throws
+  // std::invalid_argument for bad samples or beams.
+  const ScanResult& castBeamsSweep(const Scene& scene, const PoseSamples& samples,
+                                   const BeamList& beams, const CastConfig& config);
 
   // Drops the remembered inputs, so that the next cast() computes even if nothing moved (timing).
   // Kept slices of meshes by scan planes (CastConfig::keep_slices) stay: like the meshes' BVHs,

@@ -6,11 +6,13 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "laser_raycast/core/enum_names.h"
 #include "laser_raycast/core/returns.h"
+#include "laser_raycast/core/pattern_file.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/loader/map_walls.h"
 #include "laser_raycast/loader/scene_loader.h"
@@ -92,9 +94,23 @@ struct SensorParams {
   // s, > 0: a topic pose older than this at a scan's time is stale (the scan is skipped). Pose
   // sources run at 10 to 100 Hz: this is five periods of the slowest.
   double pose_timeout = 0.5;
+  // ~pattern_file: the beams from a scan pattern CSV (core::PatternFile) instead of the fan, each
+  // scan the file's next points_per_scan rows (0: all of them), point k at k / point_rate s.
+  std::string pattern_file;
+  std::shared_ptr<const core::PatternFile> pattern;  // loaded from pattern_file
+  int points_per_scan = 0;
+  double point_rate = 0;  // Hz, > 0 with a pattern file
+  // ~calibration_file: a Velodyne calibration YAML; its head's beams over one turn of scanTime(),
+  // the same every scan (core::VelodyneHead::scan).
+  std::string calibration_file;
+  std::shared_ptr<const core::BeamList> calibrated;
+  // Beams off any grid (a pattern file's or a calibrated head's): a PointCloud2 of one row.
+  bool offGrid() const { return pattern || calibrated; }
 
-  // A single ring at elevation 0: a LaserScan (otherwise a PointCloud2).
-  bool planar() const { return scan.elevations.size() == 1 && scan.elevations[0] == 0.0; }
+  // A single ring at elevation 0 and no pattern file: a LaserScan (otherwise a PointCloud2).
+  bool planar() const {
+    return !offGrid() && scan.elevations.size() == 1 && scan.elevations[0] == 0.0;
+  }
   double scanTime() const { return scan_time > 0 ? scan_time : 1.0 / rate; }
   // s between beam columns: angle_increment * scan_time / 2 pi when rotating, else 0.
   double timeIncrement() const;

@@ -9,6 +9,7 @@
 
 #include <vector>
 
+#include "laser_raycast/core/beam_list.h"
 #include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/node/point_layout.h"
@@ -35,6 +36,13 @@ struct CloudOptions {
 void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
                      const std::vector<double>& column_times, const std_msgs::Header& header,
                      const CloudOptions& options, sensor_msgs::PointCloud2* cloud);
+
+// The cloud of beams off any grid (a pattern file's, core::BeamList): beam b with a valid range r is
+// the point origin(b) + r * direction(b), with its line as the ring and its time (s after
+// header.stamp); organized: one row of every beam. Throws std::invalid_argument as buildPointCloud.
+void buildBeamCloud(const core::BeamList& beams, const core::MeasuredScan& scan,
+                    const std_msgs::Header& header, const CloudOptions& options,
+                    sensor_msgs::PointCloud2* cloud);
 
 // The times of a rotating scan's columns: column c taken c * time_increment s after the first.
 std::vector<double> rotatingColumnTimes(int azimuths, double time_increment);

@@ -134,13 +134,7 @@ const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
                                const Eigen::Isometry3d& world_from_sensor,
                                const ScanPattern& pattern, const CastConfig& config) {
   config.validate();
-  const std::size_t frame_count = scene.frames().size();
-  if (poses.pose.size() != frame_count || poses.valid.size() != frame_count) {
-    std::ostringstream msg;
-    msg << "FramePoses has " << poses.pose.size() << " poses for a scene of " << frame_count
-        << " frames";
-    throw std::invalid_argument(msg.str());
-  }
+  checkFramePoses(scene, poses);
   const bool sensor_ok = isValidPose(world_from_sensor);
   ReuseKey key = relativeInputs(scene, poses, world_from_sensor, pattern, config);
   if (sensor_ok && state_->previous && *state_->previous == key) {
@@ -229,10 +223,7 @@ void CasterState::castOnThreads(const Scene& scene, const ScanPattern& pattern,
   const std::size_t bodies = scene.bodies().size();
   if (cast.size() != bodies) cast = std::vector<std::atomic<char>>(bodies);
   for (auto& mark : cast) mark.store(0, std::memory_order_relaxed);
-  int threads = config.threads;
-  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  // Waking threads costs more than a small scan does: each gets at least kMinBeamsPerThread.
-  threads = std::max(1, std::min(threads, pattern.size() / kMinBeamsPerThread));
+  const int threads = castThreads(config, pattern.size(), kMinBeamsPerThread);
   if (threads == 1) {
     castWithin(beams.grid().all());
   } else {

@@ -62,6 +62,12 @@ ReuseKey relativeInputs(const Scene& scene, const FramePoses& poses,
                         const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
                         const CastConfig& config);
 
+// Throws std::invalid_argument if poses does not hold one pose per frame of scene.
+void checkFramePoses(const Scene& scene, const FramePoses& poses);
+// The threads a cast of `beams` beams uses: config.threads (0: every core), but no more than give
+// each thread min_per_thread beams (waking threads costs more than a small scan does), at least 1.
+int castThreads(const CastConfig& config, int beams, int min_per_thread);
+
 // A result of `beams` beams before a cast: every range inf (NaN if !sensor_ok), nothing hit.
 void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanResult* result);
 // Each hit beam's |cos| of the angle between its direction and the hit's normal.

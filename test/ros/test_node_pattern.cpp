@@ -1,0 +1,151 @@
+// rostest node_pattern.test: a sensor whose beams come from a scan pattern file (the repository's
+// rosette, read here by core::PatternFile) publishes, scan after scan, the file's next 1000 rows:
+// point k of a scan along row (first + k)'s direction (azimuth and zenith worked out here) on the
+// room's faces, its line the row's, its timestamp the stamp plus k / 100 kHz, in
+// livox_ros_driver2's fields; the next scan starts where the previous one ended.
+#include <gtest/gtest.h>
+#include <ros/package.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+#include "driver_layouts.h"
+#include "laser_raycast/core/pattern_file.h"
+#include "laser_raycast/loader/velodyne_calibration.h"
+#include "sensors_rig.h"
+#include "sensors_room.h"
+
+namespace laser_raycast_test {
+namespace {
+
+namespace core = laser_raycast::core;
+
+constexpr int kPointsPerScan = 1000;
+constexpr double kPointRate = 100000.0;  // Hz
+const Eigen::Vector3d kSensor(0, 0, 1);  // frame "lidar", not turned
+
+// A row's direction from its azimuth and zenith, worked out here.
+Eigen::Vector3d rowDirection(const core::PatternFile::Row& row) {
+  const double s = std::sin(row.zenith);
+  return Eigen::Vector3d(s * std::cos(row.azimuth), s * std::sin(row.azimuth),
+                         std::cos(row.zenith));
+}
+
+// The row a cloud starts at: the row whose direction its first point lies along.
+int firstRow(const sensor_msgs::PointCloud2& cloud, const core::PatternFile& file) {
+  const Eigen::Vector3d p(fieldValue<float>(cloud, 0, "x"), fieldValue<float>(cloud, 0, "y"),
+                          fieldValue<float>(cloud, 0, "z"));
+  for (int r = 0; r < file.size(); r += kPointsPerScan) {
+    const Eigen::Vector3d d = rowDirection(file.rows()[r]);
+    if ((p - roomDistance(kSensor, d) * d).norm() < kTolerance) return r;
+  }
+  return -1;
+}
+
+TEST(NodePattern, EachScanIsTheFilesNextRowsOnTheRoom) {
+  const core::PatternFile file = core::PatternFile::load(ros::package::getPath("laser_raycast") +
+                                                         "/config/patterns/rosette_4line.csv");
+  ros::NodeHandle nh;
+  tf2_ros::StaticTransformBroadcaster statics;
+  statics.sendTransform(transform(ros::Time::now(), "lidar", kSensor, 0));
+  std::mutex mutex;
+  std::vector<sensor_msgs::PointCloud2::ConstPtr> clouds;
+  const ros::Subscriber sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      "points", 10, [&](const sensor_msgs::PointCloud2::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        clouds.push_back(m);
+      });
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(30.0);
+  while (ros::ok() && ros::WallTime::now() < give_up) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (clouds.size() >= 3) break;
+    }
+    ros::WallDuration(0.01).sleep();
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_GE(clouds.size(), 3u);
+  int previous_end = -1;
+  for (const auto& cloud : clouds) {
+    expectDriverLayout(*cloud, laser_raycast::PointLayout::kLivox);
+    ASSERT_EQ(cloud->width * cloud->height, static_cast<std::uint32_t>(kPointsPerScan));
+    const int first = firstRow(*cloud, file);
+    ASSERT_GE(first, 0) << "the first point lies along no scan's first row";
+    if (previous_end >= 0) {
+      EXPECT_EQ(first, previous_end % file.size());
+    }
+    previous_end = first + kPointsPerScan;
+    const double stamp_ns = static_cast<double>(cloud->header.stamp.toNSec());
+    for (int k = 0; k < kPointsPerScan; ++k) {
+      const auto& row = file.rows()[(first + k) % file.size()];
+      const Eigen::Vector3d d = rowDirection(row);
+      const Eigen::Vector3d p(fieldValue<float>(*cloud, k, "x"), fieldValue<float>(*cloud, k, "y"),
+                              fieldValue<float>(*cloud, k, "z"));
+      EXPECT_LT((p - roomDistance(kSensor, d) * d).norm(), kTolerance) << "point " << k;
+      EXPECT_EQ(fieldValue<std::uint8_t>(*cloud, k, "line"), row.line) << "point " << k;
+      EXPECT_NEAR(fieldValue<double>(*cloud, k, "timestamp"), stamp_ns + k / kPointRate * 1e9, 512)
+          << "point " << k;
+    }
+  }
+}
+
+// The VLP-16 of test/data/vlp16_calibration.yaml: one turn of 1808 firing sequences of 16 lasers,
+// beam b the laser b % 16 of sequence b / 16, fired at the manual's time, its point where the
+// calibration's laser puts it (core::VelodyneHead, checked against the driver's formulas in
+// test_velodyne_calibration) on the room's faces, its ring the laser's by ascending elevation.
+TEST(NodePattern, CalibratedVelodyne) {
+  const core::VelodyneHead head = laser_raycast::loadVelodyneCalibration(
+      ros::package::getPath("laser_raycast") + "/test/data/vlp16_calibration.yaml");
+  const core::BeamList beams = head.scan(0.1);
+  ros::NodeHandle nh;
+  tf2_ros::StaticTransformBroadcaster statics;
+  statics.sendTransform(transform(ros::Time::now(), "lidar", kSensor, 0));
+  std::mutex mutex;
+  sensor_msgs::PointCloud2::ConstPtr cloud;
+  const ros::Subscriber sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      "/velodyne/points", 1, [&](const sensor_msgs::PointCloud2::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!cloud) cloud = m;
+      });
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(30.0);
+  while (ros::ok() && ros::WallTime::now() < give_up) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (cloud) break;
+    }
+    ros::WallDuration(0.01).sleep();
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_TRUE(cloud);
+  expectDriverLayout(*cloud, laser_raycast::PointLayout::kVelodyne);
+  ASSERT_EQ(cloud->width * cloud->height, 1808u * 16u);
+  const int rings[16] = {0, 8, 1, 9, 2, 10, 3, 11, 4, 12, 5, 13, 6, 14, 7, 15};
+  for (int b = 0; b < beams.size(); ++b) {
+    const int s = b / 16, i = b % 16;
+    const Eigen::Vector3d o = kSensor + beams.origins[b], d = beams.directions[b];
+    const Eigen::Vector3d expected = beams.origins[b] + roomDistance(o, d) * d;
+    const Eigen::Vector3d p(fieldValue<float>(*cloud, b, "x"), fieldValue<float>(*cloud, b, "y"),
+                            fieldValue<float>(*cloud, b, "z"));
+    EXPECT_LT((p - expected).norm(), kTolerance) << "point " << b;
+    EXPECT_EQ(fieldValue<std::uint16_t>(*cloud, b, "ring"), rings[i]) << "point " << b;
+    EXPECT_NEAR(fieldValue<float>(*cloud, b, "time"), s * 55.296e-6 + i * 2.304e-6, 1e-7)
+        << "point " << b;
+  }
+}
+
+}  // namespace
+}  // namespace laser_raycast_test
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_node_pattern");
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}
