@@ -1,10 +1,10 @@
 // Run-time scene editing: the node's services ~spawn_model, ~delete_model, ~set_model_pose and
-// ~list_models (srv/, docs/editing.md). The node's scene is a list of parts (scene_source.h: the
-// models of ~models, then those spawned, then the walls of the map topics' grids); each change
-// composes a new scene from the parts, whose meshes and BVHs are shared rather than rebuilt, and
-// swaps it into the SharedScene whole (shared_scene.h) before the service answers: the cast thread
-// takes it for its next job, so every scan stamped after the answer sees the change and no scan
-// mixes the scenes before and after it.
+// ~list_models (srv/; README, "Changing the world"). The node's scene is a list of parts
+// (scene_source.h: the models of ~models, then those spawned, then the walls of the map topics'
+// grids); each change composes a new scene from the parts, whose meshes and BVHs are shared rather
+// than rebuilt, and swaps it into the SharedScene whole (shared_scene.h) before the service
+// answers: the cast thread takes it for its next job, so every scan stamped after the answer sees
+// the change and no scan mixes the scenes before and after it.
 //
 // The services are served by a thread of their own (their own callback queue), so a slow load (a
 // large mesh file) never holds up the node's timers, pose topics or TF.
