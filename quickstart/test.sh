@@ -72,6 +72,8 @@ if [ $sanitize -eq 1 ] && [ "$sanitizer" = thread ]; then
   TSAN_OPTIONS+=":suppressions=$REPO_DIR/test/sanitizer/tsan.supp"
   # The nodelet manager is Debian's, not instrumented: the TSan runtime must be loaded into it.
   export LASER_RAYCAST_NODELET_PREFIX="env LD_PRELOAD=$(gcc -print-file-name=libtsan.so)"
+  # So is the Python interpreter of the rospy client test (node_edit.test), for the module.
+  export LASER_RAYCAST_PYTHON_PREFIX="env LD_PRELOAD=$(gcc -print-file-name=libtsan.so)"
 elif [ $sanitize -eq 1 ]; then
   BUILD_TYPE=RelWithDebInfo
   CMAKE_OPTIONS=(-Dlaser_raycast_SANITIZE=ON -Dlaser_raycast_FUZZ=OFF)
