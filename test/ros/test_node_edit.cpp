@@ -12,9 +12,13 @@
 #include <laser_raycast/SpawnModel.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -75,6 +79,13 @@ class Scans {
     }
     ADD_FAILURE() << "no scan stamped after " << t;
     return sensor_msgs::LaserScan();
+  }
+  // Scans kept (the last 50) stamped in [from, to].
+  std::size_t stampedBetween(const ros::Time& from, const ros::Time& to) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return std::count_if(scans_.begin(), scans_.end(), [&](const sensor_msgs::LaserScan& scan) {
+      return scan.header.stamp >= from && scan.header.stamp <= to;
+    });
   }
   std::size_t count() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -316,6 +327,61 @@ TEST(NodeEdit, HundredCyclesKeepRateAndMemory) {
   EXPECT_LT(rss_after - rss_before, 2048) << "RSS " << rss_before << " -> " << rss_after << " kB";
 #endif
   expectRanges(scans->after(ros::Time::now()), false, 0, 0, "after the cycles");
+}
+
+// A binary STL of a flat grid of 2 n^2 triangles at path.
+void writeGridStl(const std::string& path, int n) {
+  std::ofstream out(path, std::ios::binary);
+  const char header[80] = "laser_raycast test grid";
+  out.write(header, sizeof(header));
+  const std::uint32_t count = 2u * n * n;
+  out.write(reinterpret_cast<const char*>(&count), 4);
+  const auto corner = [n](int i, int j) {
+    return std::array<float, 3>{0.0f, float(i) / n, float(j) / n};
+  };
+  const auto triangle = [&](std::array<float, 3> a, std::array<float, 3> b,
+                            std::array<float, 3> c) {
+    const float normal[3] = {1, 0, 0};
+    out.write(reinterpret_cast<const char*>(normal), 12);
+    for (const auto& v : {a, b, c}) out.write(reinterpret_cast<const char*>(v.data()), 12);
+    const std::uint16_t attributes = 0;
+    out.write(reinterpret_cast<const char*>(&attributes), 2);
+  };
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      triangle(corner(i, j), corner(i + 1, j), corner(i, j + 1));
+      triangle(corner(i + 1, j), corner(i + 1, j + 1), corner(i, j + 1));
+    }
+  }
+}
+
+// A slow spawn (a mesh of 800,000 triangles, read and its BVH built during the call) holds up
+// neither the scans nor the other services: scans stamped while the call was under way arrive at
+// the rate.
+TEST(NodeEdit, ASlowSpawnDoesNotStallTheScans) {
+  ASSERT_TRUE(ros::service::waitForService(service("spawn_model"), ros::Duration(30)));
+  const std::string stl =
+      "/tmp/laser_raycast_test_edit_grid_" + std::to_string(::getpid()) + ".stl";
+  writeGridStl(stl, 632);
+  const std::string urdf = "<robot name='big'><link name='big'><visual><geometry><mesh filename='" +
+                           stl + "'/></geometry></visual></link></robot>";
+  const ros::Time start = ros::Time::now();
+  auto spawned = spawn("big", urdf, "", 50.0, 0.0);  // far beyond range_max
+  const ros::Time end = ros::Time::now();
+  std::remove(stl.c_str());
+  ASSERT_TRUE(spawned.success) << spawned.message;
+  const double seconds = (end - start).toSec();
+  // The scans stamped during the call, received once it returned.
+  const sensor_msgs::LaserScan last = scans->after(end);
+  const std::size_t during = scans->stampedBetween(start, end);
+  testing::Test::RecordProperty("slow_spawn_seconds", std::to_string(seconds));
+  testing::Test::RecordProperty("scans_during_spawn", static_cast<int>(during));
+  if (seconds >= 0.5) {  // long enough to tell (it is about 1 s)
+    EXPECT_GE(during, static_cast<std::size_t>(std::floor(seconds * 20 * 0.8)))
+        << during << " scans stamped during the " << seconds << " s call";
+  }
+  expectRanges(last, false, 0, 0, "the big mesh beyond range");
+  EXPECT_TRUE(remove("big").success);
 }
 
 }  // namespace
