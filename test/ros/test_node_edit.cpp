@@ -62,7 +62,10 @@ double expectedRange(double a, bool cube, double cx, double cy) {
 
 class Scans {
  public:
-  Scans() { sub_ = nh_.subscribe("scan", 100, &Scans::onScan, this); }
+  // Room for every scan of a long service call (the test does not spin while it waits): 50 s of
+  // them at 20 Hz.
+  static constexpr std::size_t kKept = 1000;
+  Scans() { sub_ = nh_.subscribe("scan", kKept, &Scans::onScan, this); }
 
   // The first scan stamped after t.
   sensor_msgs::LaserScan after(const ros::Time& t) {
@@ -80,7 +83,7 @@ class Scans {
     ADD_FAILURE() << "no scan stamped after " << t;
     return sensor_msgs::LaserScan();
   }
-  // Scans kept (the last 50) stamped in [from, to].
+  // Scans kept (the last kKept) stamped in [from, to].
   std::size_t stampedBetween(const ros::Time& from, const ros::Time& to) {
     std::lock_guard<std::mutex> lock(mutex_);
     return std::count_if(scans_.begin(), scans_.end(), [&](const sensor_msgs::LaserScan& scan) {
@@ -96,7 +99,7 @@ class Scans {
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
     std::lock_guard<std::mutex> lock(mutex_);
     scans_.push_back(*scan);
-    if (scans_.size() > 50) scans_.erase(scans_.begin());
+    if (scans_.size() > kKept) scans_.erase(scans_.begin());
     ++received_;
   }
 
