@@ -166,10 +166,10 @@ TEST(NodeParams, EveryParameterIsLoggedOnceWithItsExactValue) {
 }
 
 TEST(NodeParams, EveryValueReachesItsField) {
-  XmlRpcValue models = list({values({{"param", "robot_description"}}),
-                             values({{"file", "package://pkg/world.urdf"}, {"tf_prefix", "w/"},
-                                     {"name", "world"}}),
-                             XmlRpcValue("other_description")});
+  XmlRpcValue models =
+      list({values({{"param", "robot_description"}}),
+            values({{"file", "package://pkg/world.urdf"}, {"tf_prefix", "w/"}, {"name", "world"}}),
+            XmlRpcValue("other_description")});
   const Parsed parsed = parse(values({{"frame_id", "base_scan"},
                                       {"fixed_frame", "odom"},
                                       {"angle_min", -1.5},
