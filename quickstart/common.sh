@@ -16,6 +16,7 @@ APT_PACKAGES=(
   libboost-program-options-dev libpng-dev pybind11-dev python3-dev python3-numpy python3-pytest
   libroscpp-dev libroslib-dev libtf2-ros-dev libtf2-eigen-dev libtf2-geometry-msgs-dev
   libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libstd-msgs-dev ros-std-msgs
+  ros-geometry-msgs python3-rosservice
   ros-message-generation ros-message-runtime libnodeletlib-dev libnodeletlib-tools libtopic-tools-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure libdiagnostic-updater-dev
   libdiagnostic-msgs-dev librosbag-storage-dev libtf2-msgs-dev libyaml-cpp-dev python3-rosbag

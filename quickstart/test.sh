@@ -9,7 +9,7 @@ set -euo pipefail
 
 usage() {
   cat <<'EOF'
-usage: quickstart/test.sh [--sanitize] [--help]
+usage: quickstart/test.sh [--sanitize [address|thread]] [--help]
 
 Installs the Debian packages that are missing (apt-get, as root), builds the package in .ws/ inside
 the clone, runs every test (gtest and rostest) and catkin_lint -W2, and prints the summary. Exits
@@ -19,6 +19,10 @@ non-zero on any failure or if no test ran. CI (.ci/run) runs exactly this.
               $TMPDIR or /tmp (its path is printed) and run the same tests there (not the fuzz
               harnesses: they are sanitized builds already); a sanitizer report fails the test
               that caused it
+  --sanitize thread
+              the same with ThreadSanitizer (a workspace of its own): a data race stops the
+              process that found it; test/sanitizer/tsan.supp lists the third-party code whose
+              reports are suppressed
 
 Environment:
   LASER_RAYCAST_REQUIRE_SHARED_DATA=1  fail instead of skipping when ../shared/data is missing
@@ -33,24 +37,44 @@ Environment:
 EOF
 }
 sanitize=0
+sanitizer=address
 case "${1:-}" in
   -h|--help) usage; exit 0 ;;
-  --sanitize) sanitize=1 ;;
+  --sanitize)
+    sanitize=1
+    case "${2:-address}" in
+      address|thread) sanitizer=${2:-address} ;;
+      *) echo "quickstart/test.sh: --sanitize takes address or thread, not '$2'" >&2; exit 2 ;;
+    esac
+    [ $# -le 2 ] || { echo "quickstart/test.sh: too many arguments (try --help)" >&2; exit 2; } ;;
   "") ;;
   *) echo "quickstart/test.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
 esac
-[ $# -le 1 ] || { echo "quickstart/test.sh: one argument at most (try --help)" >&2; exit 2; }
+[ $# -le 1 ] || [ $sanitize -eq 1 ] ||
+  { echo "quickstart/test.sh: one argument at most (try --help)" >&2; exit 2; }
 
 if [ $sanitize -eq 1 ]; then
   # A workspace of its own, so that the normal build stays as it is, and outside the clone: rosrun
   # searches the package's source tree for executables, and a second devel space in it makes every
   # `rosrun laser_raycast ...` of the rostests ambiguous (in both builds).
   repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-  : "${LASER_RAYCAST_WS:=${TMPDIR:-/tmp}/laser_raycast_ws_sanitize_$(printf %s "$repo" | cksum | cut -d' ' -f1)}"
+  suffix=$([ "$sanitizer" = thread ] && echo _thread || true)
+  : "${LASER_RAYCAST_WS:=${TMPDIR:-/tmp}/laser_raycast_ws_sanitize${suffix}_$(printf %s "$repo" | cksum | cut -d' ' -f1)}"
   export LASER_RAYCAST_WS
 fi
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
-if [ $sanitize -eq 1 ]; then
+if [ $sanitize -eq 1 ] && [ "$sanitizer" = thread ]; then
+  BUILD_TYPE=RelWithDebInfo
+  CMAKE_OPTIONS=(-Dlaser_raycast_SANITIZE_THREAD=ON -Dlaser_raycast_FUZZ=OFF)
+  # A race stops the process (the node dies, its rostest fails); reports in third-party code only
+  # are suppressed, each with its reason (test/sanitizer/tsan.supp).
+  export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1"
+  TSAN_OPTIONS+=":suppressions=$REPO_DIR/test/sanitizer/tsan.supp"
+  # The nodelet manager is Debian's, not instrumented: the TSan runtime must be loaded into it.
+  export LASER_RAYCAST_NODELET_PREFIX="env LD_PRELOAD=$(gcc -print-file-name=libtsan.so)"
+  # So is the Python interpreter of the rospy client test (node_edit.test), for the module.
+  export LASER_RAYCAST_PYTHON_PREFIX="env LD_PRELOAD=$(gcc -print-file-name=libtsan.so)"
+elif [ $sanitize -eq 1 ]; then
   BUILD_TYPE=RelWithDebInfo
   CMAKE_OPTIONS=(-Dlaser_raycast_SANITIZE=ON -Dlaser_raycast_FUZZ=OFF)
   # Undefined behaviour stops the program (compiled with -fno-sanitize-recover); leaks are

@@ -66,8 +66,10 @@ void CastThread::run() {
     lock.unlock();
     takeScene();
     const ros::Time now = ros::Time::now();
-    // Zero: simulated time has not started.
-    const bool go = !now.isZero() && caster_->ready(front, now);
+    // Zero: simulated time has not started. Never before the scan's stamp: a timer that fired late
+    // stamps its scan on the nearest multiple of the period, which may lie ahead, and a scan cast
+    // early would miss a scene change made between its cast and its stamp.
+    const bool go = !now.isZero() && now >= front.stamp() && caster_->ready(front, now);
     lock.lock();
     if (!go) {
       wake_.wait_for(lock, poll, [this] { return stop_; });

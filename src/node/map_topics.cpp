@@ -3,8 +3,6 @@
 #include <chrono>
 #include <utility>
 
-#include "scene_source.h"
-
 namespace laser_raycast {
 
 OccupancyMap occupancyOf(const nav_msgs::OccupancyGrid& grid) {
@@ -25,9 +23,8 @@ OccupancyMap occupancyOf(const nav_msgs::OccupancyGrid& grid) {
   return map;
 }
 
-MapTopics::MapTopics(ros::NodeHandle nh, const NodeParams& params,
-                     std::shared_ptr<const CastScene> base, SharedScene* scene)
-    : params_(params), base_(std::move(base)), scene_(scene) {
+MapTopics::MapTopics(ros::NodeHandle nh, const NodeParams& params, WallsOut out)
+    : params_(params), out_(std::move(out)) {
   for (const ModelSource& m : params.models) {
     if (!m.map_topic.empty()) entries_.push_back({m, ros::Subscriber(), nullptr});
   }
@@ -87,8 +84,7 @@ void MapTopics::run() {
 
 bool MapTopics::rebuild(std::size_t changed) {
   const auto start = std::chrono::steady_clock::now();
-  auto next = std::make_shared<CastScene>();
-  next->scene = base_->scene;
+  core::Scene walls;
   LoadedMap made;
   for (std::size_t i = 0; i < entries_.size(); ++i) {
     const Entry& e = entries_[i];
@@ -105,7 +101,7 @@ bool MapTopics::rebuild(std::size_t changed) {
                              std::to_string(e.grid->data.size()) + " values");
       }
       if (options.frame.empty()) throw SceneLoadError("the grid's header.frame_id is empty");
-      const LoadedMap loaded = addMapWalls(occupancyOf(*e.grid), options, &next->scene);
+      const LoadedMap loaded = addMapWalls(occupancyOf(*e.grid), options, &walls);
       if (i == changed) made = loaded;
     } catch (const SceneLoadError& error) {
       ROS_ERROR_STREAM("map topic " << e.sub.getTopic() << ": the grid stamped "
@@ -114,9 +110,7 @@ bool MapTopics::rebuild(std::size_t changed) {
       return false;
     }
   }
-  next->reflectivity = labelReflectivity(params_, next->scene);
-  next->reflectivity_fixed = labelReflectivityFixed(params_, next->scene);
-  scene_->set(std::move(next));
+  out_(std::move(walls));
   const Entry& e = entries_[changed];
   ROS_INFO(
       "map topic %s: %d x %d cells of %g m in frame '%s', %zu occupied, walls %g m high as %zu "

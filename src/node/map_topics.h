@@ -1,22 +1,23 @@
 // Map worlds from topics: for each ~models entry {map_topic: TOPIC, height: H}, the walls over the
 // occupied cells of the newest nav_msgs/OccupancyGrid on TOPIC (map_server latches its map), in the
-// grid's header.frame_id at its info.origin. Each new grid rebuilds the scene off the node's
-// threads: the scene of the other models, copied, with the walls of every topic's newest grid, is
-// swapped into the SharedScene whole (shared_scene.h), between two jobs of the cast thread.
+// grid's header.frame_id at its info.origin. Each new grid rebuilds the walls off the node's
+// threads: the walls of every topic's newest grid, in a scene of their own, go to the scene editor
+// (scene_editor.h), which composes them with the models and swaps the result in whole.
 #pragma once
 
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 
 #include <condition_variable>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
 
+#include "laser_raycast/core/scene.h"
 #include "laser_raycast/loader/map_walls.h"
 #include "laser_raycast/node/node_params.h"
-#include "shared_scene.h"
 
 namespace laser_raycast {
 
@@ -31,11 +32,11 @@ class MapTopics {
   // The value above which a grid's cell is occupied.
   static constexpr int kOccupiedAbove = 65;
 
-  // Subscribes to the topic of every map_topic entry of params (none: nothing to do). base: the
-  // scene of the other models, which every rebuilt scene starts from; scene: where the rebuilt
-  // scenes go (it must outlive this).
-  MapTopics(ros::NodeHandle nh, const NodeParams& params, std::shared_ptr<const CastScene> base,
-            SharedScene* scene);
+  // Where the walls of every topic's newest grid go, from the builder thread.
+  using WallsOut = std::function<void(core::Scene walls)>;
+
+  // Subscribes to the topic of every map_topic entry of params (none: nothing to do).
+  MapTopics(ros::NodeHandle nh, const NodeParams& params, WallsOut out);
   ~MapTopics();  // stops the builder
 
  private:
@@ -47,13 +48,12 @@ class MapTopics {
 
   void onGrid(std::size_t entry, const nav_msgs::OccupancyGrid::ConstPtr& grid);
   void run();
-  // The base scene with the walls of every entry's grid; false (after ROS_ERROR) if the new grid
+  // The walls of every entry's grid; false (after ROS_ERROR) if the new grid
   // of entry `changed` is bad: it is dropped, and that entry's previous grid stays.
   bool rebuild(std::size_t changed);
 
   const NodeParams params_;
-  const std::shared_ptr<const CastScene> base_;
-  SharedScene* const scene_;
+  const WallsOut out_;
   std::vector<Entry> entries_;  // the builder thread's own, but for the subscribers
   std::mutex mutex_;            // pending_ and stop_
   std::condition_variable wake_;

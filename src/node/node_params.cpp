@@ -92,13 +92,14 @@ void readThreads(ParamReader* r, NodeParams* p) {
 }
 
 // The keys of a ~models entry: the one that says what it is, and what each kind may add.
-const char* const kModelKeys = "param, file, tf_prefix, map, map_topic, height, frame";
+const char* const kModelKeys = "param, file, tf_prefix, map, map_topic, height, frame, name";
 
 // Whether key may be given in an entry of this kind (the kind's own key).
 bool keyFitsKind(const std::string& key, const std::string& kind) {
   if (key == "tf_prefix") return kind == "param" || kind == "file";
   if (key == "height") return kind == "map" || kind == "map_topic";
   if (key == "frame") return kind == "map";
+  if (key == "name") return kind != "map_topic";
   return key == kind;
 }
 
@@ -124,6 +125,7 @@ bool readModelKeys(ParamReader* r, const std::string& where, const XmlRpc::XmlRp
                          : key == "map"       ? &m->map
                          : key == "map_topic" ? &m->map_topic
                          : key == "frame"     ? &m->frame
+                         : key == "name"      ? &m->name
                                               : nullptr;
     if (!field) {
       r->fail(where, "unknown key '" + key + "' (expected " + kModelKeys + ")");
@@ -168,9 +170,9 @@ bool readModel(ParamReader* r, const std::string& where, const XmlRpc::XmlRpcVal
       if (!keyFitsKind(it->first, kind)) {
         r->fail(where, "'" + it->first + "' does not go with '" + kind + "' (" + kind +
                            " entries take " +
-                           (kind == "map"         ? "height and frame"
+                           (kind == "map"         ? "height, frame and name"
                             : kind == "map_topic" ? "height; the grid gives the frame"
-                                                  : "tf_prefix") +
+                                                  : "tf_prefix and name") +
                            ")");
         return false;
       }

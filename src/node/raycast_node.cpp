@@ -4,6 +4,7 @@
 #include "map_topics.h"
 #include "node_diagnostics.h"
 #include "pose_topic.h"
+#include "scene_editor.h"
 #include "scene_source.h"
 #include "sensor.h"
 #include "sensor_reconfigure.h"
@@ -21,7 +22,8 @@ RaycastNode::~RaycastNode() {
   reconfigure_.clear();
   for (ros::Timer& t : align_timers_) t.stop();
   for (ros::Timer& t : timers_) t.stop();
-  map_topics_.reset();   // joins its builder: no scene is swapped in after this
+  map_topics_.reset();   // joins its builder: no walls come after this
+  editor_.reset();       // stops its services: no scene is swapped in after this
   cast_thread_.reset();  // joins: nothing casts after this
 }
 
@@ -36,7 +38,8 @@ bool RaycastNode::init() {
     *resolved = nh_.resolveName(name);
     return nh_.getParam(name, *xml);
   };
-  error = loadScene(params_, urdf_param, &base->scene, &base->reflectivity);
+  std::vector<ScenePart> parts;
+  error = loadSceneParts(params_, urdf_param, &parts, &base->reflectivity, &base->scene);
   if (!error.empty()) {
     ROS_FATAL_STREAM(error);
     return false;
@@ -71,7 +74,11 @@ bool RaycastNode::init() {
       [this] { return cast_thread_ ? cast_thread_->linkLookups() : 0; });
   const bool map_topics = std::any_of(params_.models.begin(), params_.models.end(),
                                       [](const ModelSource& m) { return !m.map_topic.empty(); });
-  if (map_topics) map_topics_ = std::make_unique<MapTopics>(nh_, params_, base, scene_.get());
+  editor_ = std::make_unique<SceneEditor>(pnh_, params_, std::move(parts), scene_.get());
+  if (map_topics) {
+    map_topics_ = std::make_unique<MapTopics>(
+        nh_, params_, [this](core::Scene walls) { editor_->setMapWalls(std::move(walls)); });
+  }
 
   align_timers_.resize(sensors_.size());
   timers_.resize(sensors_.size());

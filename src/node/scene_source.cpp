@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <mutex>
 #include <set>
 #include <sstream>
 #include <string>
 
+#include "laser_raycast/loader/kinematics.h"
 #include "laser_raycast/loader/map_file.h"
 #include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
@@ -70,35 +72,9 @@ std::string loadMapFile(const NodeParams& params, std::size_t i, core::Scene* sc
   return "";
 }
 
-// Adds model i to scene; "" or what is wrong.
-std::string loadModel(const NodeParams& params, const UrdfParam& urdf_param, std::size_t i,
-                      core::Scene* scene, std::set<std::string>* all_links) {
-  const ModelSource& model = params.models[i];
-  if (!model.map.empty()) return loadMapFile(params, i, scene);
-  if (!model.map_topic.empty()) return "";  // its walls come with its grids (map_topics.h)
-  const LoaderOptions options = optionsFor(params, model);
-  LoadedModel loaded;
-  try {
-    SharedLoader& shared = sharedLoader();
-    std::lock_guard<std::mutex> lock(shared.mutex);
-    if (!model.param.empty()) {
-      std::string xml, resolved = model.param;
-      if (!urdf_param(model.param, &xml, &resolved)) {
-        return "~models[" + std::to_string(i) + "]: parameter " + resolved +
-               " is not set or is not a string: no URDF to load";
-      }
-      loaded = shared.loader.addUrdfString(xml, "", options, scene, "parameter " + resolved);
-    } else {
-      loaded = shared.loader.addUrdfFile(model.file, options, scene);
-    }
-  } catch (const SceneLoadError& e) {
-    // The message starts with the URDF's source (file or parameter).
-    return e.what() + std::string(params.skip_bad_geometry
-                                      ? ""
-                                      : " (set ~skip_bad_geometry to skip bad elements)");
-  }
+// Logs what a model's load did.
+void logLoaded(const LoadedModel& loaded, const std::string& source) {
   for (const std::string& warning : loaded.warnings) ROS_WARN_STREAM("skipped: " << warning);
-  for (const auto& link : loaded.link_frames) all_links->insert(link.first);
   // The meshes' memory, per triangle of the meshes built (an instanced mesh is held once).
   std::string memory;
   if (loaded.mesh_triangles_built > 0) {
@@ -111,20 +87,113 @@ std::string loadModel(const NodeParams& params, const UrdfParam& urdf_param, std
   ROS_INFO(
       "model '%s' (%s): %zu links, %zu bodies, %zu triangles; loaded in %.3f s, BVHs built in "
       "%.3f s%s",
-      loaded.name.c_str(), model.describe().c_str(), loaded.links, loaded.bodies, loaded.triangles,
+      loaded.name.c_str(), source.c_str(), loaded.links, loaded.bodies, loaded.triangles,
       loaded.load_seconds, loaded.bvh_build_seconds, memory.c_str());
+}
+
+// Loads model i as a part; "" or what is wrong.
+std::string loadModel(const NodeParams& params, const UrdfParam& urdf_param, std::size_t i,
+                      ScenePart* part, std::set<std::string>* all_links) {
+  const ModelSource& model = params.models[i];
+  part->source = model.describe();
+  if (!model.map.empty()) {
+    part->name = model.name.empty() ? model.map : model.name;
+    return loadMapFile(params, i, &part->scene);
+  }
+  std::string xml, source = model.describe();
+  if (!model.param.empty()) {
+    std::string resolved = model.param;
+    if (!urdf_param(model.param, &xml, &resolved)) {
+      return "~models[" + std::to_string(i) + "]: parameter " + resolved +
+             " is not set or is not a string: no URDF to load";
+    }
+    source = "parameter " + resolved;
+  }
+  const std::string error = loadUrdfPart(params, xml, model.file, model.tf_prefix, source, part);
+  if (!error.empty()) return error;
+  part->source = source;
+  if (!model.name.empty()) part->name = model.name;
+  for (const auto& link : part->model.link_frames) all_links->insert(link.first);
   return "";
 }
 
 }  // namespace
 
-std::string loadScene(const NodeParams& params, const UrdfParam& urdf_param, core::Scene* scene,
-                      std::vector<double>* reflectivity) {
+std::string loadUrdfPart(const NodeParams& params, const std::string& xml, const std::string& file,
+                         const std::string& tf_prefix, const std::string& source, ScenePart* part) {
+  ModelSource model;
+  model.tf_prefix = tf_prefix;
+  const LoaderOptions options = optionsFor(params, model);
+  try {
+    SharedLoader& shared = sharedLoader();
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    part->model = file.empty() ? shared.loader.addUrdfString(xml, "", options, &part->scene, source)
+                               : shared.loader.addUrdfFile(file, options, &part->scene);
+  } catch (const SceneLoadError& e) {
+    // The message starts with the URDF's source (file or parameter).
+    return e.what() + std::string(params.skip_bad_geometry
+                                      ? ""
+                                      : " (set ~skip_bad_geometry to skip bad elements)");
+  }
+  part->name = part->model.name;
+  logLoaded(part->model, source);
+  return "";
+}
+
+void composeScene(const std::vector<ScenePart>& parts, const std::string& fixed_frame,
+                  core::Scene* scene) {
+  for (const ScenePart& part : parts) {
+    std::map<std::string, Eigen::Isometry3d> links;
+    if (part.placed) links = forwardKinematics(part.model, part.root_pose, {});
+    // Every label, and a TF-placed part's every frame, in the part's order: one part composed
+    // alone is the scene it was loaded as.
+    for (const std::string& label : part.scene.labels()) scene->addLabel(label);
+    if (!part.placed) {
+      for (const std::string& frame : part.scene.frames()) scene->addFrame(frame);
+    }
+    for (const core::Body& body : part.scene.bodies()) {
+      core::Body copy = body;  // the mesh is shared, not copied
+      const std::string& frame = part.scene.frames()[body.frame];
+      copy.label = scene->addLabel(part.scene.labels()[body.label]);
+      if (part.placed) {
+        const auto link = links.find(frame);
+        if (link == links.end()) {
+          throw SceneLoadError("model '" + part.name + "': no pose for its frame '" + frame + "'");
+        }
+        copy.frame = scene->addFrame(fixed_frame);
+        copy.frame_from_body = link->second * body.frame_from_body;
+      } else {
+        copy.frame = scene->addFrame(frame);
+      }
+      scene->addBody(std::move(copy));
+    }
+  }
+}
+
+std::string loadSceneParts(const NodeParams& params, const UrdfParam& urdf_param,
+                           std::vector<ScenePart>* parts, std::vector<double>* reflectivity,
+                           core::Scene* out) {
   std::set<std::string> all_links;
   for (std::size_t i = 0; i < params.models.size(); ++i) {
-    const std::string error = loadModel(params, urdf_param, i, scene, &all_links);
+    if (!params.models[i].map_topic.empty()) continue;  // its walls come with its grids
+    ScenePart part;
+    const std::string error = loadModel(params, urdf_param, i, &part, &all_links);
     if (!error.empty()) return error;
+    // Names are unique: a second model of one name (one URDF under two prefixes) takes its
+    // prefix, then a number.
+    const auto taken = [&](const std::string& name) {
+      return std::any_of(parts->begin(), parts->end(),
+                         [&](const ScenePart& p) { return p.name == name; });
+    };
+    if (taken(part.name) && !params.models[i].tf_prefix.empty()) {
+      part.name = params.models[i].tf_prefix + part.name;
+    }
+    const std::string base = part.name;
+    for (int n = 2; taken(part.name); ++n) part.name = base + "_" + std::to_string(n);
+    parts->push_back(std::move(part));
   }
+  composeScene(*parts, params.fixed_frame, out);
+  core::Scene* scene = out;
   for (const std::string& link : params.ignore_links) {
     bool found = all_links.count(link) > 0;
     for (const ModelSource& model : params.models) {
@@ -151,6 +220,12 @@ std::string loadScene(const NodeParams& params, const UrdfParam& urdf_param, cor
     ROS_WARN("the scene has no geometry: every beam will report +Inf");
   }
   return "";
+}
+
+std::string loadScene(const NodeParams& params, const UrdfParam& urdf_param, core::Scene* scene,
+                      std::vector<double>* reflectivity) {
+  std::vector<ScenePart> parts;
+  return loadSceneParts(params, urdf_param, &parts, reflectivity, scene);
 }
 
 std::vector<double> labelReflectivity(const NodeParams& params, const core::Scene& scene) {

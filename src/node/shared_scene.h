@@ -1,7 +1,7 @@
-// The scene the cast thread casts, shared with what changes it while the node runs (map_topics.h:
-// a new grid on a map topic). A scene is never changed in place: a new one is built beside it and
-// swapped in whole, and the cast thread takes one at the start of each job and casts every sensor
-// of the job with it, so no scan mixes the old scene and the new.
+// The scene the cast thread casts, shared with what changes it while the node runs (scene_editor.h:
+// a service call, or a new grid on a map topic). A scene is never changed in place: a new one is
+// built beside it and swapped in whole, and the cast thread takes one at the start of each job and
+// casts every sensor of the job with it, so no scan mixes the old scene and the new.
 #pragma once
 
 #include <memory>

@@ -178,9 +178,10 @@ TEST(NodeParams, EveryParameterIsLoggedOnceWithItsExactValue) {
 }
 
 TEST(NodeParams, EveryValueReachesItsField) {
-  XmlRpcValue models = list({values({{"param", "robot_description"}}),
-                             values({{"file", "package://pkg/world.urdf"}, {"tf_prefix", "w/"}}),
-                             XmlRpcValue("other_description")});
+  XmlRpcValue models =
+      list({values({{"param", "robot_description"}}),
+            values({{"file", "package://pkg/world.urdf"}, {"tf_prefix", "w/"}, {"name", "world"}}),
+            XmlRpcValue("other_description")});
   const Parsed parsed = parse(values({{"frame_id", "base_scan"},
                                       {"fixed_frame", "odom"},
                                       {"angle_min", -1.5},
@@ -229,6 +230,8 @@ TEST(NodeParams, EveryValueReachesItsField) {
   EXPECT_EQ(p.models[1].file, "package://pkg/world.urdf");
   EXPECT_EQ(p.models[1].param, "");
   EXPECT_EQ(p.models[1].tf_prefix, "w/");
+  EXPECT_EQ(p.models[1].name, "world");
+  EXPECT_EQ(p.models[0].name, "");  // the URDF's robot name, when loaded
   EXPECT_EQ(p.models[2].param, "other_description");
   EXPECT_EQ(p.geometry, laser_raycast::GeometrySource::kCollision);
   EXPECT_EQ(p.ignore_links, (std::vector<std::string>{"base_scan", "w/wall"}));
@@ -438,6 +441,9 @@ TEST(NodeParams, BadMapEntriesNameTheEntry) {
                 {"~models[1]", "'tf_prefix' does not go with 'map'"});
   expectRefused(models(values({{"file", "/b.urdf"}, {"height", 2}})),
                 {"~models[1]", "'height' does not go with 'file'"});
+  // A map topic's walls are not a model of their own (~list_models): no name.
+  expectRefused(models(values({{"map_topic", "/map"}, {"name", "walls"}})),
+                {"~models[1]", "'name' does not go with 'map_topic'"});
   expectRefused(models(values({{"map_topic", "/map"}, {"frame", "odom"}})),
                 {"~models[1]", "'frame' does not go with 'map_topic'", "the grid gives the frame"});
   expectRefused(models(values({{"map", "/m.yaml"}, {"frame", "/map"}})),

@@ -28,6 +28,8 @@ namespace laser_raycast {
 // links; or a map world (map_walls.h), walls over the occupied cells of a map file or of the
 // nav_msgs/OccupancyGrid messages on a topic. Exactly one of param, file, map and map_topic is set.
 struct ModelSource {
+  // The model's name (~list_models, ~delete_model); "": the URDF's robot name, or a map's path.
+  std::string name;
   std::string param;  // parameter name, resolved in the node's namespace (like robot_description)
   std::string file;   // path or package:// URI of a URDF file
   std::string tf_prefix;  // prepended to the model's link names, e.g. "robot2/"

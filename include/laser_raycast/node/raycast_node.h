@@ -21,6 +21,7 @@ class CastThread;
 class MapTopics;
 class NodeDiagnostics;
 class PoseSubscriber;
+class SceneEditor;
 class Sensor;
 class SensorReconfigure;
 class SharedScene;
@@ -54,8 +55,10 @@ class RaycastNode {
 
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
-  // The scene cast, swapped whole when a map topic's grid changes it (shared_scene.h).
+  // The scene cast, swapped whole when a service call or a map topic's grid changes it
+  // (shared_scene.h, scene_editor.h).
   std::unique_ptr<SharedScene> scene_;
+  std::unique_ptr<SceneEditor> editor_;  // ~spawn_model and the other editing services
   std::unique_ptr<MapTopics> map_topics_;
   std::unique_ptr<TfListener> tf_;
   std::vector<std::unique_ptr<Sensor>> sensors_;
