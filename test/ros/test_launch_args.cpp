@@ -105,6 +105,25 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
   EXPECT_EQ(p.sensors.at(0).scan.output.range_bias, 0.01);
   EXPECT_EQ(p.sensors.at(0).scan.output.range_resolution, 0.002);
   EXPECT_EQ(p.sensors.at(0).scan.output.dropout_probability, 0.05);
+  EXPECT_FALSE(p.sensors.at(0).scan.output.surface_reflectance);
+  EXPECT_EQ(p.sensors.at(0).scan.output.reflectance_from_color, 0.8);
+  EXPECT_EQ(p.sensors.at(0).scan.output.detection_range, 100.0);
+  EXPECT_EQ(p.sensors.at(0).scan.output.detection_reflectivity, 0.2);
+  EXPECT_EQ(p.sensors.at(0).returns.beam_divergence, 0.003);
+  EXPECT_EQ(p.sensors.at(0).returns.beam_samples, 7);
+  EXPECT_EQ(p.sensors.at(0).returns.return_mode, laser_raycast::core::ReturnMode::kDual);
+  EXPECT_EQ(p.sensors.at(0).returns.min_return_separation, 0.3);
+
+  const Parsed pattern = parseFromMaster("/pattern/laser_raycast");
+  ASSERT_EQ(pattern.error, "");
+  EXPECT_EQ(pattern.params.sensors.at(0).pattern_file,
+            ros::package::getPath("laser_raycast") + "/config/patterns/rosette_4line.csv");
+  EXPECT_EQ(pattern.params.sensors.at(0).points_per_scan, 2000);
+  EXPECT_EQ(pattern.params.sensors.at(0).point_rate, 20000.0);
+  const Parsed calibrated = parseFromMaster("/calibrated/laser_raycast");
+  ASSERT_EQ(calibrated.error, "");
+  EXPECT_EQ(calibrated.params.sensors.at(0).calibration_file,
+            ros::package::getPath("laser_raycast") + "/test/data/vlp16_calibration.yaml");
 
   const Parsed samples = parseFromMaster("/samples/laser_raycast");
   ASSERT_EQ(samples.error, "");
@@ -115,9 +134,11 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
   EXPECT_EQ(samples.params.sensors[1].name, "top");
   EXPECT_EQ(samples.params.sensors[1].sensor_model, "VLP-16");
 
-  // Between them, the two set every parameter the node reads.
+  // Between them, they set every parameter the node reads.
   std::set<std::string> set = keys(all.values);
-  for (const std::string& name : keys(samples.values)) set.insert(name);
+  for (const Parsed* other : {&samples, &pattern, &calibrated}) {
+    for (const std::string& name : keys(other->values)) set.insert(name);
+  }
   for (const std::string& name : laser_raycast::nodeParamNames()) {
     EXPECT_TRUE(set.count(name)) << "no argument of laser_raycast.launch sets ~" << name;
   }
