@@ -151,16 +151,54 @@ po::typed_value<std::vector<std::string>>* repeated(const char* value_name,
       });
 }
 
+// A finite number in `unit` into *out, or a count into *out.
+po::typed_value<std::string>* number(const char* flag, const char* unit, double* out) {
+  return single(unit, [flag, out](const std::string& v) { *out = parseNumber(flag, v); });
+}
+po::typed_value<std::string>* count(const char* flag, int* out) {
+  return single("N", [flag, out](const std::string& v) { *out = parseCount(flag, v); });
+}
+
+// Beams off any grid: a pattern file's or a Velodyne calibration's.
+void addBeamFileFlags(po::options_description_easy_init& add, Args* args) {
+  add("pattern-file", single("FILE", [args](const std::string& v) { args->pattern_path = v; }),
+      "a scan pattern CSV 'Time/s,Azimuth/deg,Zenith/deg[,Line]' read as a loop: each scan takes "
+      "its next --points-per-scan rows instead of a fan");
+  add("calibration", single("FILE", [args](const std::string& v) { args->calibration_path = v; }),
+      "a Velodyne calibration YAML (velodyne_pointcloud's): each laser's beam, origin and firing "
+      "time over one turn (--scan-time with --sweep rotating, else 0.1 s) instead of a fan");
+  add("points-per-scan", count("--points-per-scan", &args->points_per_scan),
+      "rows of --pattern-file a scan takes (default: all of them)");
+  add("point-rate", number("--point-rate", "HZ", &args->point_rate),
+      "points a second of --pattern-file: point k of a scan at k / HZ s (required with it)");
+}
+
+// Divergent beams and their returns (core/returns.h).
+void addReturnFlags(po::options_description_easy_init& add, Args* args) {
+  add("beam-divergence", number("--beam-divergence", "RAD", &args->returns.beam_divergence),
+      "full angle of a beam's footprint (with --beam-samples > 1)");
+  add("beam-samples", count("--beam-samples", &args->returns.beam_samples),
+      "sub-rays a beam (default 1: the ideal ray)");
+  add("return-mode",
+      single("NAME",
+             [args](const std::string& v) {
+               if (!core::kReturnModeNames.parse(v, &args->returns.return_mode)) {
+                 throw ArgError("--return-mode: " + core::kReturnModeNames.notOneOf(v));
+               }
+             }),
+      ("one of " + core::kReturnModeNames.list() +
+       " (default strongest); dual prints a beam's last return as a second row, with a return "
+       "column (1 strongest, 2 last)")
+          .c_str());
+  add("min-return-separation",
+      number("--min-return-separation", "M", &args->returns.min_return_separation),
+      "sub-ray hits closer in range merge into one return (default 0 m)");
+}
+
 // The flags, in the order the help lists them. Values are read as text and converted by the
 // notifiers into *args: the messages then say what is wrong with a value (program_options' own
 // say only that it is invalid), and a number must be finite.
 po::options_description flags(Args* args) {
-  const auto number = [](const char* flag, const char* unit, double* out) {
-    return single(unit, [flag, out](const std::string& v) { *out = parseNumber(flag, v); });
-  };
-  const auto count = [](const char* flag, int* out) {
-    return single("N", [flag, out](const std::string& v) { *out = parseCount(flag, v); });
-  };
   po::options_description options("Options");
   auto add = options.add_options();
   add("urdf",
@@ -204,38 +242,12 @@ po::options_description flags(Args* args) {
                args->rings = true;
              }),
       "one fan of azimuths per elevation (rad, up positive, any order); ring r is the r-th lowest");
-  add("pattern-file", single("FILE", [args](const std::string& v) { args->pattern_path = v; }),
-      "a scan pattern CSV 'Time/s,Azimuth/deg,Zenith/deg[,Line]' read as a loop: each scan takes "
-      "its next --points-per-scan rows instead of a fan");
-  add("calibration", single("FILE", [args](const std::string& v) { args->calibration_path = v; }),
-      "a Velodyne calibration YAML (velodyne_pointcloud's): each laser's beam, origin and firing "
-      "time over one turn (--scan-time with --sweep rotating, else 0.1 s) instead of a fan");
-  add("points-per-scan", count("--points-per-scan", &args->points_per_scan),
-      "rows of --pattern-file a scan takes (default: all of them)");
-  add("point-rate", number("--point-rate", "HZ", &args->point_rate),
-      "points a second of --pattern-file: point k of a scan at k / HZ s (required with it)");
+  addBeamFileFlags(add, args);
   add("joint",
       repeated("NAME=VALUE ...", [args](const std::string& v) { parseJoint(v, &args->joints); })
           ->multitoken(),
       "joint values (rad or m; 0 if not given): several after one --joint, or one each");
-  add("beam-divergence", number("--beam-divergence", "RAD", &args->returns.beam_divergence),
-      "full angle of a beam's footprint (with --beam-samples > 1)");
-  add("beam-samples", count("--beam-samples", &args->returns.beam_samples),
-      "sub-rays a beam (default 1: the ideal ray)");
-  add("return-mode",
-      single("NAME",
-             [args](const std::string& v) {
-               if (!core::kReturnModeNames.parse(v, &args->returns.return_mode)) {
-                 throw ArgError("--return-mode: " + core::kReturnModeNames.notOneOf(v));
-               }
-             }),
-      ("one of " + core::kReturnModeNames.list() +
-       " (default strongest); dual prints a beam's last return as a second row, with a return "
-       "column (1 strongest, 2 last)")
-          .c_str());
-  add("min-return-separation",
-      number("--min-return-separation", "M", &args->returns.min_return_separation),
-      "sub-ray hits closer in range merge into one return (default 0 m)");
+  addReturnFlags(add, args);
   add("repeat", count("--repeat", &args->repeat),
       "cast N more times after loading (the whole path) and print the median cast time of a "
       "scan to stderr, after the load's times and the meshes' memory per triangle");

@@ -18,17 +18,21 @@ constexpr double kSmallest = 1e-30;
 
 ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                            const Eigen::Vector3d& c, double widen, double shift, double turn) {
-  init(beams, a, b, c, widen, shift, turn);
+  // In double: a small or far triangle's edge normals cancel far beyond float's precision.
+  const Eigen::Vector3d m[3] = {b.cross(c), c.cross(a), a.cross(b)};
+  init(beams, a, b, c, m, widen, shift, turn);
 }
 
 ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                            const Eigen::Vector3d& c, const ColumnMotion& motion, double near) {
   const double shift = motion.spread().shift, turn = motion.spread().turn;
-  const Eigen::Vector3d n = (b - a).cross(c - a);
-  const double plane = std::abs(n.dot(a)) / n.norm() * (1 - 1e-9);
+  const Eigen::Vector3d m[3] = {b.cross(c), c.cross(a), a.cross(b)};
+  // The plane's distance: its normal (b - a) x (c - a) is the edge normals' sum, whose dot product
+  // with a is a . (b x c).
+  const double plane = std::abs(a.dot(m[0])) / (m[0] + m[1] + m[2]).norm() * (1 - 1e-9);
   if (std::isfinite(plane) && plane > 2 * shift) {
     motion_ = &motion;
-    init(beams, a, b, c, std::sin(std::min(M_PI / 2, turn)), shift, turn);
+    init(beams, a, b, c, m, std::sin(std::min(M_PI / 2, turn)), shift, turn);
     return;
   }
   // The plane passes near the sensor: every edge test widened by the shift, from the triangle's
@@ -37,13 +41,12 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
   const double widen = nearest > 2 * shift
                            ? std::sin(std::min(M_PI / 2, turn + std::asin(shift / nearest)))
                            : 1;  // every beam of the rect
-  init(beams, a, b, c, widen, shift, turn);
+  init(beams, a, b, c, m, widen, shift, turn);
 }
 
 void ColumnRaster::init(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                        const Eigen::Vector3d& c, double widen, double shift, double turn) {
-  // In double: a small or far triangle's edge normals cancel far beyond float's precision.
-  const Eigen::Vector3d m[3] = {b.cross(c), c.cross(a), a.cross(b)};
+                        const Eigen::Vector3d& c, const Eigen::Vector3d (&m)[3], double widen,
+                        double shift, double turn) {
   const double det = a.dot(m[0]);
   const double abs_det = std::abs(det);
   // The 1-norms bound the 2-norms from above, so this flags a few more triangles than the ratio
@@ -55,7 +58,7 @@ void ColumnRaster::init(const BeamSet& beams, const Eigen::Vector3d& a, const Ei
   const __m128 ones = _mm_castsi128_ps(_mm_set1_epi32(-1)), none = _mm_setzero_ps();
   // The edges whose cross product with a column's origin moves m (m - o x e).
   const Eigen::Vector3d e[3] = {c - b, a - c, b - a};
-  double factor = 1, moves = 0;
+  double moves = 0;  // the most |o x e|_2 <= shift |e|_1 moves a scaled normal
   for (int k = 0; k < 3; ++k) {
     const double scale = sign / (std::abs(m[k].x()) + std::abs(m[k].y()) + std::abs(m[k].z()));
     const float z = static_cast<float>(m[k].z() * scale);
@@ -71,10 +74,11 @@ void ColumnRaster::init(const BeamSet& beams, const Eigen::Vector3d& a, const Ei
       ex_[k] = _mm_set1_ps(static_cast<float>(scaled.x()));
       ey_[k] = _mm_set1_ps(static_cast<float>(scaled.y()));
       ez_[k] = _mm_set1_ps(static_cast<float>(scaled.z()));
-      factor = std::max(factor, 1 + std::sqrt(3.0) * shift * scaled.lpNorm<1>());
       moves = std::max(moves, shift * scaled.lpNorm<1>());
     }
   }
+  // A column's normal's |m'|_1 <= 1 + |o x e|_1 <= 1 + sqrt(3) |o x e|_2.
+  const double factor = 1 + std::sqrt(3.0) * moves;
   widen *= factor;
   if (!(widen < 0.5)) {
     all_ = true;
