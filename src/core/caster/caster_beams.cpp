@@ -274,21 +274,28 @@ int castThreads(const CastConfig& config, int beams, int min_per_thread) {
 
 namespace {
 
-// Casts every beam with the frames placed by posesAt(time, &poses) (called again only where a
-// beam's time differs from the one before it in its piece), on the caster's threads.
+// Casts every beam with the frames placed by posesAt(time, &poses), on the caster's threads. With
+// timed, posesAt is called again wherever a beam's time differs from the one before it in its
+// piece; without (every beam from the same poses, whatever the beams' times), once a piece: placing
+// the frames anew also places every body and moves every triangle into the sensor frame anew, so a
+// calibrated sensor's beams, each at its own firing time, would otherwise pay that at every beam.
 void castBeamList(CasterState& state, const Scene& scene, const BeamList& beams,
-                  const CastConfig& config, const std::function<void(double, GroupPoses*)>& posesAt,
-                  ScanResult* result) {
+                  const CastConfig& config, bool timed,
+                  const std::function<void(double, GroupPoses*)>& posesAt, ScanResult* result) {
   const SceneIndex& index = state.indexOf(scene);
   const int n = beams.size();
-  const int pieces = (n + kBeamsPerPiece - 1) / kBeamsPerPiece;
+  const int threads = castThreads(config, n, kMinBeamsPerThread);
+  // One thread casts every beam as one piece: a piece's tracer starts with an empty cache of
+  // bodies and triangles.
+  const int piece_beams = threads == 1 ? std::max(n, 1) : kBeamsPerPiece;
+  const int pieces = (n + piece_beams - 1) / piece_beams;
   auto castPiece = [&](int p) {
     dispatchTriangleMethod(config.method, [&](auto method) {
       BeamTracer<decltype(method)::value> tracer(scene, index, config);
       GroupPoses poses;
       double placed_time = std::numeric_limits<double>::quiet_NaN();
-      for (int i = p * kBeamsPerPiece; i < std::min(n, (p + 1) * kBeamsPerPiece); ++i) {
-        const double t = beams.time(i);
+      for (int i = p * piece_beams; i < std::min(n, (p + 1) * piece_beams); ++i) {
+        const double t = timed ? beams.time(i) : 0.0;
         if (!(t == placed_time)) {
           posesAt(t, &poses);
           tracer.setPoses(poses);
@@ -309,7 +316,6 @@ void castBeamList(CasterState& state, const Scene& scene, const BeamList& beams,
       }
     });
   };
-  const int threads = castThreads(config, n, kMinBeamsPerThread);
   if (threads == 1) {
     for (int p = 0; p < pieces; ++p) castPiece(p);
   } else {
@@ -353,7 +359,8 @@ const ScanResult& Caster::castBeams(const Scene& scene, const FramePoses& poses,
     }
   }
   castBeamList(
-      *state_, scene, beams, config, [&](double, GroupPoses* out) { *out = placed; }, &result_);
+      *state_, scene, beams, config, false, [&](double, GroupPoses* out) { *out = placed; },
+      &result_);
   return result_;
 }
 
@@ -364,7 +371,7 @@ const ScanResult& Caster::castBeamsSweep(const Scene& scene, const PoseSamples& 
   startResult(scene, beams, config, &result_);
   const SceneIndex& index = state_->indexOf(scene);
   castBeamList(
-      *state_, scene, beams, config,
+      *state_, scene, beams, config, true,
       [&](double t, GroupPoses* out) {
         placeGroupsAt(
             index, samples.sensorAt(t),
