@@ -135,9 +135,15 @@ void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>&
     measurement_model_.measure(scene, returns_.first, reflectivity, &measured_,
                                &returns_.first_surface);
   } else if (output.needsIncidence() && output.surface_reflectance) {
-    // A sweep's surfaces are sampled from its first pose (sampleSurfaces).
-    core::sampleSurfaces(scene, frames.front(), poses.front(), pattern_, *result,
-                         output.reflectance_from_color, reflectivity_fixed, &surface_);
+    // A sweep's surfaces are sampled from its first pose (sampleSurfaces); beams off the grid
+    // from their own origins and directions.
+    if (cast_params_.offGrid()) {
+      core::sampleSurfaces(scene, frames.front(), poses.front(), beams_, *result,
+                           output.reflectance_from_color, reflectivity_fixed, &surface_);
+    } else {
+      core::sampleSurfaces(scene, frames.front(), poses.front(), pattern_, *result,
+                           output.reflectance_from_color, reflectivity_fixed, &surface_);
+    }
     measurement_model_.measure(scene, *result, reflectivity, &measured_, &surface_);
   } else {
     measurement_model_.measure(scene, *result, reflectivity, &measured_);

@@ -98,7 +98,8 @@ TEST(NodePattern, EachScanIsTheFilesNextRowsOnTheRoom) {
 // The VLP-16 of test/data/vlp16_calibration.yaml: one turn of 1808 firing sequences of 16 lasers,
 // beam b the laser b % 16 of sequence b / 16, fired at the manual's time, its point where the
 // calibration's laser puts it (core::VelodyneHead, checked against the driver's formulas in
-// test_velodyne_calibration) on the room's faces, its ring the laser's by ascending elevation.
+// test_velodyne_calibration) on the room's faces, its ring the laser's by ascending elevation, its
+// intensity the cosine of its incidence there.
 TEST(NodePattern, CalibratedVelodyne) {
   const core::VelodyneHead head = laser_raycast::loadVelodyneCalibration(
       ros::package::getPath("laser_raycast") + "/test/data/vlp16_calibration.yaml");
@@ -135,6 +136,10 @@ TEST(NodePattern, CalibratedVelodyne) {
     EXPECT_LT((p - expected).norm(), kTolerance) << "point " << b;
     EXPECT_EQ(fieldValue<std::uint16_t>(*cloud, b, "ring"), rings[i]) << "point " << b;
     EXPECT_NEAR(fieldValue<float>(*cloud, b, "time"), s * 55.296e-6 + i * 2.304e-6, 1e-7)
+        << "point " << b;
+    // ~intensity: the default reflectivity 1 times the cosine of the incidence on the face hit,
+    // the beam's own direction against the face's normal.
+    EXPECT_NEAR(fieldValue<float>(*cloud, b, "intensity"), std::abs(d[roomFaceAxis(o, d)]), 1e-5)
         << "point " << b;
   }
 }

@@ -20,4 +20,21 @@ inline double roomDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
   return t;
 }
 
+// The axis of the inner face that the beam from p along unit d meets first (roomDistance's).
+inline int roomFaceAxis(const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
+  const Eigen::Vector3d lo(-5, -4, 0), hi(5, 4, 4);
+  double t = std::numeric_limits<double>::infinity();
+  int face = -1;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double s = d[axis] > 0 ? (hi[axis] - p[axis]) / d[axis]
+                     : d[axis] < 0 ? (lo[axis] - p[axis]) / d[axis]
+                                   : std::numeric_limits<double>::infinity();
+    if (s < t) {
+      t = s;
+      face = axis;
+    }
+  }
+  return face;
+}
+
 }  // namespace laser_raycast_test

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "laser_raycast/core/beam_list.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/surface.h"
@@ -95,6 +96,38 @@ TEST(SurfaceReflectance, ACheckerboardTextureGivesTheCheckerboardInTheIntensitie
   EXPECT_GT(checked, pattern.size() * 9 / 10);
   EXPECT_GT(white, checked / 3);
   EXPECT_LT(white, 2 * checked / 3);
+}
+
+TEST(SurfaceReflectance, BeamsOffTheGridAreSampledFromTheirOwnOrigins) {
+  // Parallel beams along +x from origins spread over y and z (a calibrated head's beams, each
+  // from its own origin): each hits the wall x = 2 straight ahead of its origin, on the texel
+  // under (y, z), which the beam from the sensor's origin along the same direction would not.
+  const core::Scene scene = sceneOf(load("checker_wall.obj"));
+  core::BeamList beams;
+  for (int k = 0; k < 40; ++k) {
+    beams.directions.push_back(Vector3d::UnitX());
+    beams.origins.push_back(Vector3d(0.3, -0.93 + 0.047 * k, 0.81 - 0.041 * k));
+  }
+  core::Caster caster;
+  core::CastConfig config;
+  config.compute_incidence = true;
+  const core::FramePoses poses = core::FramePoses::identity(scene);
+  const core::ScanResult result =
+      caster.castBeams(scene, poses, Eigen::Isometry3d::Identity(), beams, config);
+  core::SurfaceSamples surface;
+  core::sampleSurfaces(scene, poses, Eigen::Isometry3d::Identity(), beams, result, 1.0, {},
+                       &surface);
+  int white = 0;
+  for (int i = 0; i < beams.size(); ++i) {
+    ASSERT_NEAR(result.range[i], 1.7, 1e-12) << i;
+    const double u = (beams.origins[i].y() + 1) / 2, v = (beams.origins[i].z() + 1) / 2;
+    const bool is_white = (static_cast<int>(u * 8) + static_cast<int>((1 - v) * 8)) % 2 == 0;
+    EXPECT_EQ(surface.reflectance[i], is_white ? 1.0 : 0.0) << "beam " << i;
+    EXPECT_NEAR(surface.cos_incidence[i], 1.0, 1e-12) << i;
+    white += is_white;
+  }
+  EXPECT_GT(white, 5);
+  EXPECT_LT(white, 35);
 }
 
 TEST(SurfaceReflectance, TheIntensityChangesAtTheTexturesCellEdges) {

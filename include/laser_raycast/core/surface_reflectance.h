@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <vector>
 
+#include "laser_raycast/core/beam_list.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scan_result.h"
 #include "laser_raycast/core/scene.h"
@@ -32,6 +33,12 @@ struct SurfaceSamples {
 // coordinates are recomputed from that pose and clamped into the triangle).
 void sampleSurfaces(const Scene& scene, const FramePoses& poses,
                     const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
+                    const ScanResult& result, double reflectance_from_color,
+                    const std::vector<char>& label_fixed, SurfaceSamples* out);
+// The same for beams off any grid (Caster::castBeams, castBeamsSweep): each beam from its own
+// origin along its own direction (beam_list.h), from world_from_sensor (a sweep's first pose).
+void sampleSurfaces(const Scene& scene, const FramePoses& poses,
+                    const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
                     const ScanResult& result, double reflectance_from_color,
                     const std::vector<char>& label_fixed, SurfaceSamples* out);
 

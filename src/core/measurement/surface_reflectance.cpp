@@ -15,14 +15,17 @@ namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
-}  // namespace
-
-void sampleSurfaces(const Scene& scene, const FramePoses& poses,
-                    const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
-                    const ScanResult& result, double reflectance_from_color,
-                    const std::vector<char>& label_fixed, SurfaceSamples* out) {
+// Beam i leaves from origins[i] (sensor frame; the sensor's origin if origins is empty) along
+// directions[i].
+void sampleBeams(const Scene& scene, const FramePoses& poses,
+                 const Eigen::Isometry3d& world_from_sensor,
+                 const std::vector<Eigen::Vector3d>& directions,
+                 const std::vector<Eigen::Vector3d>& origins, const ScanResult& result,
+                 double reflectance_from_color, const std::vector<char>& label_fixed,
+                 SurfaceSamples* out) {
   const std::size_t n = result.range.size();
-  if (result.cos_incidence.size() != n || pattern.directions().size() != n) {
+  if (result.cos_incidence.size() != n || directions.size() != n ||
+      !(origins.empty() || origins.size() == n)) {
     throw std::invalid_argument(
         "sampleSurfaces needs the cast's cos_incidence (compute_incidence) for every beam of its "
         "pattern");
@@ -58,8 +61,9 @@ void sampleSurfaces(const Scene& scene, const FramePoses& poses,
       placed[body_index] = 1;
     }
     const Eigen::Isometry3d& body_from_sensor = body_from_sensor_of[body_index];
-    const Eigen::Vector3d origin = body_from_sensor.translation();
-    const Eigen::Vector3d dir = body_from_sensor.linear() * pattern.directions()[i];
+    const Eigen::Vector3d origin = origins.empty() ? body_from_sensor.translation()
+                                                   : Eigen::Vector3d(body_from_sensor * origins[i]);
+    const Eigen::Vector3d dir = body_from_sensor.linear() * directions[i];
     const TriangleIndices& tri = mesh.triangles()[triangle];
     const auto& v = mesh.vertices();
     Eigen::Vector3d w;
@@ -94,6 +98,24 @@ void sampleSurfaces(const Scene& scene, const FramePoses& poses,
       out->reflectance[i] = reflectanceFromColor(material.diffuse, reflectance_from_color);
     }
   }
+}
+
+}  // namespace
+
+void sampleSurfaces(const Scene& scene, const FramePoses& poses,
+                    const Eigen::Isometry3d& world_from_sensor, const ScanPattern& pattern,
+                    const ScanResult& result, double reflectance_from_color,
+                    const std::vector<char>& label_fixed, SurfaceSamples* out) {
+  sampleBeams(scene, poses, world_from_sensor, pattern.directions(), {}, result,
+              reflectance_from_color, label_fixed, out);
+}
+
+void sampleSurfaces(const Scene& scene, const FramePoses& poses,
+                    const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
+                    const ScanResult& result, double reflectance_from_color,
+                    const std::vector<char>& label_fixed, SurfaceSamples* out) {
+  sampleBeams(scene, poses, world_from_sensor, beams.directions, beams.origins, result,
+              reflectance_from_color, label_fixed, out);
 }
 
 }  // namespace core
