@@ -257,6 +257,12 @@ void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::st
   readPoseSource(r, s);
   readPatternFile(r, s);
   readCalibration(r, s);
+  if (s->returns.beam_samples > 1 && (s->pattern || s->calibrated)) {
+    r->fail("beam_samples", "is " + std::to_string(s->returns.beam_samples) + " but " +
+                                r->prefix() +
+                                (s->pattern ? "pattern_file" : "calibration_file") +
+                                " is set: divergent beams are cast for a fan or rings only");
+  }
   // The angles and beam count, elevations, ranges, noise and realism: checked once, by the core.
   if (r->error().empty()) {
     try {

@@ -333,6 +333,18 @@ TEST(NodeParams, TheLimitsThemselvesAreAccepted) {
   expectAccepted(values({{"reflectivity", values({{"black", 0}})}, {"intensity", "reflectivity"}}));
 }
 
+TEST(NodeParams, DivergentBeamsAreRefusedForBeamsOffTheGrid) {
+  const std::string pattern = LASER_RAYCAST_SOURCE_DIR "/config/patterns/rosette_4line.csv";
+  const std::string calibration = LASER_RAYCAST_SOURCE_DIR "/test/data/vlp16_calibration.yaml";
+  expectAccepted(values({{"pattern_file", pattern}, {"point_rate", 1e5}, {"beam_samples", 1}}));
+  expectRefused(values({{"pattern_file", pattern}, {"point_rate", 1e5}, {"beam_samples", 7},
+                        {"beam_divergence", 0.003}}),
+                {"~beam_samples", "is 7", "~pattern_file is set", "a fan or rings"});
+  expectRefused(values({{"calibration_file", calibration}, {"beam_samples", 7},
+                        {"beam_divergence", 0.003}}),
+                {"~beam_samples", "is 7", "~calibration_file is set"});
+}
+
 TEST(NodeParams, NamesOutsideTheirTablesListTheChoices) {
   expectRefused(values({{"min_range_policy", "zero"}}),
                 {"~min_range_policy", "'zero' is not one of -inf, pass_through, nan"});
