@@ -22,6 +22,7 @@
 #include "laser_raycast/core/pattern_file.h"
 #include "laser_raycast/core/returns.h"
 #include "laser_raycast/core/scan_spec.h"
+#include "laser_raycast/core/surface_reflectance.h"
 #include "laser_raycast/loader/kinematics.h"
 #include "laser_raycast/loader/map_file.h"
 #include "laser_raycast/loader/package_resolver.h"
@@ -56,7 +57,7 @@ struct Args {
   std::map<std::string, double> joints;
   int repeat = 0;
   int threads = core::CastConfig().threads;  // 0: every core
-  bool rings = false;  // --elevations given: one fan per elevation, and the ring columns
+  bool rings = false;           // --elevations given: one fan per elevation, and the ring columns
   core::ReturnsConfig returns;  // divergent beams (core/returns.h); 1 sample: the ideal ray
   // Dual returns: a second row for a beam's last return, and the return column.
   bool dual() const {
@@ -72,6 +73,11 @@ struct Args {
   std::optional<core::BeamList> calibrated;
   // Beams off any grid: a pattern file's or a calibrated head's.
   bool offGrid() const { return pattern_file || calibrated; }
+  // The radiometry (scan.output's intensity and detection range): each link's reflectivity by its
+  // name (--reflectivity), the others' --default-reflectivity.
+  std::map<std::string, double> reflectivity;
+  double default_reflectivity = 1.0;
+  bool radiometry() const { return scan.output.needsIncidence(); }
 };
 
 std::string formatNumber(double value) {
@@ -195,6 +201,47 @@ void addReturnFlags(po::options_description_easy_init& add, Args* args) {
       "sub-ray hits closer in range merge into one return (default 0 m)");
 }
 
+// Intensity and the radiometric range limit (core/measurement_model.h).
+void addRadiometryFlags(po::options_description_easy_init& add, Args* args) {
+  core::MeasurementConfig& output = args->scan.output;
+  add("intensity", po::bool_switch(&output.intensity),
+      "print an intensity column: the reflectivity at the hit times the cosine of the incidence");
+  add("detection-range",
+      single("R@REFLECTIVITY",
+             [&output](const std::string& v) {
+               const std::size_t at = v.find('@');
+               if (at == std::string::npos) {
+                 throw ArgError("--detection-range: '" + v + "' is not R@REFLECTIVITY");
+               }
+               output.detection_range = parseNumber("--detection-range", v.substr(0, at));
+               output.detection_reflectivity = parseNumber("--detection-range", v.substr(at + 1));
+               if (!(output.detection_range > 0 && output.detection_reflectivity > 0)) {
+                 throw ArgError("--detection-range: '" + v +
+                                "' needs R > 0 m and REFLECTIVITY > 0");
+               }
+             }),
+      "a datasheet's 'range R at reflectivity': returns weaker than its target's are lost (inf)");
+  add("reflectivity",
+      repeated("LINK=VALUE",
+               [args](const std::string& v) {
+                 const std::size_t eq = v.find('=');
+                 if (eq == std::string::npos || eq == 0) {
+                   throw ArgError("--reflectivity: '" + v + "' is not LINK=VALUE");
+                 }
+                 const double value =
+                     parseNumber("--reflectivity " + v.substr(0, eq), v.substr(eq + 1));
+                 if (!(value >= 0)) {
+                   throw ArgError("--reflectivity " + v.substr(0, eq) + ": must be >= 0, got " +
+                                  formatNumber(value));
+                 }
+                 args->reflectivity[v.substr(0, eq)] = value;
+               }),
+      "a link's reflectivity, over its mesh's colours (repeat for several links)");
+  add("default-reflectivity",
+      number("--default-reflectivity", "VALUE", &args->default_reflectivity),
+      "the reflectivity of links without one and without colours (default 1)");
+}
+
 // The flags, in the order the help lists them. Values are read as text and converted by the
 // notifiers into *args: the messages then say what is wrong with a value (program_options' own
 // say only that it is invalid), and a number must be finite.
@@ -248,6 +295,7 @@ po::options_description flags(Args* args) {
           ->multitoken(),
       "joint values (rad or m; 0 if not given): several after one --joint, or one each");
   addReturnFlags(add, args);
+  addRadiometryFlags(add, args);
   add("repeat", count("--repeat", &args->repeat),
       "cast N more times after loading (the whole path) and print the median cast time of a "
       "scan to stderr, after the load's times and the meshes' memory per triangle");
@@ -283,8 +331,9 @@ constexpr double kCalibratedScanTime = 0.1;  // s
 void checkPatternFlags(const po::variables_map& values, Args* args) {
   if ((!args->calibration_path.empty() || !args->pattern_path.empty()) &&
       args->returns.beam_samples > 1) {
-    throw ArgError("--beam-samples > 1: not with --pattern-file or --calibration (divergent beams "
-                   "are cast for a fan or rings)");
+    throw ArgError(
+        "--beam-samples > 1: not with --pattern-file or --calibration (divergent beams "
+        "are cast for a fan or rings)");
   }
   if (!args->calibration_path.empty()) {
     if (!args->pattern_path.empty())
@@ -359,6 +408,15 @@ Args parseArgs(int argc, char** argv, bool* help) {
   }
   laser_raycast::tools::checkSweepTimes(args.path, args.scan.fan);
   checkPatternFlags(values, &args);
+  if (!(args.default_reflectivity >= 0)) {
+    throw ArgError("--default-reflectivity: must be >= 0, got " +
+                   formatNumber(args.default_reflectivity));
+  }
+  for (const char* flag : {"reflectivity", "default-reflectivity"}) {
+    if (values.count(flag) && !args.radiometry()) {
+      throw ArgError(std::string("--") + flag + ": give --intensity or --detection-range too");
+    }
+  }
   return args;
 }
 
@@ -394,6 +452,10 @@ std::string synopsis() {
       << indent << "[--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n"
       << indent << "[--pattern-file FILE --point-rate HZ [--points-per-scan N]]\n"
       << indent << "[--calibration FILE]\n"
+      << indent << "[--beam-divergence RAD --beam-samples N [--min-return-separation M]\n"
+      << indent << " [--return-mode " << choices(core::kReturnModeNames) << "]]\n"
+      << indent << "[--intensity] [--detection-range R@REFLECTIVITY]\n"
+      << indent << "[--reflectivity LINK=VALUE ...] [--default-reflectivity VALUE]\n"
       << indent << "[--threads N] [--mesh-import-max-memory-mb MB] [--mesh-import-timeout S]\n";
   return out.str();
 }
@@ -411,6 +473,9 @@ std::string notes() {
       << "With --pattern-file or --calibration, 'index,line,azimuth,elevation,time,range,link'\n"
       << "(rad; time k / HZ s, or the laser's firing time; with --sweep rotating each beam is\n"
       << "cast from the pose at its time; line: the file's Line, or the laser's ring).\n"
+      << "With --return-mode dual, a second row for a beam's last return and a 'return'\n"
+      << "column; with --intensity, an 'intensity' column last. A return that --detection-range\n"
+      << "loses prints range inf and no link.\n"
       << "Defaults: angles " << formatAngle(scan.fan.angle_min) << ".."
       << formatAngle(scan.fan.angle_max) << ", " << core::FanSpec::kDefaultSamples
       << " samples, ranges " << formatNumber(scan.output.range_min) << ".."
@@ -514,10 +579,79 @@ struct Casting {
   core::ScanPattern pattern;
   core::CastConfig config;
   core::Caster caster;
-  double time_increment;  // s between two azimuth columns: > 0 for a rotating sweep
+  double time_increment;       // s between two azimuth columns: > 0 for a rotating sweep
   core::PulseReturns returns;  // with --beam-samples > 1
   core::BeamList beams;        // --pattern-file: this scan's beams
+  // The radiometry: by label, each one's reflectivity and whether --reflectivity set it; the scan
+  // measured (the second return's too, in dual mode).
+  std::vector<double> reflectivity;
+  std::vector<char> reflectivity_fixed;
+  core::SurfaceSamples surface;
+  core::MeasuredScan measured, measured_second;
 };
+
+// The label of the body hit ("" for none), without a model's private prefix.
+std::string bodyLabel(const LoadedScene& loaded, int body) {
+  if (body < 0) return "";
+  const std::string& label = loaded.scene.labels()[loaded.scene.bodies()[body].label];
+  return loaded.prefixed ? label.substr(label.find('/') + 1) : label;
+}
+
+// Each label's reflectivity: --reflectivity's for its link (named without a model's private
+// prefix), else --default-reflectivity. Throws ArgError for a link no model has.
+void labelReflectivity(const Args& args, const LoadedScene& loaded, Casting* casting) {
+  std::map<std::string, bool> used;
+  for (const std::string& label : loaded.scene.labels()) {
+    const std::string link = loaded.prefixed ? label.substr(label.find('/') + 1) : label;
+    const auto it = args.reflectivity.find(link);
+    casting->reflectivity.push_back(it != args.reflectivity.end() ? it->second
+                                                                  : args.default_reflectivity);
+    casting->reflectivity_fixed.push_back(it != args.reflectivity.end());
+    if (it != args.reflectivity.end()) used[link] = true;
+  }
+  for (const auto& entry : args.reflectivity) {
+    if (!used.count(entry.first)) {
+      throw ArgError("--reflectivity " + entry.first + ": no model has a link of that name");
+    }
+  }
+}
+
+// The intensities and the detection range of the scan just cast from sensor (result), as the
+// node measures them: the surface's reflectance and incidence at each hit where it gives them
+// (a sweep's from its first pose), else the link's reflectivity and the cast's incidence. No
+// noise: cast_scan's ranges stay the caster's.
+void measure(const Args& args, const LoadedScene& loaded, const Eigen::Isometry3d& sensor,
+             const core::ScanResult& result, Casting* casting) {
+  if (!args.radiometry()) return;
+  const core::MeasurementConfig& output = args.scan.output;
+  core::MeasurementModel model(output);
+  if (args.returns.beam_samples > 1) {
+    model.measure(loaded.scene, casting->returns.first, casting->reflectivity, &casting->measured,
+                  &casting->returns.first_surface);
+    model.measure(loaded.scene, casting->returns.second, casting->reflectivity,
+                  &casting->measured_second, &casting->returns.second_surface);
+    return;
+  }
+  if (args.offGrid()) {
+    core::sampleSurfaces(loaded.scene, loaded.poses, sensor, casting->beams, result,
+                         output.reflectance_from_color, casting->reflectivity_fixed,
+                         &casting->surface);
+  } else {
+    core::sampleSurfaces(loaded.scene, loaded.poses, sensor, casting->pattern, result,
+                         output.reflectance_from_color, casting->reflectivity_fixed,
+                         &casting->surface);
+  }
+  model.measure(loaded.scene, result, casting->reflectivity, &casting->measured, &casting->surface);
+}
+
+// Beam i's range and link as the CSV prints them: REP 117's range, and the label hit; a return
+// that the detection range loses (a hit in range with no measured return) prints inf and no link.
+std::string rangeAndLink(const Args& args, const LoadedScene& loaded, const core::ScanResult& beams,
+                         const core::MeasuredScan& measured, int i) {
+  const double range = core::classifyRange(beams.range[i], args.scan.output);
+  if (args.radiometry() && std::isfinite(range) && measured.labels[i] < 0) return "inf,";
+  return formatNumber(range) + "," + bodyLabel(loaded, beams.body[i]);
+}
 
 // A pattern file's beams of the path's scan number `pose` into casting->beams: its rows from
 // pose * points_per_scan on.
@@ -547,7 +681,9 @@ const core::ScanResult& castFrom(const Args& args, const LoadedScene& loaded,
   if (args.returns.beam_samples > 1) {
     // Divergent beams, from the scan's first pose (a sweep's motion is not applied to them).
     core::castReturns(&casting->caster, loaded.scene, loaded.poses, sensor, args.scan.fan,
-                      args.scan.ringElevations(), casting->config, args.returns, {}, {}, 1.0, true,
+                      args.scan.ringElevations(), casting->config, args.returns,
+                      casting->reflectivity, casting->reflectivity_fixed,
+                      args.scan.output.reflectance_from_color, args.scan.output.surface_reflectance,
                       &casting->returns);
     const auto t1 = std::chrono::steady_clock::now();
     if (ns) *ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
@@ -610,20 +746,19 @@ void reportLoad(const LoadedScene& loaded) {
 // The CSV's header: with --poses, the pose's number first; with a rotating sweep, the beam's time
 // last.
 std::string csvHeader(const Args& args, const Casting& casting) {
+  const std::string intensity = args.scan.output.intensity ? ",intensity\n" : "\n";
   if (args.offGrid()) {
     return std::string(args.path.pose_column ? "pose," : "") +
-           "index,line,azimuth,elevation,time,range,link\n";
+           "index,line,azimuth,elevation,time,range,link" + intensity;
   }
   return std::string(args.path.pose_column ? "pose," : "") +
          (args.rings ? "index,ring,elevation,angle,range,link" : "index,angle,range,link") +
-         (casting.time_increment > 0 ? ",time" : "") + (args.dual() ? ",return\n" : "\n");
+         (casting.time_increment > 0 ? ",time" : "") + (args.dual() ? ",return" : "") + intensity;
 }
 
-// The label of the body hit ("" for none), without a model's private prefix.
-std::string bodyLabel(const LoadedScene& loaded, int body) {
-  if (body < 0) return "";
-  const std::string& label = loaded.scene.labels()[loaded.scene.bodies()[body].label];
-  return loaded.prefixed ? label.substr(label.find('/') + 1) : label;
+// The intensity column's field of beam i (with a leading comma), or "" without --intensity.
+std::string intensityField(const Args& args, const core::MeasuredScan& measured, int i) {
+  return args.scan.output.intensity ? "," + formatNumber(measured.intensities[i]) : "";
 }
 
 // One CSV row per beam of the scan from the path's pose number `pose`, in beam order
@@ -640,8 +775,8 @@ std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& 
              formatNumber(std::atan2(d.y(), d.x())) + "," +
              formatNumber(std::atan2(d.z(), std::hypot(d.x(), d.y()))) + "," +
              formatNumber(beams.time(i)) + "," +
-             formatNumber(core::classifyRange(result.range[i], args.scan.output)) + "," +
-             bodyLabel(loaded, result.body[i]) + "\n";
+             rangeAndLink(args, loaded, result, casting.measured, i) +
+             intensityField(args, casting.measured, i) + "\n";
     }
     return out;
   }
@@ -652,6 +787,7 @@ std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& 
     const int i = args.dual() ? row / 2 : row;
     const bool second = args.dual() && row % 2 == 1;
     const core::ScanResult& beams = second ? casting.returns.second : result;
+    const core::MeasuredScan& measured = second ? casting.measured_second : casting.measured;
     if (second && beams.body[i] < 0) continue;
     const int ring = i / azimuths;
     if (args.path.pose_column) out += std::to_string(pose) + ",";
@@ -660,13 +796,12 @@ std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& 
       out += std::to_string(ring) + "," + formatNumber(pattern.elevations()[ring]) + ",";
     }
     out += formatNumber(pattern.azimuth(i % azimuths)) + "," +
-           formatNumber(core::classifyRange(beams.range[i], args.scan.output)) + ",";
-    out += bodyLabel(loaded, beams.body[i]);
+           rangeAndLink(args, loaded, beams, measured, i);
     if (casting.time_increment > 0) {
       out += "," + formatNumber(i % azimuths * casting.time_increment);  // castSweep's column time
     }
     if (args.dual()) out += second ? ",2" : ",1";
-    out += "\n";
+    out += intensityField(args, measured, i) + "\n";
   }
   return out;
 }
@@ -697,12 +832,20 @@ int main(int argc, char** argv) {
                   {},
                   {}};
   casting.config.threads = args.threads;
+  try {
+    labelReflectivity(args, loaded, &casting);
+  } catch (const ArgError& e) {
+    std::cerr << "cast_scan: " << e.what() << "\n";
+    return kExitBadArguments;
+  }
   // The path in order, each scan printed before the next is cast (the result is the caster's).
   print(csvHeader(args, casting));
   for (std::size_t p = 0; p < args.path.sensors.size(); ++p) {
     patternScan(args, p, &casting);
-    print(csvRows(args, loaded, casting,
-                  castFrom(args, loaded, args.path.sensors[p], &casting, nullptr), p));
+    const core::ScanResult& result =
+        castFrom(args, loaded, args.path.sensors[p], &casting, nullptr);
+    measure(args, loaded, args.path.sensors[p], result, &casting);
+    print(csvRows(args, loaded, casting, result, p));
   }
   if (args.repeat > 0) {
     reportLoad(loaded);

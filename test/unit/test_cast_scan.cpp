@@ -8,6 +8,8 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "cast_scan_cli.h"
@@ -496,6 +498,84 @@ TEST(CastScan, BadReturnSettingsNameTheirFlag) {
   const CliRun run = runCli(kStraddle + " --min-return-separation -1");
   EXPECT_NE(run.status, 0);
   EXPECT_NE(run.err.find("--min-return-separation"), std::string::npos) << run.err;
+}
+
+// Two beams at -0.3 and 0.3 rad across test/data/surfaces/edge.urdf: the first meets the box's face
+// x = 2 and the second the wall's face x = 3, both at incidence 0.3 rad (boxes: no colours, so
+// the links' reflectivity applies).
+const std::string kTwoFaces = "--urdf " + kData +
+                              "surfaces/edge.urdf --sensor 0,0,0,0,0,0 --angle-min -0.3 "
+                              "--angle-max 0.3 --samples 2";
+
+TEST(CastScan, IntensityIsTheLinksReflectivityTimesTheIncidence) {
+  for (const auto& [flags, box, base] :
+       {std::make_tuple(std::string(""), 1.0, 1.0),
+        std::make_tuple(std::string(" --reflectivity box=0.5 --default-reflectivity 0.2"), 0.5,
+                        0.2)}) {
+    SCOPED_TRACE(flags);
+    const CliRun run = runCli(kTwoFaces + " --intensity" + flags);
+    ASSERT_EQ(run.status, 0) << run.err;
+    const auto rows = csvRows(run.out, "index,angle,range,link,intensity");
+    ASSERT_EQ(rows.size(), 2u);
+    EXPECT_EQ(rows[0][3], "box");
+    EXPECT_NEAR(std::stod(rows[0][2]), 2 / std::cos(0.3), 1e-7);
+    EXPECT_NEAR(std::stod(rows[0][4]), box * std::cos(0.3), 1e-7);
+    EXPECT_EQ(rows[1][3], "base");
+    EXPECT_NEAR(std::stod(rows[1][4]), base * std::cos(0.3), 1e-7);
+  }
+}
+
+// --detection-range R@rho: a return of reflectivity r_b at range d and incidence theta is kept iff
+// r_b cos(theta) / d^2 >= rho / R^2 (a Lambertian target filling the beam, the datasheet's
+// target as the threshold), worked out here for the box's face at several reflectivities.
+TEST(CastScan, TheDetectionRangeLosesWeakReturns) {
+  const double d = 2 / std::cos(0.3), threshold = 0.1 / (10.0 * 10.0);
+  for (const double box : {0.001, 0.004, 0.0045, 0.006, 0.5}) {
+    SCOPED_TRACE(box);
+    const CliRun run = runCli(kTwoFaces + " --detection-range 10@0.1 --reflectivity box=" +
+                              std::to_string(box));
+    ASSERT_EQ(run.status, 0) << run.err;
+    const auto rows = csvRows(run.out, "index,angle,range,link");
+    ASSERT_EQ(rows.size(), 2u);
+    const bool detected = box * std::cos(0.3) / (d * d) >= threshold;
+    EXPECT_EQ(rows[0][2] == "inf", !detected);
+    EXPECT_EQ(rows[0][3], detected ? "box" : "");
+    EXPECT_EQ(rows[1][3], "base");  // reflectivity 1 at 3.14 m: far above the threshold
+  }
+  // Off, every hit is a return.
+  const CliRun off = runCli(kTwoFaces + " --intensity --reflectivity box=0.001");
+  ASSERT_EQ(off.status, 0) << off.err;
+  EXPECT_EQ(csvRows(off.out, "index,angle,range,link,intensity")[0][3], "box");
+}
+
+TEST(CastScan, DualReturnsPrintTheirIntensities) {
+  const CliRun run = runCli(kStraddle + " --intensity --reflectivity box=0.5");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = csvRows(run.out, "index,angle,range,link,return,intensity");
+  ASSERT_EQ(rows.size(), 3u) << run.out;
+  // Each return's power share of the pulse: both positive, the missed beam's 0.
+  EXPECT_GT(std::stod(rows[0][5]), 0);
+  EXPECT_GT(std::stod(rows[1][5]), 0);
+  EXPECT_EQ(rows[2][5], "0");
+}
+
+TEST(CastScan, BadRadiometrySettingsNameTheirFlag) {
+  const std::pair<std::string, std::string> cases[] = {
+      {" --intensity --reflectivity nosuch=0.5", "--reflectivity nosuch: no model has a link"},
+      {" --intensity --reflectivity box", "--reflectivity: 'box' is not LINK=VALUE"},
+      {" --intensity --reflectivity box=-1", "--reflectivity box: must be >= 0"},
+      {" --reflectivity box=0.5", "--reflectivity: give --intensity or --detection-range"},
+      {" --intensity --default-reflectivity -2", "--default-reflectivity: must be >= 0"},
+      {" --detection-range 10", "--detection-range: '10' is not R@REFLECTIVITY"},
+      {" --detection-range 0@0.1", "needs R > 0 m and REFLECTIVITY > 0"},
+      {" --detection-range 10@x", "--detection-range"},
+  };
+  for (const auto& [flags, message] : cases) {
+    SCOPED_TRACE(flags);
+    const CliRun run = runCli(kTwoFaces + flags);
+    EXPECT_EQ(run.status, 2);
+    EXPECT_NE(run.err.find(message), std::string::npos) << run.err;
+  }
 }
 
 }  // namespace

@@ -50,6 +50,26 @@ TEST(CastScanBeams, PatternFileScansTakeTheNextRows) {
   }
 }
 
+// --intensity for beams off the grid: each pattern row's incidence on the room's face it meets
+// (the default reflectivity 1), from its own direction.
+TEST(CastScanBeams, PatternFileIntensities) {
+  const std::string pattern = writeFile("pattern_i.csv",
+                                        "Time/s,Azimuth/deg,Zenith/deg,Line\n"
+                                        "0,0,90,2\n0.1,90,60,0\n0.2,-135,100,1\n0.3,30,180,3\n");
+  const CliRun run = runCli(kRoom + " --sensor 0.5,-1,1,0,0,0 --pattern-file " + pattern +
+                            " --point-rate 1000 --intensity");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = csvRows(run.out, "index,line,azimuth,elevation,time,range,link,intensity");
+  ASSERT_EQ(rows.size(), 4u);
+  const Eigen::Vector3d sensor(0.5, -1, 1);
+  for (int r = 0; r < 4; ++r) {
+    const double az = kRows[r][0] * kDeg, zen = kRows[r][1] * kDeg;
+    const Eigen::Vector3d d(std::sin(zen) * std::cos(az), std::sin(zen) * std::sin(az),
+                            std::cos(zen));
+    EXPECT_NEAR(std::stod(rows[r][7]), std::abs(d[roomFaceAxis(sensor, d)]), 1e-6) << r;
+  }
+}
+
 // VLP-16 laser 0 (-15 deg, no vertical offset) from 1 m up meets the floor 1 / sin(15 deg) m
 // along its beam, whatever its azimuth; laser i of sequence s fires at s * 55.296 + i * 2.304 us.
 TEST(CastScanBeams, CalibrationGivesTheHeadsBeams) {
