@@ -127,16 +127,23 @@ void checkSizes(const core::ScanPattern& pattern, const core::MeasuredScan& scan
 namespace {
 
 // The cloud of `beams` beams as height x width (organized) or one row of the valid returns: beam b
-// with a valid range r is the point at(b, r), with ring ring(b) and time time(b).
+// with a valid range r is the point at(b, r), with ring ring(b) and time time(b). With last (dual
+// returns), each beam's return in last follows its own in scan, and a `return` field says which.
 template <class At, class Ring, class Time>
 void fillCloud(int beams, int height, int width, const core::MeasuredScan& scan,
                const std_msgs::Header& header, const CloudOptions& options, At&& at, Ring&& ring,
-               Time&& time, sensor_msgs::PointCloud2* cloud) {
-  int points = beams;
+               Time&& time, sensor_msgs::PointCloud2* cloud,
+               const core::MeasuredScan* last = nullptr) {
+  const int returns = last ? 2 : 1;
+  int points = beams * returns;
   if (!options.organized) {
     points = 0;
     for (const float r : scan.ranges) points += std::isfinite(r);
+    if (last) {
+      for (const float r : last->ranges) points += std::isfinite(r);
+    }
   }
+  width *= returns;
 
   cloud->header = header;
   cloud->height = options.organized ? height : 1;
@@ -154,6 +161,15 @@ void fillCloud(int beams, int height, int width, const core::MeasuredScan& scan,
     }
     cloud->point_step = ref.table.point_step;
   });
+  if (last) {
+    PointField field;
+    field.name = kReturnField;
+    field.offset = cloud->point_step;
+    field.datatype = PointField::UINT8;
+    field.count = 1;
+    cloud->fields.push_back(field);
+    cloud->point_step += 1;
+  }
   cloud->row_step = cloud->width * cloud->point_step;
   // Zeroed, the padding too, so that equal clouds are equal bytes.
   cloud->data.assign(static_cast<std::size_t>(points) * cloud->point_step, 0);
@@ -167,24 +183,28 @@ void fillCloud(int beams, int height, int width, const core::MeasuredScan& scan,
     using Ref = decltype(ref);
     const auto each_field = std::make_index_sequence<Ref::table.fields.size()>();
     for (int b = 0; b < beams; ++b) {
-      const float range = scan.ranges[b];
-      const bool valid = std::isfinite(range);
-      all_valid = all_valid && valid;
-      if (!valid && !options.organized) continue;
-      Beam beam;
-      beam.ring = ring(b);
-      beam.time = time(b);
-      if (valid) {
-        beam.xyz = at(b, static_cast<double>(range)).template cast<float>();
-        beam.intensity = scan.intensities.empty() ? 0.0f : scan.intensities[b];
-        beam.range = range;
-      } else {
-        beam.xyz.setConstant(kNan);
-        beam.intensity = kNan;
-        beam.range = 0;
+      for (int k = 0; k < returns; ++k) {
+        const core::MeasuredScan& from = k == 0 ? scan : *last;
+        const float range = from.ranges[b];
+        const bool valid = std::isfinite(range);
+        all_valid = all_valid && valid;
+        if (!valid && !options.organized) continue;
+        Beam beam;
+        beam.ring = ring(b);
+        beam.time = time(b);
+        if (valid) {
+          beam.xyz = at(b, static_cast<double>(range)).template cast<float>();
+          beam.intensity = from.intensities.empty() ? 0.0f : from.intensities[b];
+          beam.range = range;
+        } else {
+          beam.xyz.setConstant(kNan);
+          beam.intensity = kNan;
+          beam.range = 0;
+        }
+        writePoint<Ref>(beam, stamp_ns, out, each_field);
+        if (last) out[Ref::table.point_step] = static_cast<std::uint8_t>(k + 1);
+        out += cloud->point_step;
       }
-      writePoint<Ref>(beam, stamp_ns, out, each_field);
-      out += Ref::table.point_step;
     }
   });
   cloud->is_dense = !options.organized || all_valid;
@@ -194,14 +214,17 @@ void fillCloud(int beams, int height, int width, const core::MeasuredScan& scan,
 
 void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
                      const std::vector<double>& column_times, const std_msgs::Header& header,
-                     const CloudOptions& options, sensor_msgs::PointCloud2* cloud) {
+                     const CloudOptions& options, sensor_msgs::PointCloud2* cloud,
+                     const core::MeasuredScan* last) {
   checkSizes(pattern, scan, column_times, options.layout);
+  if (last) checkSizes(pattern, *last, column_times, options.layout);
   const int azimuths = pattern.azimuthCount();
   fillCloud(
       pattern.size(), pattern.ringCount(), azimuths, scan, header, options,
       [&](int b, double range) -> Eigen::Vector3d { return pattern.directions()[b] * range; },
       [&](int b) { return b / azimuths; },
-      [&](int b) { return column_times.empty() ? 0.0 : column_times[b % azimuths]; }, cloud);
+      [&](int b) { return column_times.empty() ? 0.0 : column_times[b % azimuths]; }, cloud,
+      last);
 }
 
 void buildBeamCloud(const core::BeamList& beams, const core::MeasuredScan& scan,

@@ -126,14 +126,18 @@ void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>&
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const core::MeasurementConfig& output = cast_params_.scan.output;
   if (cast_params_.returns.beam_samples > 1) {
-    // Divergent beams: the mode's single return (dual: the strongest), cast from the scan's first
-    // pose (a sweep's motion is not applied to them).
+    // Divergent beams: the mode's return (dual: the strongest, and for a cloud the last too),
+    // cast from the scan's first pose (a sweep's motion is not applied to them).
     core::castReturns(&caster_, scene, frames.front(), poses.front(), cast_params_.scan.fan,
                       cast_params_.scan.ringElevations(), cast_config_, cast_params_.returns,
                       reflectivity, reflectivity_fixed, output.reflectance_from_color,
                       output.surface_reflectance, &returns_);
     measurement_model_.measure(scene, returns_.first, reflectivity, &measured_,
                                &returns_.first_surface);
+    if (dual()) {
+      measurement_model_.measure(scene, returns_.second, reflectivity, &measured_last_,
+                                 &returns_.second_surface);
+    }
   } else if (output.needsIncidence() && output.surface_reflectance) {
     // A sweep's surfaces are sampled from its first pose (sampleSurfaces); beams off the grid
     // from their own origins and directions.
@@ -215,7 +219,8 @@ void Sensor::publishCloud(const ros::Time& stamp) {
   if (cast_params_.offGrid()) {
     buildBeamCloud(beams_, measured_, header, options, &cloud);
   } else {
-    buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud);
+    buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud,
+                    dual() ? &measured_last_ : nullptr);
   }
   output_->send(cloud);
 }

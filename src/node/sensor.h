@@ -84,6 +84,11 @@ class Sensor {
   const core::ScanResult* castPattern(const core::Scene& scene, const std::vector<ros::Time>& times,
                                       const std::vector<core::FramePoses>& frames,
                                       const std::vector<Eigen::Isometry3d>& poses);
+  // Divergent beams in dual return mode: a 3D sensor's cloud has each beam's last return too.
+  bool dual() const {
+    return cast_params_.returns.beam_samples > 1 &&
+           cast_params_.returns.return_mode == core::ReturnMode::kDual && !cast_params_.planar();
+  }
   void publishScan(const ros::Time& stamp);
   void publishCloud(const ros::Time& stamp);
   void publishLabels(const core::Scene& scene, const std_msgs::Header& header);
@@ -101,7 +106,8 @@ class Sensor {
   core::Caster caster_;
   core::MeasurementModel measurement_model_;
   core::MeasuredScan measured_;
-  core::PulseReturns returns_;    // with divergent beams (beam_samples > 1)
+  core::PulseReturns returns_;        // with divergent beams (beam_samples > 1)
+  core::MeasuredScan measured_last_;  // return_mode dual: the beams' last returns
   core::SurfaceSamples surface_;  // the surfaces' reflectance and incidence, when intensity is on
   std::vector<double> column_times_;  // s after the stamp, per azimuth column (rotating)
   // A pattern file's beams: this scan's, and the row the next scan starts at (the file a loop).

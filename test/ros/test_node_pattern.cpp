@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "driver_layouts.h"
+#include "first_message.h"
 #include "laser_raycast/core/pattern_file.h"
 #include "laser_raycast/loader/velodyne_calibration.h"
 #include "sensors_rig.h"
@@ -104,25 +105,9 @@ TEST(NodePattern, CalibratedVelodyne) {
   const core::VelodyneHead head = laser_raycast::loadVelodyneCalibration(
       ros::package::getPath("laser_raycast") + "/test/data/vlp16_calibration.yaml");
   const core::BeamList beams = head.scan(0.1);
-  ros::NodeHandle nh;
   tf2_ros::StaticTransformBroadcaster statics;
   statics.sendTransform(transform(ros::Time::now(), "lidar", kSensor, 0));
-  std::mutex mutex;
-  sensor_msgs::PointCloud2::ConstPtr cloud;
-  const ros::Subscriber sub = nh.subscribe<sensor_msgs::PointCloud2>(
-      "/velodyne/points", 1, [&](const sensor_msgs::PointCloud2::ConstPtr& m) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!cloud) cloud = m;
-      });
-  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(30.0);
-  while (ros::ok() && ros::WallTime::now() < give_up) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (cloud) break;
-    }
-    ros::WallDuration(0.01).sleep();
-  }
-  std::lock_guard<std::mutex> lock(mutex);
+  const auto cloud = firstMessage<sensor_msgs::PointCloud2>("/velodyne/points", 30.0);
   ASSERT_TRUE(cloud);
   expectDriverLayout(*cloud, laser_raycast::PointLayout::kVelodyne);
   ASSERT_EQ(cloud->width * cloud->height, 1808u * 16u);

@@ -147,6 +147,58 @@ TEST(PointCloud, OrganizedHoldsEveryBeam) {
   EXPECT_EQ(readAll(cloud)[5].time, 0.0f);  // instantaneous: every point at the stamp
 }
 
+// Dual returns: each beam's last return (where it has one of its own) follows its strongest, and a
+// uint8 field `return` after the layout's says which (1 strongest, 2 last).
+TEST(PointCloud, DualReturnsFollowEachBeamsStrongest) {
+  MeasuredScan last = sixBeams();  // strongest: 2 m, inf, 1.5 m / inf, 3 m, inf
+  last.ranges = {2.5f, kNan, kNan, 4.0f, 3.5f, kNan};
+  last.intensities = {0.125f, 0, 0, 0.375f, 0.0625f, 0};
+  sensor_msgs::PointCloud2 cloud;
+  buildPointCloud(twoRings(), sixBeams(), {0.0, 0.01, 0.02}, header(), CloudOptions{}, &cloud,
+                  &last);
+  ASSERT_EQ(cloud.fields.size(), 7u);
+  EXPECT_EQ(cloud.fields[6].name, "return");
+  EXPECT_EQ(cloud.fields[6].offset, 22u);
+  EXPECT_EQ(cloud.fields[6].datatype, PointField::UINT8);
+  EXPECT_EQ(cloud.point_step, 23u);
+  EXPECT_EQ(cloud.width, 6u);  // three strongest, and three last of their own
+  EXPECT_EQ(cloud.data.size(), 6u * 23u);
+  const auto p = readAll(cloud);
+  std::vector<int> which;
+  for (sensor_msgs::PointCloud2ConstIterator<std::uint8_t> r(cloud, "return"); r != r.end(); ++r) {
+    which.push_back(*r);
+  }
+  ASSERT_EQ(p.size(), 6u);
+  EXPECT_EQ(which, (std::vector<int>{1, 2, 1, 2, 1, 2}));
+  // Beam 0: 2 m then 2.5 m; beam 2: 1.5 m (no last of its own); beam 3: only a last return, 4 m;
+  // beam 4: 3 m then 3.5 m.
+  expectPoint(p[0], 2.0, -0.3, -M_PI / 2);
+  expectPoint(p[1], 2.5, -0.3, -M_PI / 2);
+  EXPECT_EQ(p[1].intensity, 0.125f);
+  expectPoint(p[2], 1.5, -0.3, M_PI / 2);
+  expectPoint(p[3], 4.0, 0.2, -M_PI / 2);
+  EXPECT_EQ(p[3].ring, 1);
+  expectPoint(p[4], 3.0, 0.2, 0.0);
+  expectPoint(p[5], 3.5, 0.2, 0.0);
+  EXPECT_EQ(p[5].time, 0.01f);
+
+  // Organized: rows twice as wide, beam column c's returns at 2c and 2c + 1.
+  CloudOptions organized;
+  organized.organized = true;
+  buildPointCloud(twoRings(), sixBeams(), {}, header(), organized, &cloud, &last);
+  EXPECT_EQ(cloud.height, 2u);
+  EXPECT_EQ(cloud.width, 6u);
+  EXPECT_EQ(cloud.row_step, 6u * 23u);
+  EXPECT_FALSE(cloud.is_dense);
+  const auto q = readAll(cloud);
+  ASSERT_EQ(q.size(), 12u);
+  expectPoint(q[1], 2.5, -0.3, -M_PI / 2);
+  EXPECT_TRUE(std::isnan(q[5].x));  // beam 2's last: none of its own
+  EXPECT_TRUE(std::isnan(q[6].x));  // beam 3's strongest: too close
+  expectPoint(q[7], 4.0, 0.2, -M_PI / 2);
+  EXPECT_EQ(q[7].ring, 1);
+}
+
 TEST(PointCloud, NoIntensitiesGiveZero) {
   MeasuredScan scan = sixBeams();
   scan.intensities.clear();

@@ -33,9 +33,19 @@ struct CloudOptions {
 // an instantaneous scan; see rotatingColumnTimes), each in the fields of options.layout that hold
 // it (PointValue). Throws std::invalid_argument if scan.ranges, scan.intensities or column_times
 // do not match the pattern's size, or the layout cannot hold the scan (pointLayoutLimit).
+//
+// With last (dual returns, core::ReturnMode::kDual: scan the strongest returns, last the last
+// ones, invalid where a beam's last return is its strongest), every point also has a uint8 field
+// `return` after the layout's (1 the strongest, 2 the last; point_step one byte longer), and each
+// beam's last return follows its strongest as a point of its own; organized, a row is 2 x
+// azimuths wide, beam column c's strongest return at 2c and its last at 2c + 1 (NaN without one).
 void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan& scan,
                      const std::vector<double>& column_times, const std_msgs::Header& header,
-                     const CloudOptions& options, sensor_msgs::PointCloud2* cloud);
+                     const CloudOptions& options, sensor_msgs::PointCloud2* cloud,
+                     const core::MeasuredScan* last = nullptr);
+
+// The name of the dual returns' field (buildPointCloud's last).
+inline constexpr const char* kReturnField = "return";
 
 // The cloud of beams off any grid (a pattern file's, core::BeamList): beam b with a valid range r is
 // the point origin(b) + r * direction(b), with its line as the ring and its time (s after

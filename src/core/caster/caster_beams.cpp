@@ -110,6 +110,12 @@ class BeamTracer {
   BeamHit trace(const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
     const GroupPoses& poses = *poses_;
     BeamHit hit;
+    // The beam's sensor-frame ray, prepared once for every mesh triangle it is tested against.
+    Ray sensor_ray;
+    sensor_ray.origin = o;
+    sensor_ray.dir = d;
+    sensor_ray.tmin = config_.tmin;
+    const PreparedRay<double, M> prepared(sensor_ray, config_.cull_backfaces);
     const auto& groups = index_.groups();
     for (std::size_t g = 0; g < groups.size(); ++g) {
       if (!poses.valid[g] || groups[g]->wide.empty()) continue;
@@ -125,7 +131,7 @@ class BeamTracer {
       double tmax = std::min(config_.tmax, hit.t);
       traceWide(group.wide, group.wide.root(), box_ray, &tmax, [&](std::uint32_t slot) {
         const int body = group.bodies[group.tree.triangleIds()[slot]];
-        castBody(body, placedBody(body, sensor_from_frame), o, d, &hit);
+        castBody(body, placedBody(body, sensor_from_frame), o, d, prepared, &hit);
         tmax = std::min(config_.tmax, hit.t);
       });
     }
@@ -175,7 +181,7 @@ class BeamTracer {
   }
 
   void castBody(int body, const Placed& p, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
-                BeamHit* hit) {
+                const PreparedRay<double, M>& prepared, BeamHit* hit) {
     const Eigen::Matrix3d& rot = p.rot;
     const Eigen::Vector3d& trans = p.trans;
     Ray body_ray;
@@ -186,7 +192,7 @@ class BeamTracer {
     if (!mayEnterBox(body_ray, scene_.boxCenter(body), scene_.boxHalf(body))) return;
     const Shape& shape = scene_.bodies()[body].shape;
     if (const auto* mesh_ptr = std::get_if<std::shared_ptr<const Mesh>>(&shape)) {
-      castMesh(**mesh_ptr, body, rot, trans, body_ray, o, d, hit);
+      castMesh(**mesh_ptr, body, rot, trans, body_ray, prepared, hit);
       return;
     }
     std::visit(
@@ -204,19 +210,15 @@ class BeamTracer {
   }
 
   // The mesh's wide BVH walked by the beam in the body's frame; each triangle it reaches moved into
-  // the sensor frame and tested against the beam's sensor-frame ray, as the mesh walk tests it.
+  // the sensor frame and tested against the beam's sensor-frame ray (ray), as the mesh walk tests
+  // it.
   void castMesh(const Mesh& mesh, int body, const Eigen::Matrix3d& rot,
-                const Eigen::Vector3d& trans, const Ray& body_ray, const Eigen::Vector3d& o,
-                const Eigen::Vector3d& d, BeamHit* hit) {
+                const Eigen::Vector3d& trans, const Ray& body_ray, const PreparedRay<double, M>& ray,
+                BeamHit* hit) {
     const WideBvh& wide = mesh.wideBvh();
     if (wide.empty()) return;
     const auto& slots = mesh.bvh().triangleVertices();
     const auto& ids = mesh.bvh().triangleIds();
-    Ray sensor_ray;
-    sensor_ray.origin = o;
-    sensor_ray.dir = d;
-    sensor_ray.tmin = config_.tmin;
-    const PreparedRay<double, M> ray(sensor_ray, config_.cull_backfaces);
     const WideBoxRay box_ray(body_ray, mesh.bvh().bounds());
     double tmax = body_ray.tmax;
     double best_t = kInf;
