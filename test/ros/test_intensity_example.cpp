@@ -1,0 +1,71 @@
+// rostest intensity_example.test: the OS1-64 of launch/intensity_example.launch, 3 m in front of
+// worlds/intensity_wall.urdf's checkerboard wall. Each point on the wall (x = 3 in the lidar's
+// frame, |y|, |z| < 1) has the intensity of its texel (checker.png: 8 x 8 cells, white where column
+// + row is even, u = (y + 1) / 2, v = (z + 1) / 2, row 0 at the top) times the cosine of its
+// incidence, x / |p|; each point on the pillar its URDF colour's luminance times its incidence on
+// the cylinder; each point on the dark box the launch file's reflectivity 0.08 times its
+// incidence on the face it meets.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include "driver_layouts.h"
+#include "first_message.h"
+
+namespace laser_raycast_test {
+namespace {
+
+TEST(IntensityExample, TheCloudShowsTheWorldsSurfaces) {
+  const auto cloud = firstMessage<sensor_msgs::PointCloud2>("/points", 40.0);
+  ASSERT_TRUE(cloud);
+  const double kLuminanceRed = 0.2126 * 0.8 + 0.7152 * 0.15 + 0.0722 * 0.1;
+  int wall = 0, white = 0, pillar = 0, box = 0;
+  for (std::size_t i = 0; i < std::size_t{cloud->width} * cloud->height; ++i) {
+    const Eigen::Vector3d p(fieldValue<float>(*cloud, i, "x"), fieldValue<float>(*cloud, i, "y"),
+                            fieldValue<float>(*cloud, i, "z"));
+    if (!std::isfinite(p.x())) continue;
+    const double intensity = fieldValue<float>(*cloud, i, "intensity");
+    const Eigen::Vector3d d = p.normalized();
+    if (std::abs(p.x() - 3) < 1e-3 && std::abs(p.y()) < 0.999 && std::abs(p.z()) < 0.999) {
+      const double column = (p.y() + 1) / 2 * 8, row = (1 - (p.z() + 1) / 2) * 8;
+      // Points within float rounding of a cell's edge could be on either side.
+      if (std::abs(column - std::round(column)) < 1e-3 || std::abs(row - std::round(row)) < 1e-3) {
+        continue;
+      }
+      const bool is_white = (static_cast<int>(column) + static_cast<int>(row)) % 2 == 0;
+      EXPECT_NEAR(intensity, is_white ? std::abs(d.x()) : 0.0, 1e-4) << "wall point " << i;
+      ++wall;
+      white += is_white;
+    } else if (std::hypot(p.x() - 2.2, p.y() + 1.8) < 0.2 + 1e-3 && p.z() > -1.2 + 1e-3 &&
+               p.z() < 1.2 - 1e-3) {
+      // The pillar's side (radius 0.2 m about x = 2.2, y = -1.8): its outward normal there.
+      const Eigen::Vector3d n = Eigen::Vector3d(p.x() - 2.2, p.y() + 1.8, 0).normalized();
+      EXPECT_NEAR(intensity, kLuminanceRed * std::abs(d.dot(n)), 1e-4) << "pillar point " << i;
+      ++pillar;
+    } else if (std::abs(p.x() - 1.9) < 1e-3 && std::abs(p.y() - 1.8) < 0.3 && p.z() < -0.4) {
+      // The dark box's face x = 1.9 (a 0.6 m cube-ish box about x = 2.2, y = 1.8, z 0 to 0.8 in
+      // the world: z below -0.4 in the lidar's frame).
+      EXPECT_NEAR(intensity, 0.08 * std::abs(d.x()), 1e-4) << "box point " << i;
+      ++box;
+    }
+  }
+  EXPECT_GT(wall, 1000);
+  EXPECT_GT(white, wall / 3);
+  EXPECT_LT(white, 2 * wall / 3);
+  EXPECT_GT(pillar, 50);
+  EXPECT_GT(box, 50);
+}
+
+}  // namespace
+}  // namespace laser_raycast_test
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_intensity_example");
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}
