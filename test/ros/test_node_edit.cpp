@@ -1,14 +1,16 @@
 // Run-time scene editing end to end (rostest node_edit.test): laser_raycast_node on a wall 4.9 m in
 // front of the sensor (test/data/edit_room.urdf); this test spawns a 0.5 m cube through
 // ~spawn_model, moves it with ~set_model_pose and deletes it with ~delete_model, and checks the
-// first scan stamped after each call against ranges worked out from the geometry; a cube whose
-// link is looked up in TF, seen once its transform is published; bad requests; then 100
+// first scan stamped after each call against ranges worked out from the geometry, and the links
+// the labels name; a two-link model placed by its joint's origin; a cube whose link is looked up
+// in TF, seen once its transform is published; bad requests; then 100
 // spawn/delete cycles while the node scans at 20 Hz, counting the scans against quiet stretches
 // between them and reading the node's resident memory from /proc.
 #include <dirent.h>
 #include <gtest/gtest.h>
 #include <laser_raycast/DeleteModel.h>
 #include <laser_raycast/ListModels.h>
+#include <laser_raycast/ScanLabels.h>
 #include <laser_raycast/SetModelPose.h>
 #include <laser_raycast/SpawnModel.h>
 #include <ros/ros.h>
@@ -23,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -68,7 +71,10 @@ class Scans {
   // Room for every scan of a long service call (the test does not spin while it waits): 50 s of
   // them at 20 Hz.
   static constexpr std::size_t kKept = 1000;
-  Scans() { sub_ = nh_.subscribe("scan", kKept, &Scans::onScan, this); }
+  Scans() {
+    sub_ = nh_.subscribe("scan", kKept, &Scans::onScan, this);
+    labels_sub_ = nh_.subscribe("scan_labels", kKept, &Scans::onLabels, this);
+  }
 
   // The first scan stamped after t.
   sensor_msgs::LaserScan after(const ros::Time& t) {
@@ -86,12 +92,31 @@ class Scans {
     ADD_FAILURE() << "no scan stamped after " << t;
     return sensor_msgs::LaserScan();
   }
+  // The labels of the scan stamped at stamp (they come beside it on scan_labels).
+  laser_raycast::ScanLabels labelsOf(const ros::Time& stamp) {
+    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(20.0);
+    while (ros::ok() && ros::WallTime::now() < give_up) {
+      ros::spinOnce();
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (const auto& labels : labels_) {
+          if (labels.header.stamp == stamp) return labels;
+        }
+      }
+      ros::WallDuration(0.005).sleep();
+    }
+    ADD_FAILURE() << "no labels stamped " << stamp;
+    return laser_raycast::ScanLabels();
+  }
   // Scans kept (the last kKept) stamped in [from, to].
-  std::size_t stampedBetween(const ros::Time& from, const ros::Time& to) {
+  std::vector<sensor_msgs::LaserScan> stampedBetween(const ros::Time& from, const ros::Time& to) {
     std::lock_guard<std::mutex> lock(mutex_);
-    return std::count_if(scans_.begin(), scans_.end(), [&](const sensor_msgs::LaserScan& scan) {
-      return scan.header.stamp >= from && scan.header.stamp <= to;
-    });
+    std::vector<sensor_msgs::LaserScan> found;
+    std::copy_if(scans_.begin(), scans_.end(), std::back_inserter(found),
+                 [&](const sensor_msgs::LaserScan& scan) {
+                   return scan.header.stamp >= from && scan.header.stamp <= to;
+                 });
+    return found;
   }
   std::size_t count() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -105,11 +130,17 @@ class Scans {
     if (scans_.size() > kKept) scans_.erase(scans_.begin());
     ++received_;
   }
+  void onLabels(const laser_raycast::ScanLabels::ConstPtr& labels) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    labels_.push_back(*labels);
+    if (labels_.size() > kKept) labels_.erase(labels_.begin());
+  }
 
   ros::NodeHandle nh_;
-  ros::Subscriber sub_;
+  ros::Subscriber sub_, labels_sub_;
   std::mutex mutex_;
   std::vector<sensor_msgs::LaserScan> scans_;
+  std::vector<laser_raycast::ScanLabels> labels_;
   std::size_t received_ = 0;
 };
 
@@ -122,6 +153,24 @@ void expectRanges(const sensor_msgs::LaserScan& scan, bool cube, double cx, doub
     EXPECT_NEAR(scan.ranges[i], expectedRange(kAngles[i], cube, cx, cy), kTolerance)
         << what << ", beam " << i << " at " << kAngles[i] << " rad";
   }
+}
+
+// Whether every range of scan is that of the scene with (cube) or without the cube at (cx, cy).
+bool matches(const sensor_msgs::LaserScan& scan, bool cube, double cx, double cy) {
+  if (scan.ranges.size() != kAngles.size()) return false;
+  for (std::size_t i = 0; i < kAngles.size(); ++i) {
+    if (!(std::abs(scan.ranges[i] - expectedRange(kAngles[i], cube, cx, cy)) <= kTolerance)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// The link beam i of the scan stamped at stamp hit ("" for none).
+std::string linkHit(const ros::Time& stamp, std::size_t beam) {
+  const laser_raycast::ScanLabels labels = scans->labelsOf(stamp);
+  if (beam >= labels.labels.size() || labels.labels[beam] < 0) return "";
+  return labels.link_names.at(labels.labels[beam]);
 }
 
 laser_raycast::SpawnModel::Response spawn(const std::string& name, const std::string& urdf,
@@ -185,9 +234,14 @@ TEST(NodeEdit, SpawnMoveDeleteRestoresRangesBitForBit) {
   expectRanges(before, false, 0, 0, "before spawning");
 
   // In front: the middle beam meets the near face at 2 - 0.25 m; the beams at +-0.2 rad pass it.
+  EXPECT_EQ(linkHit(before.header.stamp, 2), "wall");
   auto spawned = spawn("cube1", kCube, "", 2.0, 0.0);
   ASSERT_TRUE(spawned.success) << spawned.message;
-  expectRanges(scans->after(ros::Time::now()), true, 2.0, 0.0, "cube at (2, 0)");
+  const sensor_msgs::LaserScan with_cube = scans->after(ros::Time::now());
+  expectRanges(with_cube, true, 2.0, 0.0, "cube at (2, 0)");
+  // The labels follow: the middle beam hit the cube's link, the others the wall.
+  EXPECT_EQ(linkHit(with_cube.header.stamp, 2), "cube");
+  EXPECT_EQ(linkHit(with_cube.header.stamp, 0), "wall");
   const auto names = listed();
   EXPECT_NE(std::find(names.begin(), names.end(), "room"), names.end());
   EXPECT_NE(std::find(names.begin(), names.end(), "cube1"), names.end());
@@ -208,8 +262,37 @@ TEST(NodeEdit, SpawnMoveDeleteRestoresRangesBitForBit) {
     // Bit for bit: the scene is again the one the ranges before were cast on.
     EXPECT_EQ(after.ranges[i], before.ranges[i]) << "beam " << i;
   }
+  EXPECT_EQ(linkHit(after.header.stamp, 2), "wall");
   const auto left = listed();
   EXPECT_EQ(std::find(left.begin(), left.end(), "cube1"), left.end());
+}
+
+// Two links: the cube on arm_tip, which a revolute joint holds 0.5 m ahead of and 0.25 m left of
+// the root link arm_base, at the joint's zero.
+const char* const kArm = R"(<robot name="arm"><link name="arm_base"/><link name="arm_tip">
+  <visual><geometry><box size="0.5 0.5 0.5"/></geometry></visual></link>
+  <joint name="arm_joint" type="revolute"><parent link="arm_base"/><child link="arm_tip"/>
+  <origin xyz="0.5 0.25 0"/><axis xyz="0 0 1"/>
+  <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>)";
+
+// Without TF, the root link goes where the pose puts it and the others where the joints' origins
+// put them at zero joint values: the root at (2.25, -0.5) turned 90 degrees, so arm_tip is at
+// (2.25 - 0.25, -0.5 + 0.5) = (2, 0), turned 90 degrees (the same cube).
+TEST(NodeEdit, SpawnPlacesChildLinksByTheirJointsAtZero) {
+  ASSERT_TRUE(ros::service::waitForService(service("spawn_model"), ros::Duration(30)));
+  laser_raycast::SpawnModel srv;
+  srv.request.name = "arm";
+  srv.request.urdf = kArm;
+  srv.request.pose = poseAt(2.25, -0.5);
+  srv.request.pose.orientation.z = std::sin(M_PI / 4);
+  srv.request.pose.orientation.w = std::cos(M_PI / 4);
+  ASSERT_TRUE(ros::service::call(service("spawn_model"), srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  const sensor_msgs::LaserScan scan = scans->after(ros::Time::now());
+  expectRanges(scan, true, 2.0, 0.0, "arm_tip at (2, 0)");
+  EXPECT_EQ(linkHit(scan.header.stamp, 2), "arm_tip");
+  EXPECT_TRUE(remove("arm").success);
+  expectRanges(scans->after(ros::Time::now()), false, 0, 0, "arm deleted");
 }
 
 TEST(NodeEdit, SpawnFromFileAndDeleteAModelOfModels) {
@@ -430,7 +513,7 @@ TEST(NodeEdit, HundredCyclesKeepRateAndMemory) {
     *s = 0;
     for (const auto& span : spans) {
       // Half-open: a scan stamped at a boundary counts once.
-      n += scans->stampedBetween(span.first, span.second - ros::Duration(1e-9));
+      n += scans->stampedBetween(span.first, span.second - ros::Duration(1e-9)).size();
       *s += (span.second - span.first).toSec();
     }
     return n;
@@ -457,6 +540,13 @@ TEST(NodeEdit, HundredCyclesKeepRateAndMemory) {
   EXPECT_GE(busy_rate, 0.8 * quiet_rate)
       << busy_scans << " scans in " << busy_seconds << " s of cycles, " << quiet_scans << " in "
       << quiet_seconds << " s between them";
+  // Each scan during the cycles is of one scene, with the cube or without, never a mix.
+  for (const auto& span : busy) {
+    for (const auto& scan : scans->stampedBetween(span.first, span.second)) {
+      EXPECT_TRUE(matches(scan, true, 2.0, 0.0) || matches(scan, false, 0, 0))
+          << "scan stamped " << scan.header.stamp << " is of neither scene";
+    }
+  }
   // Memory: no growth beyond 2 MB (see cycleModel).
 #ifndef __SANITIZE_THREAD__  // ThreadSanitizer's own memory grows with the threads' history
   EXPECT_LT(rss_after - rss_before, 2048)
@@ -509,7 +599,7 @@ TEST(NodeEdit, ASlowSpawnDoesNotStallTheScans) {
   const double seconds = (end - start).toSec();
   // The scans stamped during the call, received once it returned.
   const sensor_msgs::LaserScan last = scans->after(end);
-  const std::size_t during = scans->stampedBetween(start, end);
+  const std::size_t during = scans->stampedBetween(start, end).size();
   testing::Test::RecordProperty("slow_spawn_seconds", std::to_string(seconds));
   testing::Test::RecordProperty("scans_during_spawn", static_cast<int>(during));
   if (seconds >= 0.5) {  // long enough to tell (it is about 1 s)
