@@ -7,13 +7,12 @@ aside with ~set_model_pose, lists and deletes it, and checks the scan is again t
 spawn, bit for bit.
 """
 import math
-import threading
 import unittest
 
 import rospy
 import rostest
 from geometry_msgs.msg import Pose
-from sensor_msgs.msg import LaserScan
+from scan_buffer import ScanBuffer
 
 from laser_raycast.srv import DeleteModel, ListModels, SetModelPose, SpawnModel
 
@@ -32,9 +31,7 @@ def pose_at(x, y):
 
 class EditClient(unittest.TestCase):
     def setUp(self):
-        self.lock = threading.Lock()
-        self.scans = []
-        self.sub = rospy.Subscriber('scan', LaserScan, self.on_scan, queue_size=50)
+        self.buffer = ScanBuffer('scan')
         for name in ('spawn_model', 'delete_model', 'set_model_pose', 'list_models'):
             rospy.wait_for_service(NODE + name, timeout=30)
         self.spawn = rospy.ServiceProxy(NODE + 'spawn_model', SpawnModel)
@@ -42,21 +39,12 @@ class EditClient(unittest.TestCase):
         self.move = rospy.ServiceProxy(NODE + 'set_model_pose', SetModelPose)
         self.list = rospy.ServiceProxy(NODE + 'list_models', ListModels)
 
-    def on_scan(self, scan):
-        with self.lock:
-            self.scans.append(scan)
-            del self.scans[:-50]
-
     def scan_after(self, stamp):
         """The first scan stamped after stamp."""
-        deadline = rospy.get_rostime() + rospy.Duration(20)
-        while not rospy.is_shutdown() and rospy.get_rostime() < deadline:
-            with self.lock:
-                for scan in self.scans:
-                    if scan.header.stamp > stamp:
-                        return scan
-            rospy.sleep(0.005)
-        self.fail('no scan stamped after %s' % stamp)
+        scan = self.buffer.after(stamp)
+        if scan is None:
+            self.fail('no scan stamped after %s' % stamp)
+        return scan
 
     def test_spawn_move_delete(self):
         before = self.scan_after(rospy.get_rostime())
