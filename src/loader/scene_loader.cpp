@@ -397,7 +397,10 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
     const auto key =
         std::make_pair(canonical.string(), std::array<double, 3>{scale.x(), scale.y(), scale.z()});
     const auto cached = cache_.find(key);
-    if (cached != cache_.end()) return cached->second;
+    if (cached != cache_.end()) {
+      if (std::shared_ptr<const core::Mesh> mesh = cached->second.lock()) return mesh;
+      cache_.erase(cached);  // every holder let it go: read the file anew
+    }
 
     if (!std::ifstream(path, std::ios::binary).good()) {
       throw SceneLoadError("file cannot be opened for reading");
@@ -426,6 +429,7 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
     last_bvh_seconds_ = secondsSince(start);
     last_mesh_bytes_ = input_bytes + std::max<std::size_t>(heapBytes(), heap_before) - heap_before;
     cache_.emplace(key, mesh);
+    ++meshes_built_;
     return mesh;
   } catch (const SceneLoadError& e) {
     rethrowWithContext(e, where);

@@ -93,6 +93,23 @@ TEST_F(SceneLoaderTest, EveryFormatGivesTheCuboid) {
   EXPECT_EQ(loader_.meshesLoaded(), files.size());
 }
 
+// A mesh is shared while something holds it; once every holder has let it go (a deleted model of
+// a node that edits its scene) it is freed, and the next load reads the file anew.
+TEST_F(SceneLoaderTest, AMeshNoLongerHeldIsFreedAndReadAgain) {
+  const std::string abs = kMeshes + "/cuboid.obj";
+  std::shared_ptr<const laser_raycast::core::Mesh> held =
+      loader_.loadMesh(abs, "", Vector3d::Ones(), {});
+  std::weak_ptr<const laser_raycast::core::Mesh> watch = held;
+  EXPECT_EQ(loader_.loadMesh(abs, "", Vector3d::Ones(), {}), held);
+  EXPECT_EQ(loader_.meshesLoaded(), 1u);
+  held.reset();
+  EXPECT_TRUE(watch.expired());  // the loader does not keep it alive
+  const auto again = loader_.loadMesh(abs, "", Vector3d::Ones(), {});
+  ASSERT_NE(again, nullptr);
+  EXPECT_EQ(loader_.meshesLoaded(), 2u);
+  expectBounds(*again, Vector3d::Zero(), kCuboidHi, 0.0);
+}
+
 TEST_F(SceneLoaderTest, EveryUriFormReachesTheSameFile) {
   const std::string abs = kMeshes + "/cuboid.obj";
   const LoadedModel model =

@@ -147,8 +147,9 @@ class SceneLoader {
                                              const core::BvhConfig& bvh,
                                              const MeshImportBounds& bounds = {});
 
-  // Files read and BVHs built so far (each (file, scale) once).
-  std::size_t meshesLoaded() const { return cache_.size(); }
+  // Files read and BVHs built so far: each (file, scale) once while a mesh of it is held (by a
+  // scene, or by the caller), again once every holder has let it go.
+  std::size_t meshesLoaded() const { return meshes_built_; }
 
  private:
   // Both public add functions end here; source names the URDF in messages.
@@ -157,7 +158,10 @@ class SceneLoader {
 
   PackageResolver resolver_;
   std::unique_ptr<import_process::MeshImporter> importer_;  // started at the first mesh file
-  std::map<std::pair<std::string, std::array<double, 3>>, std::shared_ptr<const core::Mesh>> cache_;
+  // The meshes built, by (file, scale), as long as something else holds them: a node that spawns
+  // and deletes models of many files keeps only the meshes of the models it has.
+  std::map<std::pair<std::string, std::array<double, 3>>, std::weak_ptr<const core::Mesh>> cache_;
+  std::size_t meshes_built_ = 0;
   double last_bvh_seconds_ = 0;
   std::size_t last_mesh_bytes_ = 0;  // of the last mesh built, 0 if it came from the cache
 };
