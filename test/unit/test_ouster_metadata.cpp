@@ -208,6 +208,9 @@ TEST(OusterMetadata, BadFilesAreRefused) {
                        ", \"data_format\": {\"column_window\": [0, 1024]}}"),
                "column_window [0, 1024] is not within [0, 1023]");
   EXPECT_PRED2(contains,
+               message("{" + beams + kAzimuths + mode + ", \"data_format\": {\"fps\": 0}}"),
+               "fps 0 is not > 0");
+  EXPECT_PRED2(contains,
                message("{" + beams + kAzimuths + mode +
                        ", \"lidar_to_sensor_transform\": [2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, "
                        "0, 0, 1]}"),

@@ -32,8 +32,9 @@ struct OusterHead {
   int rows() const { return static_cast<int>(altitudes_deg.size()); }
   // Throws std::invalid_argument naming the problem: no rows, angle lists of different sizes, more
   // than 256 rows, an angle that is not finite, an altitude outside [-90, 90] deg, columns not in
-  // [1, 65536], a column window outside [0, W), a non-finite beam origin, a lidar_to_sensor that
-  // is not a rigid motion (rotation orthonormal within 1e-6, determinant 1, last row 0 0 0 1).
+  // [1, 65536], a column window outside [0, W), fps not > 0, a non-finite beam origin, a
+  // lidar_to_sensor that is not a rigid motion (rotation orthonormal within 1e-6, determinant 1,
+  // last row 0 0 0 1).
   void validate() const;
 
   // One frame taking scan_time s: the window's columns in turn, column c at

@@ -40,6 +40,11 @@ void OusterHead::validate() const {
     bad("column_window [" + std::to_string(first_column) + ", " + std::to_string(last_column) +
         "] is not within [0, " + std::to_string(columns - 1) + "]");
   }
+  if (!(std::isfinite(fps) && fps > 0)) {
+    std::ostringstream msg;
+    msg << "fps " << fps << " is not > 0";
+    bad(msg.str());
+  }
   if (!std::isfinite(beam_origin_x_mm) || !std::isfinite(beam_origin_z_mm)) {
     bad("the beam origin (lidar_origin_to_beam_origin_mm) is not finite");
   }
