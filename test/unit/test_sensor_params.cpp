@@ -196,6 +196,8 @@ TEST(SensorParams, OusterMetadata) {
               {"pattern_file", LASER_RAYCAST_SOURCE_DIR "/config/patterns/rosette_4line.csv"},
               {"point_rate", 1000}}),
       {"~ouster_metadata", "~pattern_file: give one"});
+  expectRefused(values({{"ouster_metadata", file}, {"beam_samples", 4}}),
+                {"~beam_samples", "~ouster_metadata is set"});
   expectRefused(values({{"ouster_metadata", "/nonexistent/os.json"}}),
                 {"~ouster_metadata", "/nonexistent/os.json"});
 }
