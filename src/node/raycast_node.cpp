@@ -98,7 +98,7 @@ bool RaycastNode::init() {
         s.pattern
             ? std::to_string(s.points_per_scan) + " points a scan from '" + s.pattern_file + "'"
         : s.calibrated ? std::to_string(s.calibrated->size()) + " beams a turn from '" +
-                             s.calibration_file + "'"
+                             s.calibratedFrom() + "'"
                        : std::to_string(s.scan.pattern().size()) + " beams (" +
                              std::to_string(s.scan.elevations.size()) + " rings)";
     ROS_INFO(

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "laser_raycast/core/sensor_model.h"
+#include "laser_raycast/loader/ouster_metadata.h"
 #include "laser_raycast/loader/velodyne_calibration.h"
 
 namespace laser_raycast {
@@ -180,6 +181,33 @@ void readCalibration(ParamReader* r, SensorParams* s) {
   }
 }
 
+// ~ouster_metadata: an Ouster head's beams instead of the fan. Its columns' times follow the
+// sensor's scan_time, not the metadata's lidar_mode (a warning says when they differ).
+void readOusterMetadata(ParamReader* r, SensorParams* s, std::vector<std::string>* warnings) {
+  s->ouster_metadata = r->text("ouster_metadata", s->ouster_metadata);
+  if (s->ouster_metadata.empty()) return;
+  const char* other = !s->pattern_file.empty()       ? "pattern_file"
+                      : !s->calibration_file.empty() ? "calibration_file"
+                                                     : nullptr;
+  if (other) {
+    r->fail("ouster_metadata", "is set and so is " + r->prefix() + other + ": give one");
+    return;
+  }
+  try {
+    const core::OusterHead head = loadOusterMetadata(s->ouster_metadata);
+    s->calibrated = std::make_shared<const core::BeamList>(head.scan(s->scanTime()));
+    if (std::abs(head.fps * s->scanTime() - 1) > 1e-6) {
+      warnings->push_back(r->prefix() + "ouster_metadata: the file's lidar mode turns at " +
+                          formatNumber(head.fps) + " Hz, the sensor once in " +
+                          formatNumber(s->scanTime()) + " s (" + r->prefix() +
+                          "scan_time or 1 / " + r->prefix() +
+                          "rate); its columns follow the sensor's");
+    }
+  } catch (const std::invalid_argument& e) {
+    r->fail("ouster_metadata", e.what());
+  }
+}
+
 // ~pattern_file, ~points_per_scan, ~point_rate: beams from a scan pattern file instead of the fan.
 void readPatternFile(ParamReader* r, SensorParams* s) {
   s->pattern_file = r->text("pattern_file", s->pattern_file);
@@ -257,10 +285,13 @@ void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::st
   readPoseSource(r, s);
   readPatternFile(r, s);
   readCalibration(r, s);
+  readOusterMetadata(r, s, warnings);
   if (s->returns.beam_samples > 1 && (s->pattern || s->calibrated)) {
+    const char* file = s->pattern                      ? "pattern_file"
+                       : !s->calibration_file.empty() ? "calibration_file"
+                                                      : "ouster_metadata";
     r->fail("beam_samples", "is " + std::to_string(s->returns.beam_samples) + " but " +
-                                r->prefix() +
-                                (s->pattern ? "pattern_file" : "calibration_file") +
+                                r->prefix() + file +
                                 " is set: divergent beams are cast for a fan or rings only");
   }
   // The angles and beam count, elevations, ranges, noise and realism: checked once, by the core.

@@ -36,17 +36,19 @@ const char* const kSynopsis =
     "             [--threads N] [--list-scenes]\n";
 const char* const kNotes =
     "Times every method on the workloads fan2d and rings3d (one pose cast again and again)\n"
-    "and on beams off any grid from the same poses (pattern_rosette: a pattern file's rosette;\n"
-    "vlp16_calibrated: a calibrated VLP-16's beams), and the pipeline and Embree on sensors moving along a path (fan_path, fan_path_tilted,\n"
-    "rings_path, sweep_fan, sweep_rings), and measures each beam's error against a long\n"
-    "double reference and its agreement with Embree's robust mode. Writes DIR/results.csv,\n"
-    "results.md, pareto.png (one point per method) and pareto_matrix.png (every workload and\n"
-    "scene) (DIR defaults to bench_results). Scenes: sphere box_room tb3 million vertex_rows\n"
-    "forest warehouse forest_10m (default all, forest_10m not with --quick; tb3 needs\n"
-    "tb3_world_data: $LASER_RAYCAST_SHARED_DATA, the ROS package, or ../shared/data beside\n"
-    "the source). --method: only these rows (default all; --list-methods names them).\n"
-    "--quick: fewer poses, scans and repetitions (a few minutes). --threads N: a second\n"
-    "pipeline row cast with N threads (0: every core); every other row is single-threaded.\n"
+    "and on beams off any grid from the same poses (pattern_rosette: a pattern file's\n"
+    "rosette; vlp16_calibrated: a calibrated VLP-16's beams; os1_64_metadata: an Ouster\n"
+    "OS1-64's from its metadata file), and the pipeline and Embree on sensors moving along a\n"
+    "path (fan_path, fan_path_tilted, rings_path, sweep_fan, sweep_rings), and measures each\n"
+    "beam's error against a long double reference and its agreement with Embree's robust\n"
+    "mode. Writes DIR/results.csv, results.md, pareto.png (one point per method) and\n"
+    "pareto_matrix.png (every workload and scene) (DIR defaults to bench_results). Scenes:\n"
+    "sphere box_room tb3 million vertex_rows forest warehouse forest_10m (default all,\n"
+    "forest_10m not with --quick; tb3 needs tb3_world_data: $LASER_RAYCAST_SHARED_DATA, the\n"
+    "ROS package, or ../shared/data beside the source). --method: only these rows (default\n"
+    "all; --list-methods names them). --quick: fewer poses, scans and repetitions (a few\n"
+    "minutes). --threads N: a second pipeline row cast with N threads (0: every core); every\n"
+    "other row is single-threaded.\n"
     "Exit status: 0 ok, 1 the run failed, 2 bad arguments.\n";
 
 struct Options {

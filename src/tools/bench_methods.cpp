@@ -11,6 +11,7 @@
 #include "bench_paths.h"
 #include "laser_raycast/core/pattern_file.h"
 #include "laser_raycast/core/velodyne_beams.h"
+#include "laser_raycast/loader/ouster_metadata.h"
 
 namespace laser_raycast {
 namespace bench {
@@ -237,6 +238,11 @@ const std::vector<Workload>& workloads() {
     vlp16.pattern_file.clear();
     vlp16.calibrated_vlp16 = true;
     all.push_back(vlp16);
+    Workload ouster = vlp16;
+    ouster.name = "os1_64_metadata";
+    ouster.calibrated_vlp16 = false;
+    ouster.ouster_metadata = "os1_64_nominal.json";
+    all.push_back(ouster);
     return all;
   }();
   return list;
@@ -252,14 +258,16 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
     const core::PatternFile file = core::PatternFile::load(
         std::string(LASER_RAYCAST_SOURCE_DIR "/config/patterns/") + workload.pattern_file);
     w.beams = file.scan(0, file.size(), 1.0);
-    w.beams.times.clear();
-    w.beams.lines.clear();
   }
-  if (workload.calibrated_vlp16) {
-    w.beams = core::nominalVlp16().scan(0.1);
-    w.beams.times.clear();
-    w.beams.lines.clear();
+  if (workload.calibrated_vlp16) w.beams = core::nominalVlp16().scan(0.1);
+  if (!workload.ouster_metadata.empty()) {
+    w.beams = loadOusterMetadata(std::string(LASER_RAYCAST_SOURCE_DIR "/config/ouster/") +
+                                 workload.ouster_metadata)
+                  .scan(0.1);
   }
+  // Still workloads: every beam from the pose's one time.
+  w.beams.times.clear();
+  w.beams.lines.clear();
   if (workload.motion == Motion::kPath) {
     w.poses = pathPoses(scene, soup_bvh, workload, count);
   } else if (workload.motion == Motion::kSweep) {
@@ -274,7 +282,7 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
     for (int b = 0; b < w.beamCount(); ++b) {
       const Eigen::Isometry3d& sensor = w.sensors[w.poseIndex(scan, b)];
       core::Ray ray;
-      ray.origin = sensor.translation();
+      ray.origin = sensor * w.origin(b);
       ray.dir = sensor.linear() * directions[b];
       ray.tmin = 0;
       ray.tmax = tmax;

@@ -39,6 +39,10 @@ struct Workload {
   // Beams off any grid: a VLP-16 with its published per-laser elevations, each laser at its own
   // azimuth and firing time (core::nominalVlp16(), one 0.1 s turn), by Caster::castBeams.
   bool calibrated_vlp16 = false;
+  // Beams off any grid: an Ouster head's (this metadata file in config/ouster/, one 0.1 s turn of
+  // its columns, each row at its own azimuth offset and from its beam origin), by
+  // Caster::castBeams; "" for none.
+  std::string ouster_metadata;
 };
 
 // Still, from the scene's sensor poses: fan2d, 1081 beams over 270 degrees; rings3d, 64 rings
@@ -48,7 +52,8 @@ struct Workload {
 // +15 degrees x 1800 azimuths) at 10 Hz; sweep_fan, a rotating 360-beam fan at 5 Hz (an LDS-01);
 // sweep_rings, a rotating VLP-16 at 10 Hz. Still, beams off any grid: pattern_rosette, the
 // 10000 points of config/patterns/rosette_4line.csv (a Livox-like rosette) from the scene's poses;
-// vlp16_calibrated, a VLP-16's 1808 x 16 beams as a calibrated head fires them.
+// vlp16_calibrated, a VLP-16's 1808 x 16 beams as a calibrated head fires them; os1_64_metadata,
+// the 1024 x 64 beams of config/ouster/os1_64_nominal.json.
 const std::vector<Workload>& workloads();
 
 // Every beam of a workload from each sensor pose, pose-major, as the triangle methods and peers get
@@ -73,6 +78,10 @@ struct WorkloadRays {
   int beamCount() const { return offGrid() ? beams.size() : pattern->size(); }
   const std::vector<Eigen::Vector3d>& directions() const {
     return offGrid() ? beams.directions : pattern->directions();
+  }
+  // Where beam b leaves from, sensor frame (an Ouster head's beam origins; the grid's: 0).
+  Eigen::Vector3d origin(int b) const {
+    return offGrid() ? beams.origin(b) : Eigen::Vector3d::Zero();
   }
   bool planar() const { return !offGrid() && pattern->planar(); }
   std::size_t scans() const { return sweeps.empty() ? sensors.size() : sweeps.size(); }

@@ -66,7 +66,8 @@ std::vector<RayL> pipelineInputRays(const WorkloadRays& w) {
     for (int b = 0; b < w.beamCount(); ++b) {
       const Eigen::Isometry3d& sensor = w.sensors[w.poseIndex(scan, b)];
       RayL ray;
-      ray.origin = sensor.translation().cast<Real>();
+      ray.origin = sensor.linear().cast<Real>() * w.origin(b).cast<Real>() +
+                   sensor.translation().cast<Real>();
       ray.dir = sensor.linear().cast<Real>() * directions[b].cast<Real>();
       ray.tmin = 0;
       ray.tmax = w.tmax;

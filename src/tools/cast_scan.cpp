@@ -25,6 +25,7 @@
 #include "laser_raycast/core/surface_reflectance.h"
 #include "laser_raycast/loader/kinematics.h"
 #include "laser_raycast/loader/map_file.h"
+#include "laser_raycast/loader/ouster_metadata.h"
 #include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 #include "laser_raycast/loader/velodyne_calibration.h"
@@ -70,7 +71,9 @@ struct Args {
   double point_rate = 0;    // Hz, > 0 with --pattern-file
   // --calibration: a Velodyne head's beams, one turn (the same every scan).
   std::string calibration_path;
-  std::optional<core::BeamList> calibrated;
+  // --ouster-metadata: an Ouster head's beams, one turn (the same every scan).
+  std::string ouster_path;
+  std::optional<core::BeamList> calibrated;  // --calibration's or --ouster-metadata's
   // Beams off any grid: a pattern file's or a calibrated head's.
   bool offGrid() const { return pattern_file || calibrated; }
   // The radiometry (scan.output's intensity and detection range): each link's reflectivity by its
@@ -165,7 +168,7 @@ po::typed_value<std::string>* count(const char* flag, int* out) {
   return single("N", [flag, out](const std::string& v) { *out = parseCount(flag, v); });
 }
 
-// Beams off any grid: a pattern file's or a Velodyne calibration's.
+// Beams off any grid: a pattern file's, a Velodyne calibration's or an Ouster metadata file's.
 void addBeamFileFlags(po::options_description_easy_init& add, Args* args) {
   add("pattern-file", single("FILE", [args](const std::string& v) { args->pattern_path = v; }),
       "a scan pattern CSV 'Time/s,Azimuth/deg,Zenith/deg[,Line]' read as a loop: each scan takes "
@@ -173,6 +176,10 @@ void addBeamFileFlags(po::options_description_easy_init& add, Args* args) {
   add("calibration", single("FILE", [args](const std::string& v) { args->calibration_path = v; }),
       "a Velodyne calibration YAML (velodyne_pointcloud's): each laser's beam, origin and firing "
       "time over one turn (--scan-time with --sweep rotating, else 0.1 s) instead of a fan");
+  add("ouster-metadata", single("FILE", [args](const std::string& v) { args->ouster_path = v; }),
+      "an Ouster sensor metadata JSON (legacy or nested): each row's beam and origin, each column "
+      "at its time over one turn (--scan-time with --sweep rotating, else the file's lidar mode's) "
+      "instead of a fan");
   add("points-per-scan", count("--points-per-scan", &args->points_per_scan),
       "rows of --pattern-file a scan takes (default: all of them)");
   add("point-rate", number("--point-rate", "HZ", &args->point_rate),
@@ -327,28 +334,45 @@ std::string underItsFlag(const std::string& message, const std::string& beams_fr
 // The turn of a calibrated head cast at once (no --scan-time): 10 Hz, the models' default.
 constexpr double kCalibratedScanTime = 0.1;  // s
 
-// --pattern-file and its flags, or --calibration; loads the file. Throws ArgError.
+// --pattern-file and its flags, or --calibration, or --ouster-metadata; loads the file. Throws
+// ArgError.
 void checkPatternFlags(const po::variables_map& values, Args* args) {
-  if ((!args->calibration_path.empty() || !args->pattern_path.empty()) &&
-      args->returns.beam_samples > 1) {
-    throw ArgError(
-        "--beam-samples > 1: not with --pattern-file or --calibration (divergent beams "
-        "are cast for a fan or rings)");
+  const std::vector<std::pair<const char*, const std::string*>> files = {
+      {"--pattern-file", &args->pattern_path},
+      {"--calibration", &args->calibration_path},
+      {"--ouster-metadata", &args->ouster_path}};
+  const char* given = nullptr;
+  for (const auto& [flag, path] : files) {
+    if (path->empty()) continue;
+    if (given) throw ArgError(std::string("give ") + given + " or " + flag + ", not both");
+    given = flag;
   }
-  if (!args->calibration_path.empty()) {
-    if (!args->pattern_path.empty())
-      throw ArgError("give --calibration or --pattern-file, not both");
+  if (given && args->returns.beam_samples > 1) {
+    throw ArgError(std::string("--beam-samples > 1: not with ") + given +
+                   " (divergent beams are cast for a fan or rings)");
+  }
+  if (given) {
     for (const char* flag :
          {"elevations", "samples", "angle-increment", "angle-min", "angle-max"}) {
-      if (values.count(flag)) throw ArgError(std::string("--") + flag + ": not with --calibration");
+      if (values.count(flag)) throw ArgError(std::string("--") + flag + ": not with " + given);
     }
+  }
+  const bool rotating = args->path.sweep == laser_raycast::tools::Sweep::kRotating;
+  if (!args->calibration_path.empty()) {
     try {
       const core::VelodyneHead head =
           laser_raycast::loadVelodyneCalibration(args->calibration_path);
-      const bool rotating = args->path.sweep == laser_raycast::tools::Sweep::kRotating;
       args->calibrated = head.scan(rotating ? args->path.scan_time : kCalibratedScanTime);
     } catch (const std::invalid_argument& e) {
       throw ArgError(std::string("--calibration: ") + e.what());
+    }
+  }
+  if (!args->ouster_path.empty()) {
+    try {
+      const core::OusterHead head = laser_raycast::loadOusterMetadata(args->ouster_path);
+      args->calibrated = head.scan(rotating ? args->path.scan_time : 1 / head.fps);
+    } catch (const std::invalid_argument& e) {
+      throw ArgError(std::string("--ouster-metadata: ") + e.what());
     }
   }
   if (args->pattern_path.empty()) {
@@ -357,9 +381,6 @@ void checkPatternFlags(const po::variables_map& values, Args* args) {
         throw ArgError(std::string("--") + flag + ": only with --pattern-file");
     }
     return;
-  }
-  for (const char* flag : {"elevations", "samples", "angle-increment", "angle-min", "angle-max"}) {
-    if (values.count(flag)) throw ArgError(std::string("--") + flag + ": not with --pattern-file");
   }
   if (!(args->point_rate > 0)) throw ArgError("--pattern-file: give --point-rate HZ (> 0)");
   try {
@@ -451,7 +472,7 @@ std::string synopsis() {
       << indent << "[--method " << choices(core::kTriangleMethodNames) << "]\n"
       << indent << "[--elevations RAD,RAD,...] [--joint NAME=VALUE ...] [--repeat N]\n"
       << indent << "[--pattern-file FILE --point-rate HZ [--points-per-scan N]]\n"
-      << indent << "[--calibration FILE]\n"
+      << indent << "[--calibration FILE | --ouster-metadata FILE]\n"
       << indent << "[--beam-divergence RAD --beam-samples N [--min-return-separation M]\n"
       << indent << " [--return-mode " << choices(core::kReturnModeNames) << "]]\n"
       << indent << "[--intensity] [--detection-range R@REFLECTIVITY]\n"
@@ -470,9 +491,10 @@ std::string notes() {
       << "'index,ring,elevation,angle,range,link' (ring 0 the lowest). With --poses, a scan\n"
       << "from each pose of FILE in turn, its rows led by 'pose' (0: the file's first pose line).\n"
       << "With --sweep rotating, each row ends with 'time', s after the scan's first beam.\n"
-      << "With --pattern-file or --calibration, 'index,line,azimuth,elevation,time,range,link'\n"
-      << "(rad; time k / HZ s, or the laser's firing time; with --sweep rotating each beam is\n"
-      << "cast from the pose at its time; line: the file's Line, or the laser's ring).\n"
+      << "With --pattern-file, --calibration or --ouster-metadata,\n"
+      << "'index,line,azimuth,elevation,time,range,link' (rad; time k / HZ s, or the laser's\n"
+      << "firing time, or the column's; with --sweep rotating each beam is cast from the pose at\n"
+      << "its time; line: the file's Line, the laser's ring, or the Ouster row).\n"
       << "With --return-mode dual, a second row for a beam's last return and a 'return'\n"
       << "column; with --intensity, an 'intensity' column last. A return that --detection-range\n"
       << "loses prints range inf and no link.\n"

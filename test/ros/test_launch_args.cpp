@@ -124,6 +124,12 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
   ASSERT_EQ(calibrated.error, "");
   EXPECT_EQ(calibrated.params.sensors.at(0).calibration_file,
             ros::package::getPath("laser_raycast") + "/test/data/vlp16_calibration.yaml");
+  const Parsed ouster = parseFromMaster("/ouster/laser_raycast");
+  ASSERT_EQ(ouster.error, "");
+  EXPECT_EQ(ouster.params.sensors.at(0).ouster_metadata,
+            ros::package::getPath("laser_raycast") + "/config/ouster/os1_64_nominal.json");
+  ASSERT_TRUE(ouster.params.sensors.at(0).calibrated);
+  EXPECT_EQ(ouster.params.sensors.at(0).calibrated->size(), 64 * 1024);
 
   const Parsed samples = parseFromMaster("/samples/laser_raycast");
   ASSERT_EQ(samples.error, "");
@@ -136,7 +142,7 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
 
   // Between them, they set every parameter the node reads.
   std::set<std::string> set = keys(all.values);
-  for (const Parsed* other : {&samples, &pattern, &calibrated}) {
+  for (const Parsed* other : {&samples, &pattern, &calibrated, &ouster}) {
     for (const std::string& name : keys(other->values)) set.insert(name);
   }
   for (const std::string& name : laser_raycast::nodeParamNames()) {

@@ -2,7 +2,9 @@
 // rosette, read here by core::PatternFile) publishes, scan after scan, the file's next 1000 rows:
 // point k of a scan along row (first + k)'s direction (azimuth and zenith worked out here) on the
 // room's faces, its line the row's, its timestamp the stamp plus k / 100 kHz, in
-// livox_ros_driver2's fields; the next scan starts where the previous one ended.
+// livox_ros_driver2's fields; the next scan starts where the previous one ended. A calibrated
+// VLP-16 and an Ouster OS1-64 from its metadata JSON: every (sampled) point where the driver's
+// formulas put that beam, with its ring and time.
 #include <gtest/gtest.h>
 #include <ros/package.h>
 #include <ros/ros.h>
@@ -18,6 +20,7 @@
 #include "driver_layouts.h"
 #include "first_message.h"
 #include "laser_raycast/core/pattern_file.h"
+#include "laser_raycast/loader/ouster_metadata.h"
 #include "laser_raycast/loader/velodyne_calibration.h"
 #include "sensors_rig.h"
 #include "sensors_room.h"
@@ -125,6 +128,41 @@ TEST(NodePattern, CalibratedVelodyne) {
     // ~intensity: the default reflectivity 1 times the cosine of the incidence on the face hit,
     // the beam's own direction against the face's normal.
     EXPECT_NEAR(fieldValue<float>(*cloud, b, "intensity"), std::abs(d[roomFaceAxis(o, d)]), 1e-5)
+        << "point " << b;
+  }
+}
+
+// The OS1-64 of config/ouster/os1_64_nominal.json: 1024 columns of 64 rows, beam b row b % 64 of
+// column b / 64, taken at column * 0.1 s / 1024; its direction and origin worked out here from the
+// file's angles with Ouster's formulas (encoder angle 2 pi (1 - c / 1024) less the row's azimuth
+// offset, the beam origin 12.163 mm out along the encoder angle, then the file's half turn about z
+// and 36.18 mm up into os_sensor), its point on the room's faces, its ring the row.
+TEST(NodePattern, OusterMetadata) {
+  const core::OusterHead head = laser_raycast::loadOusterMetadata(
+      ros::package::getPath("laser_raycast") + "/config/ouster/os1_64_nominal.json");
+  ASSERT_EQ(head.rows(), 64);
+  tf2_ros::StaticTransformBroadcaster statics;
+  statics.sendTransform(transform(ros::Time::now(), "lidar", kSensor, 0));
+  const auto cloud = firstMessage<sensor_msgs::PointCloud2>("/ouster/points", 30.0);
+  ASSERT_TRUE(cloud);
+  expectDriverLayout(*cloud, laser_raycast::PointLayout::kOuster);
+  ASSERT_EQ(cloud->width * cloud->height, 1024u * 64u);
+  for (int b = 0; b < 1024 * 64; b += 37) {
+    const int c = b / 64, r = b % 64;
+    const double encoder = 2 * M_PI * (1 - c / 1024.0);
+    const double azimuth = encoder - head.azimuths_deg[r] * M_PI / 180;
+    const double altitude = head.altitudes_deg[r] * M_PI / 180;
+    // Lidar frame to os_sensor: (x, y, z) -> (-x, -y, z + 36.18 mm).
+    const Eigen::Vector3d d(-std::cos(azimuth) * std::cos(altitude),
+                            -std::sin(azimuth) * std::cos(altitude), std::sin(altitude));
+    const Eigen::Vector3d origin(-0.012163 * std::cos(encoder), -0.012163 * std::sin(encoder),
+                                 0.03618);
+    const Eigen::Vector3d expected = origin + roomDistance(kSensor + origin, d) * d;
+    const Eigen::Vector3d p(fieldValue<float>(*cloud, b, "x"), fieldValue<float>(*cloud, b, "y"),
+                            fieldValue<float>(*cloud, b, "z"));
+    EXPECT_LT((p - expected).norm(), kTolerance) << "point " << b;
+    EXPECT_EQ(fieldValue<std::uint16_t>(*cloud, b, "ring"), r) << "point " << b;
+    EXPECT_EQ(fieldValue<std::uint32_t>(*cloud, b, "t"), std::llround(c * 0.1 / 1024 * 1e9))
         << "point " << b;
   }
 }

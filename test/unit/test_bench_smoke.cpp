@@ -79,7 +79,7 @@ std::string tempDir(const std::string& name) {
 }
 
 // The beams of one scan of each workload: still (fan2d, rings3d, and beams off any grid:
-// pattern_rosette, vlp16_calibrated) and moving.
+// pattern_rosette, vlp16_calibrated, os1_64_metadata) and moving.
 const std::map<std::string, long> kWorkloadBeams = {{"fan2d", 1081},
                                                     {"rings3d", 64 * 1024},
                                                     {"fan_path", 1081},
@@ -88,12 +88,13 @@ const std::map<std::string, long> kWorkloadBeams = {{"fan2d", 1081},
                                                     {"sweep_fan", 360},
                                                     {"sweep_rings", 16 * 1800},
                                                     {"pattern_rosette", 10000},
-                                                    {"vlp16_calibrated", 16 * 1808}};
+                                                    {"vlp16_calibrated", 16 * 1808},
+                                                    {"os1_64_metadata", 64 * 1024}};
 
 // A workload cast from the scene's poses, every method on it.
 bool isStill(const std::string& workload) {
   return workload == "fan2d" || workload == "rings3d" || workload == "pattern_rosette" ||
-         workload == "vlp16_calibrated";
+         workload == "vlp16_calibrated" || workload == "os1_64_metadata";
 }
 
 bool isBruteForce(const std::string& method) {
@@ -277,8 +278,8 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  // header, 4 still workloads x 2 rows, 5 moving ones x the pipeline's row
-  ASSERT_EQ(lines.size(), 14u) << readFile(dir + "/results.csv");
+  // header, 5 still workloads x 2 rows, 5 moving ones x the pipeline's row
+  ASSERT_EQ(lines.size(), 16u) << readFile(dir + "/results.csv");
   std::multiset<std::string> rows;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const auto f = splitFields(lines[i]);
@@ -291,7 +292,8 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
                       "rings3d pipeline", "fan_path pipeline", "fan_path_tilted pipeline",
                       "rings_path pipeline", "sweep_fan pipeline", "sweep_rings pipeline",
                       "pattern_rosette watertight_bvh", "pattern_rosette pipeline",
-                      "vlp16_calibrated watertight_bvh", "vlp16_calibrated pipeline"}));
+                      "vlp16_calibrated watertight_bvh", "vlp16_calibrated pipeline",
+                      "os1_64_metadata watertight_bvh", "os1_64_metadata pipeline"}));
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
 }
@@ -307,8 +309,8 @@ TEST(BenchSmoke, NewPlaneRowHasThePipelinesRanges) {
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
   // header, fan2d x 2 rows, rings3d x 1 row, the pipeline's 5 moving rows, then one row each of
-  // pattern_rosette and vlp16_calibrated
-  ASSERT_EQ(lines.size(), 11u) << readFile(dir + "/results.csv");
+  // pattern_rosette, vlp16_calibrated and os1_64_metadata
+  ASSERT_EQ(lines.size(), 12u) << readFile(dir + "/results.csv");
   const auto kept = splitFields(lines[1]), fresh = splitFields(lines[2]);
   ASSERT_EQ(kept.size(), kFields);
   ASSERT_EQ(fresh.size(), kFields);
@@ -332,7 +334,7 @@ TEST(BenchSmoke, ThreadsAddsAPipelineRowWithTheSameRanges) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  ASSERT_EQ(lines.size(), 19u) << readFile(dir + "/results.csv");  // header, 9 workloads x 2
+  ASSERT_EQ(lines.size(), 21u) << readFile(dir + "/results.csv");  // header, 10 workloads x 2
   for (std::size_t i = 1; i + 1 < lines.size(); i += 2) {
     const auto one = splitFields(lines[i]), two = splitFields(lines[i + 1]);
     ASSERT_EQ(one.size(), kFields) << lines[i];

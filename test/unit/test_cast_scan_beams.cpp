@@ -1,6 +1,7 @@
 // cast_scan with beams off any grid: --pattern-file (each pose's scan the file's next rows, point k
 // at k / HZ s, on the closed room of test/data/sensors_room.urdf at distances worked out here) and
-// --calibration (a Velodyne calibration YAML: its turn's beams, rings and firing times).
+// --calibration (a Velodyne calibration YAML: its turn's beams, rings and firing times) and
+// --ouster-metadata (an Ouster metadata JSON: its rows' beams and origins, its columns' times).
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -90,6 +91,52 @@ TEST(CastScanBeams, CalibrationGivesTheHeadsBeams) {
   }
 }
 
+// An Ouster head of 4 rows and 512 columns whose lidar frame is turned a quarter turn about z and
+// raised 30 mm: row r of column c leaves from the beam origin (15.806 mm out along the encoder
+// angle 2 pi (1 - c / 512)) along the encoder angle less the row's azimuth offset, at the row's
+// altitude (Ouster's formulas, written out here), and meets the room where worked out here.
+const double kOusterAlt[4] = {20.5, 7.25, -3.0, -21.75};
+const double kOusterAz[4] = {4.0, 1.5, -1.25, -3.5};
+const std::string kOusterJson =
+    "{\"beam_altitude_angles\": [20.5, 7.25, -3.0, -21.75],"
+    " \"beam_azimuth_angles\": [4.0, 1.5, -1.25, -3.5],"
+    " \"lidar_origin_to_beam_origin_mm\": 15.806, \"lidar_mode\": \"512x20\","
+    " \"lidar_to_sensor_transform\": [0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 30, 0, 0, 0, 1]}";
+
+void expectOusterRows(const std::vector<std::vector<std::string>>& rows, double scan_time) {
+  const Eigen::Vector3d sensor(0, 0, 1);
+  for (std::size_t b = 0; b < rows.size(); b += 5) {
+    const int c = static_cast<int>(b) / 4, r = static_cast<int>(b) % 4;
+    const double encoder = 2 * M_PI * (1 - c / 512.0);
+    const double az = encoder - kOusterAz[r] * kDeg, alt = kOusterAlt[r] * kDeg;
+    // The quarter turn: lidar (x, y, z) is sensor (-y, x, z).
+    const Eigen::Vector3d d(-std::sin(az) * std::cos(alt), std::cos(az) * std::cos(alt),
+                            std::sin(alt));
+    const Eigen::Vector3d origin(-0.015806 * std::sin(encoder), 0.015806 * std::cos(encoder),
+                                 0.030);
+    EXPECT_EQ(std::stoi(rows[b][1]), r) << b;
+    EXPECT_NEAR(std::stod(rows[b][2]), std::atan2(d.y(), d.x()), 1e-8) << b;
+    EXPECT_NEAR(std::stod(rows[b][3]), std::asin(d.z()), 1e-8) << b;
+    EXPECT_NEAR(std::stod(rows[b][4]), c * scan_time / 512, 1e-10) << b;  // 9 digits
+    EXPECT_NEAR(std::stod(rows[b][5]), roomDistance(sensor + origin, d), 1e-7) << b;
+  }
+}
+
+TEST(CastScanBeams, OusterMetadataGivesTheHeadsBeams) {
+  const std::string metadata = writeFile("ouster.json", kOusterJson);
+  CliRun run = runCli(kRoom + " --sensor 0,0,1,0,0,0 --ouster-metadata " + metadata);
+  ASSERT_EQ(run.status, 0) << run.err;
+  auto rows = csvRows(run.out, "index,line,azimuth,elevation,time,range,link");
+  ASSERT_EQ(rows.size(), 512u * 4u);
+  expectOusterRows(rows, 1 / 20.0);  // the lidar mode's turn
+  run = runCli(kRoom + " --sensor 0,0,1,0,0,0 --sweep rotating --scan-time 0.08" +
+               " --ouster-metadata " + metadata);
+  ASSERT_EQ(run.status, 0) << run.err;
+  rows = csvRows(run.out, "index,line,azimuth,elevation,time,range,link");
+  ASSERT_EQ(rows.size(), 512u * 4u);
+  expectOusterRows(rows, 0.08);
+}
+
 TEST(CastScanBeams, BadArgumentsNameTheProblem) {
   const std::string pattern = writeFile("bad.csv", "Time/s,Azimuth/deg,Zenith/deg\n0,0,200\n");
   const std::string good = writeFile("good.csv", "Time/s,Azimuth/deg,Zenith/deg\n0,0,90\n");
@@ -107,6 +154,26 @@ TEST(CastScanBeams, BadArgumentsNameTheProblem) {
                " --pattern-file " + good + " --point-rate 10");
   EXPECT_EQ(run.status, 2);
   EXPECT_NE(run.err.find("not both"), std::string::npos) << run.err;
+  const std::string ouster = writeFile("ouster.json", kOusterJson);
+  run = runCli(kRoom + sensor + " --calibration " + kData + "vlp16_calibration.yaml" +
+               " --ouster-metadata " + ouster);
+  EXPECT_EQ(run.status, 2);
+  EXPECT_NE(run.err.find("give --calibration or --ouster-metadata, not both"), std::string::npos)
+      << run.err;
+  run = runCli(kRoom + sensor + " --ouster-metadata " + ouster + " --elevations 0.1,0.2");
+  EXPECT_EQ(run.status, 2);
+  EXPECT_NE(run.err.find("--elevations: not with --ouster-metadata"), std::string::npos) << run.err;
+  run = runCli(kRoom + sensor + " --ouster-metadata " + ouster + " --beam-samples 4");
+  EXPECT_EQ(run.status, 2);
+  EXPECT_NE(run.err.find("--beam-samples > 1: not with --ouster-metadata"), std::string::npos)
+      << run.err;
+  const std::string bad = writeFile("bad_ouster.json", "{\"beam_altitude_angles\": [1]}");
+  run = runCli(kRoom + sensor + " --ouster-metadata " + bad);
+  EXPECT_EQ(run.status, 2);
+  EXPECT_NE(run.err.find("--ouster-metadata: ouster metadata " + bad +
+                         ": beam_azimuth_angles is missing"),
+            std::string::npos)
+      << run.err;
   run = runCli(kRoom + sensor + " --points-per-scan 4");
   EXPECT_EQ(run.status, 2);
   EXPECT_NE(run.err.find("only with --pattern-file"), std::string::npos) << run.err;

@@ -107,6 +107,7 @@ const std::map<std::string, std::string>& publicHeaderLayers() {
       {"beam_list.h", "beams"},
       {"pattern_file.h", "beams"},
       {"velodyne_beams.h", "beams"},
+      {"ouster_beams.h", "beams"},
       {"cast_config.h", "beams"},
       {"scan_result.h", "beams"},
       {"caster.h", "caster"},

@@ -87,6 +87,7 @@ const std::vector<std::string> kReadmeParameters = {"frame_id",
                                                     "points_per_scan",
                                                     "point_rate",
                                                     "calibration_file",
+                                                    "ouster_metadata",
                                                     "sensors"};
 
 TEST(NodeParams, TheNodeReadsExactlyTheDocumentedParameters) {

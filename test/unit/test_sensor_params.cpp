@@ -1,7 +1,7 @@
 // The sensor parameters beyond a planar instantaneous scan, parsed as the node parses them (no
-// parameter server, no roscore): rings, sweeps, range realism, presets and the sensors list, each
-// value reaching its field and each bad one refused naming the parameter (or the entry) and the
-// value.
+// parameter server, no roscore): rings, sweeps, range realism, presets, Ouster metadata files and
+// the sensors list, each value reaching its field and each bad one refused naming the parameter
+// (or the entry) and the value.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -167,6 +167,39 @@ TEST(SensorParams, PointLayoutPerSensor) {
   const Parsed planar = parse(values({{"point_layout", "ouster"}}));
   ASSERT_EQ(planar.report.warnings.size(), 1u);
   expectMentions(planar.report.warnings[0], {"~point_layout", "planar"});
+}
+
+// ~ouster_metadata: the file's beams (a turn of scan_time), one of the three beam files, a warning
+// when the node's turn is not the lidar mode's, a bad file refused naming the parameter.
+TEST(SensorParams, OusterMetadata) {
+  const std::string file = LASER_RAYCAST_SOURCE_DIR "/config/ouster/os1_64_nominal.json";
+  const Parsed parsed = parse(values({{"ouster_metadata", file}, {"sweep", "rotating"}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_TRUE(parsed.report.warnings.empty()) << parsed.report.warnings.front();
+  const laser_raycast::SensorParams& s = parsed.params.sensors.at(0);
+  ASSERT_TRUE(s.calibrated);
+  EXPECT_EQ(s.calibrated->size(), 64 * 1024);
+  EXPECT_EQ(s.calibratedFrom(), file);
+  EXPECT_FALSE(s.planar());
+  EXPECT_NEAR(s.sweepDuration(), 0.1 * 1023 / 1024, 1e-15);  // the last column's time
+  const Parsed fast = parse(values({{"ouster_metadata", file}, {"rate", 20}}));
+  ASSERT_EQ(fast.error, "");
+  ASSERT_EQ(fast.report.warnings.size(), 1u);
+  expectMentions(fast.report.warnings[0], {"~ouster_metadata", "10 Hz", "0.05 s"});
+  EXPECT_NEAR(fast.params.sensors.at(0).calibrated->times.back(), 0.05 * 1023 / 1024, 1e-15);
+  expectRefused(
+      values({{"ouster_metadata", file},
+              {"calibration_file", LASER_RAYCAST_SOURCE_DIR "/test/data/vlp16_calibration.yaml"}}),
+      {"~ouster_metadata", "~calibration_file: give one"});
+  expectRefused(
+      values({{"ouster_metadata", file},
+              {"pattern_file", LASER_RAYCAST_SOURCE_DIR "/config/patterns/rosette_4line.csv"},
+              {"point_rate", 1000}}),
+      {"~ouster_metadata", "~pattern_file: give one"});
+  expectRefused(values({{"ouster_metadata", file}, {"beam_samples", 4}}),
+                {"~beam_samples", "~ouster_metadata is set"});
+  expectRefused(values({{"ouster_metadata", "/nonexistent/os.json"}}),
+                {"~ouster_metadata", "/nonexistent/os.json"});
 }
 
 TEST(SensorParams, SeveralSensors) {

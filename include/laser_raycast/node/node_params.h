@@ -105,7 +105,15 @@ struct SensorParams {
   // ~calibration_file: a Velodyne calibration YAML; its head's beams over one turn of scanTime(),
   // the same every scan (core::VelodyneHead::scan).
   std::string calibration_file;
+  // ~ouster_metadata: an Ouster sensor metadata JSON; its W columns over one turn of scanTime(),
+  // the same every scan (core::OusterHead::scan).
+  std::string ouster_metadata;
+  // The beams of calibration_file or ouster_metadata (one turn).
   std::shared_ptr<const core::BeamList> calibrated;
+  // The file calibrated was read from.
+  const std::string& calibratedFrom() const {
+    return calibration_file.empty() ? ouster_metadata : calibration_file;
+  }
   // Beams off any grid (a pattern file's or a calibrated head's): a PointCloud2 of one row.
   bool offGrid() const { return pattern || calibrated; }
 
