@@ -24,8 +24,7 @@ TEST(IntensityExample, TheCloudShowsTheWorldsSurfaces) {
   const double kLuminanceRed = 0.2126 * 0.8 + 0.7152 * 0.15 + 0.0722 * 0.1;
   int wall = 0, white = 0, pillar = 0, box = 0;
   for (std::size_t i = 0; i < std::size_t{cloud->width} * cloud->height; ++i) {
-    const Eigen::Vector3d p(fieldValue<float>(*cloud, i, "x"), fieldValue<float>(*cloud, i, "y"),
-                            fieldValue<float>(*cloud, i, "z"));
+    const Eigen::Vector3d p = pointAt(*cloud, i);
     if (!std::isfinite(p.x())) continue;
     const double intensity = fieldValue<float>(*cloud, i, "intensity");
     const Eigen::Vector3d d = p.normalized();

@@ -80,8 +80,7 @@ double expectOnTheRoom(const sensor_msgs::PointCloud2& cloud, std::size_t i, con
   const int ring = static_cast<int>(i) / kAzimuths, column = static_cast<int>(i) % kAzimuths;
   const double el = kElevations[ring], az = -M_PI + column * M_PI / 18;
   const Eigen::Vector3d dir(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-  const Eigen::Vector3d p(fieldValue<float>(cloud, i, "x"), fieldValue<float>(cloud, i, "y"),
-                          fieldValue<float>(cloud, i, "z"));
+  const Eigen::Vector3d p = pointAt(cloud, i);
   EXPECT_LT((p - roomDistance(kSensor, dir) * dir).norm(), kTolerance) << "point " << i;
   const int ring_value = uint8_ring ? fieldValue<std::uint8_t>(cloud, i, ring_field)
                                     : fieldValue<std::uint16_t>(cloud, i, ring_field);

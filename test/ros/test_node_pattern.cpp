@@ -43,8 +43,7 @@ Eigen::Vector3d rowDirection(const core::PatternFile::Row& row) {
 
 // The row a cloud starts at: the row whose direction its first point lies along.
 int firstRow(const sensor_msgs::PointCloud2& cloud, const core::PatternFile& file) {
-  const Eigen::Vector3d p(fieldValue<float>(cloud, 0, "x"), fieldValue<float>(cloud, 0, "y"),
-                          fieldValue<float>(cloud, 0, "z"));
+  const Eigen::Vector3d p = pointAt(cloud, 0);
   for (int r = 0; r < file.size(); r += kPointsPerScan) {
     const Eigen::Vector3d d = rowDirection(file.rows()[r]);
     if ((p - roomDistance(kSensor, d) * d).norm() < kTolerance) return r;
@@ -89,8 +88,7 @@ TEST(NodePattern, EachScanIsTheFilesNextRowsOnTheRoom) {
     for (int k = 0; k < kPointsPerScan; ++k) {
       const auto& row = file.rows()[(first + k) % file.size()];
       const Eigen::Vector3d d = rowDirection(row);
-      const Eigen::Vector3d p(fieldValue<float>(*cloud, k, "x"), fieldValue<float>(*cloud, k, "y"),
-                              fieldValue<float>(*cloud, k, "z"));
+      const Eigen::Vector3d p = pointAt(*cloud, k);
       EXPECT_LT((p - roomDistance(kSensor, d) * d).norm(), kTolerance) << "point " << k;
       EXPECT_EQ(fieldValue<std::uint8_t>(*cloud, k, "line"), row.line) << "point " << k;
       EXPECT_NEAR(fieldValue<double>(*cloud, k, "timestamp"), stamp_ns + k / kPointRate * 1e9, 512)
@@ -119,8 +117,7 @@ TEST(NodePattern, CalibratedVelodyne) {
     const int s = b / 16, i = b % 16;
     const Eigen::Vector3d o = kSensor + beams.origins[b], d = beams.directions[b];
     const Eigen::Vector3d expected = beams.origins[b] + roomDistance(o, d) * d;
-    const Eigen::Vector3d p(fieldValue<float>(*cloud, b, "x"), fieldValue<float>(*cloud, b, "y"),
-                            fieldValue<float>(*cloud, b, "z"));
+    const Eigen::Vector3d p = pointAt(*cloud, b);
     EXPECT_LT((p - expected).norm(), kTolerance) << "point " << b;
     EXPECT_EQ(fieldValue<std::uint16_t>(*cloud, b, "ring"), rings[i]) << "point " << b;
     EXPECT_NEAR(fieldValue<float>(*cloud, b, "time"), s * 55.296e-6 + i * 2.304e-6, 1e-7)
@@ -158,8 +155,7 @@ TEST(NodePattern, OusterMetadata) {
     const Eigen::Vector3d origin(-0.012163 * std::cos(encoder), -0.012163 * std::sin(encoder),
                                  0.03618);
     const Eigen::Vector3d expected = origin + roomDistance(kSensor + origin, d) * d;
-    const Eigen::Vector3d p(fieldValue<float>(*cloud, b, "x"), fieldValue<float>(*cloud, b, "y"),
-                            fieldValue<float>(*cloud, b, "z"));
+    const Eigen::Vector3d p = pointAt(*cloud, b);
     EXPECT_LT((p - expected).norm(), kTolerance) << "point " << b;
     EXPECT_EQ(fieldValue<std::uint16_t>(*cloud, b, "ring"), r) << "point " << b;
     EXPECT_EQ(fieldValue<std::uint32_t>(*cloud, b, "t"), std::llround(c * 0.1 / 1024 * 1e9))

@@ -38,8 +38,7 @@ TEST(NodeReturns, AStraddlingBeamIsTwoPoints) {
   // By (ring, azimuth column), the returns found, each its range.
   std::map<std::pair<int, int>, std::map<int, double>> found;
   for (std::size_t i = 0; i < 6; ++i) {
-    const Eigen::Vector3d p(fieldValue<float>(*cloud, i, "x"), fieldValue<float>(*cloud, i, "y"),
-                            fieldValue<float>(*cloud, i, "z"));
+    const Eigen::Vector3d p = pointAt(*cloud, i);
     const int ring = fieldValue<std::uint16_t>(*cloud, i, "ring");
     const int which = fieldValue<std::uint8_t>(*cloud, i, "return");
     const double azimuth = std::atan2(p.y(), p.x()), elevation = std::asin(p.z() / p.norm());

@@ -7,6 +7,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/PointField.h>
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -118,6 +119,12 @@ T fieldValue(const sensor_msgs::PointCloud2& cloud, std::size_t i, const std::st
   }
   ADD_FAILURE() << "no field " << name;
   return T{};
+}
+
+// Point i's x, y, z (float fields, as every layout has them).
+inline Eigen::Vector3d pointAt(const sensor_msgs::PointCloud2& cloud, std::size_t i) {
+  return Eigen::Vector3d(fieldValue<float>(cloud, i, "x"), fieldValue<float>(cloud, i, "y"),
+                         fieldValue<float>(cloud, i, "z"));
 }
 
 }  // namespace laser_raycast_test
