@@ -153,6 +153,67 @@ inline bool beamCrossesSegment(double dx, double dy, const Eigen::Vector2d& p,
   return !(front && dx * front->x() + dy * front->y() > 0);
 }
 
+// The beams of fan [first, last] that may cross the segment with ends p != q (x, y in the sensor
+// frame of a reference pose): test(lo, hi, near) for column ranges holding every such beam, near a
+// distance below which no point of the segment lies from any beam's origin. Each beam leaves from
+// within `shift` of the reference origin along its pattern direction turned in the plane by at most
+// `turn` (a rotating sweep's block, beams/column_motion.h; both 0 for a scan from one pose).
+//
+// A few beams are all tested directly; for more, only those the segment's bearings can reach: the
+// shorter arc between the endpoints' bearings, widened by one bearing error each side (each true
+// bearing lies within kBearingError of its approximation, so the arc from the lower approximation
+// minus the error to the higher plus the error holds the true arc, also when the approximation
+// flipped the sign of a tiny sweep). The shorter arc is the true one unless the sweep is within two
+// errors of half a turn (a segment passing beside the sensor): then every beam is tried. A beam
+// that meets the segment at x from an origin o at most `shift` from the reference's points at most
+// asin(shift / |x|) from x's bearing, and its column's pattern azimuth is at most `turn` from the
+// beam's: the arc is widened by both, unless the segment comes within twice the shift (then every
+// beam is tried).
+template <class Test>
+void forSegmentColumns(const ScanPattern& fan, const Eigen::Vector2d& p, const Eigen::Vector2d& q,
+                       int first, int last, double shift, double turn, Test&& test) {
+  // Below this many beams in the window, every one is tested without computing bearings.
+  constexpr int kDirectBeams = 8;
+  if (p == q) return;  // touches the plane at a vertex: no beam crosses it
+  // No point of the segment is nearer to the reference origin than this (the distance to its line
+  // where the foot of the perpendicular falls inside it, else to the nearer end), lowered for
+  // rounding; from a beam's origin, no nearer than that less the shift. A beam that has already
+  // hit something nearer needs no test.
+  const Eigen::Vector2d pq = q - p;
+  const double along = -p.dot(pq), length2 = pq.squaredNorm();
+  const double reference_near =
+      (along > 0 && along < length2 ? std::abs(p.x() * pq.y() - p.y() * pq.x()) / std::sqrt(length2)
+                                    : std::sqrt(std::min(p.squaredNorm(), q.squaredNorm()))) *
+          (1 - 16 * std::numeric_limits<double>::epsilon()) -
+      16 * std::numeric_limits<double>::epsilon() * (p.norm() + q.norm());
+  const double near = shift > 0 ? std::max(0.0, reference_near - shift * (1 + 1e-9))
+                                : reference_near;
+  auto clipped = [&](int lo, int hi) {
+    lo = std::max(lo, first);
+    hi = std::min(hi, last);
+    if (lo <= hi) test(lo, hi, near);
+  };
+  if (last - first < kDirectBeams || (shift > 0 && !(reference_near > 2 * shift))) {
+    clipped(first, last);
+    return;
+  }
+  const double bearing_p = approxAtan2(p.y(), p.x());
+  const double bearing_q = approxAtan2(q.y(), q.x());
+  double sweep = bearing_q - bearing_p;
+  if (sweep > M_PI) sweep -= 2 * M_PI;
+  if (sweep < -M_PI) sweep += 2 * M_PI;
+  double pad = kBearingError;
+  if (shift > 0 || turn > 0) {
+    pad += (turn + (shift > 0 ? std::asin(shift / reference_near) : 0.0)) * (1 + 1e-9) + 1e-15;
+  }
+  if (std::abs(sweep) > M_PI - 2 * pad) {
+    clipped(first, last);
+    return;
+  }
+  const double start = wrapToTurn((sweep >= 0 ? bearing_p : bearing_q) - pad - fan.angleMin());
+  forEachBeamRange(fan, start, std::abs(sweep) + 2 * pad, clipped);
+}
+
 // Tests the beams [first, last] of fan against a segment with ends p, q (sensor x, y): hit(beam, t)
 // for every beam that crosses it with t in [tmin, tmax]; open(beam, near) may say that a beam needs
 // no test (it has hit something nearer than `near`, the segment's nearest distance). With front
@@ -161,50 +222,14 @@ template <class Hit, class Open>
 void testSegmentInFan(const ScanPattern& fan, const Eigen::Vector2d& p, const Eigen::Vector2d& q,
                       double tmin, double tmax, const Eigen::Vector2d* front, int first, int last,
                       Hit&& hit, Open&& open) {
-  // Below this many beams in the window, every one is tested without computing bearings.
-  constexpr int kDirectBeams = 8;
-  if (p == q) return;  // touches the plane at a vertex: no beam crosses it
-  // No point of the segment is nearer to the sensor than this (the distance to its line where the
-  // foot of the perpendicular falls inside it, else to the nearer end), lowered for rounding: a
-  // beam that has already hit something nearer needs no test.
-  const Eigen::Vector2d pq = q - p;
-  const double along = -p.dot(pq), length2 = pq.squaredNorm();
-  const double near =
-      (along > 0 && along < length2 ? std::abs(p.x() * pq.y() - p.y() * pq.x()) / std::sqrt(length2)
-                                    : std::sqrt(std::min(p.squaredNorm(), q.squaredNorm()))) *
-          (1 - 16 * std::numeric_limits<double>::epsilon()) -
-      16 * std::numeric_limits<double>::epsilon() * (p.norm() + q.norm());
   const auto& dirs = fan.directions();
-  auto test = [&](int lo, int hi) {
-    for (int i = std::max(lo, first); i <= std::min(hi, last); ++i) {
+  forSegmentColumns(fan, p, q, first, last, 0.0, 0.0, [&](int lo, int hi, double near) {
+    for (int i = lo; i <= hi; ++i) {
       if (!open(i, near)) continue;
       double t;
       if (beamCrossesSegment(dirs[i].x(), dirs[i].y(), p, q, tmin, tmax, front, &t)) hit(i, t);
     }
-  };
-  // A few beams are tested directly; for more, only those the segment's bearings can reach.
-  if (last - first < kDirectBeams) {
-    test(first, last);
-    return;
-  }
-  // The shorter arc between the endpoints' bearings, widened by one bearing error each side. Each
-  // true bearing lies within kBearingError of its approximation, so the arc from the lower
-  // approximation minus the error to the higher plus the error holds the true arc, also when the
-  // approximation flipped the sign of a tiny sweep (the window spans both approximations either
-  // way). The shorter arc is the true one unless the sweep is within two errors of half a turn (a
-  // segment passing beside the sensor): then every beam is tried.
-  const double bearing_p = approxAtan2(p.y(), p.x());
-  const double bearing_q = approxAtan2(q.y(), q.x());
-  double sweep = bearing_q - bearing_p;
-  if (sweep > M_PI) sweep -= 2 * M_PI;
-  if (sweep < -M_PI) sweep += 2 * M_PI;
-  const double pad = kBearingError;
-  if (std::abs(sweep) > M_PI - 2 * pad) {
-    test(first, last);
-    return;
-  }
-  const double start = wrapToTurn((sweep >= 0 ? bearing_p : bearing_q) - pad - fan.angleMin());
-  forEachBeamRange(fan, start, std::abs(sweep) + 2 * pad, test);
+  });
 }
 
 template <class Hit, class Open>

@@ -166,41 +166,28 @@ class SliceWalk {
                      open);
   }
 
-  // testSegment for a sweep's block: the columns of the segment's window (widened by the block's
-  // spread), each beam tested against the segment mapped to its column's sensor x, y, as
-  // testSegmentInFan tests it (beamCrossesSegment); no point of the segment is nearer to any
-  // column's origin than the window's near distance.
+  // testSegment for a sweep's block: the columns forSegmentColumns finds for the block's spread,
+  // each beam tested against the segment mapped to its column's sensor x, y, as testSegmentInFan
+  // tests it (beamCrossesSegment).
   template <class Hit, class Open>
   void testSegmentByColumn(const KeptSlice::Item& s, int first, int last, Hit&& hit, Open&& open) {
-    constexpr int kDirectColumns = 8;  // fewer are tested without a window (speed only)
     const Eigen::Vector2d p = plane_.toSensor(s.p), q = plane_.toSensor(s.q);
     const auto& dirs = beams_.grid().pattern().directions();
-    auto testColumns = [&](int lo, int hi, double near) {
-      for (int col = lo; col <= hi; ++col) {
-        if (!open(col, near)) continue;
-        Eigen::Vector2d front;
-        if (config_.cull_backfaces) front = frontOf(s, col);
-        double t;
-        if (beamCrossesSegment(dirs[col].x(), dirs[col].y(), motion_->pointToColumn(col, p),
-                               motion_->pointToColumn(col, q), config_.tmin, config_.tmax,
-                               config_.cull_backfaces ? &front : nullptr, &t)) {
-          hit(col, t);
-        }
-      }
-    };
-    if (last - first < kDirectColumns) {
-      testColumns(first, last, 0.0);
-      return;
-    }
-    const Eigen::Vector3d center(0.5 * (p.x() + q.x()), 0.5 * (p.y() + q.y()), 0.0);
-    const Eigen::Vector3d half(0.5 * std::abs(p.x() - q.x()), 0.5 * std::abs(p.y() - q.y()), 0.0);
-    const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
-    const View view = boxView(center, half, identity, identity, Eigen::Vector3d::Zero(),
-                              beams_.grid().pattern().angleMin(), false, spread_);
-    if (!(view.near <= config_.tmax)) return;
-    beams_.grid().forEachRect(view, BeamRect{0, 0, first, last}, [&](const BeamRect& r) {
-      testColumns(r.col_lo, r.col_hi, view.near);
-    });
+    forSegmentColumns(
+        beams_.grid().pattern(), p, q, first, last, spread_.shift, spread_.turn,
+        [&](int lo, int hi, double near) {
+          for (int col = lo; col <= hi; ++col) {
+            if (!open(col, near)) continue;
+            Eigen::Vector2d front;
+            if (config_.cull_backfaces) front = frontOf(s, col);
+            double t;
+            if (beamCrossesSegment(dirs[col].x(), dirs[col].y(), motion_->pointToColumn(col, p),
+                                   motion_->pointToColumn(col, q), config_.tmin, config_.tmax,
+                                   config_.cull_backfaces ? &front : nullptr, &t)) {
+              hit(col, t);
+            }
+          }
+        });
   }
 
   // A point of the plane in the sensor's x, y (column col's sensor for a sweep).
