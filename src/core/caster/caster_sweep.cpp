@@ -66,8 +66,8 @@ class ColumnPoses {
     for (std::size_t k = 0; k < n; ++k) {
       sample_sensor_ok_[k] = isValidPose(samples.world_from_sensor[k]);
     }
-    sample_rotation_.set(samples.world_from_sensor);
     findBrackets(columns);
+    sample_rotation_.set(samples.world_from_sensor, arcs_used_);
     sensor_.resize(columns);
     sensor_valid_.resize(columns);
     for (int c = 0; c < columns; ++c) {
@@ -106,16 +106,23 @@ class ColumnPoses {
   // The samples' rotations as quaternions, and the slerp between two of them as Eigen's
   // QuaternionBase::slerp computes it, with the angle between each sample and the next and its
   // sine worked out once rather than at every column, and the sines of its fractions by smallSin.
+  // Only the samples some column is interpolated between (arc_used[k]: between k and k + 1) are
+  // converted: with a sample at every column's time (cast_scan's sweeps), none is.
   class Rotations {
    public:
-    void set(const std::vector<Eigen::Isometry3d>& poses) {
+    void set(const std::vector<Eigen::Isometry3d>& poses, const std::vector<char>& arc_used) {
       q_.resize(poses.size());
-      for (std::size_t k = 0; k < poses.size(); ++k) q_[k] = Eigen::Quaterniond(poses[k].linear());
       arc_.resize(poses.size());
-      for (std::size_t k = 0; k + 1 < poses.size(); ++k) arc_[k] = arcBetween(q_[k], q_[k + 1]);
+      for (std::size_t k = 0; k + 1 < poses.size(); ++k) {
+        if (!arc_used[k]) continue;
+        q_[k] = Eigen::Quaterniond(poses[k].linear());
+        q_[k + 1] = Eigen::Quaterniond(poses[k + 1].linear());
+        arc_[k] = arcBetween(q_[k], q_[k + 1]);
+      }
     }
+    // The bracket's samples must be consecutive, with their arc used.
     Eigen::Quaterniond slerp(const Bracket& b) const {
-      const Arc arc = b.j == b.i + 1 ? arc_[b.i] : arcBetween(q_[b.i], q_[b.j]);
+      const Arc& arc = arc_[b.i];
       const double t = b.s;
       double scale0, scale1;
       if (arc.linear) {
@@ -168,6 +175,7 @@ class ColumnPoses {
   void findBrackets(int columns) {
     const std::vector<double>& times = samples_.times;
     brackets_.resize(columns);
+    arcs_used_.assign(times.size(), 0);
     std::size_t k = 0;  // the last sample at or before t, once t reaches the first
     for (int c = 0; c < columns; ++c) {
       const double t = time(c);
@@ -179,6 +187,7 @@ class ColumnPoses {
         b = Bracket{k, k + 1, (t - times[k]) / (times[k + 1] - times[k])};
         if (b.s == 0) b.j = k;
       }
+      if (b.j != b.i) arcs_used_[b.i] = 1;
     }
   }
 
@@ -208,13 +217,15 @@ class ColumnPoses {
         frame.ok[k] = sample.valid[f] && isValidPose(sample.pose[f]);
         frame.pose[k] = sample.pose[f];
       }
-      frame.rotation.set(frame.pose);
+      frame.rotation.set(frame.pose, arcs_used_);
     }
   }
 
-  // interpolatePose(a, b, s) of the bracket's samples, from their rotations as quaternions.
+  // interpolatePose(a, b, s) of the bracket's samples, from their rotations as quaternions; a
+  // column exactly at a sample has its pose.
   static Eigen::Isometry3d interpolate(const std::vector<Eigen::Isometry3d>& pose,
                                        const Rotations& rotation, const Bracket& b) {
+    if (b.j == b.i) return pose[b.i];
     Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
     const Eigen::Vector3d& ta = pose[b.i].translation();
     out.translation() = ta + b.s * (pose[b.j].translation() - ta);
@@ -227,6 +238,7 @@ class ColumnPoses {
   std::vector<char> sample_sensor_ok_;
   Rotations sample_rotation_;
   std::vector<Bracket> brackets_;
+  std::vector<char> arcs_used_;  // by sample: some column lies strictly between it and the next
   std::vector<Eigen::Isometry3d> sensor_;
   std::vector<char> sensor_valid_;
   std::vector<int> frames_;

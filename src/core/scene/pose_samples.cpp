@@ -13,6 +13,7 @@ namespace core {
 
 Eigen::Isometry3d interpolatePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
                                   double s) {
+  if (s == 0) return a;  // at a sample: its pose, as given
   Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
   // Interpolated as a + s (b - a): the difference of nearby poses far from the origin is exact
   // (Sterbenz), so a pose 10^6 m out loses nothing.
