@@ -32,8 +32,8 @@ using laser_raycast::tools::ArgError;
 constexpr int kExitRunFailed = 1;  // bad command lines: tools::kExitBadArguments
 
 const char* const kSynopsis =
-    "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--method NAME ...] [--list-methods]\n"
-    "             [--threads N] [--list-scenes]\n";
+    "usage: bench [--quick] [--out DIR] [--scene NAME ...] [--workload NAME ...]\n"
+    "             [--method NAME ...] [--list-methods] [--threads N] [--list-scenes]\n";
 const char* const kNotes =
     "Times every method on the workloads fan2d and rings3d (one pose cast again and again)\n"
     "and on beams off any grid from the same poses (pattern_rosette: a pattern file's\n"
@@ -45,7 +45,8 @@ const char* const kNotes =
     "pareto_matrix.png (every workload and scene) (DIR defaults to bench_results). Scenes:\n"
     "sphere box_room tb3 million vertex_rows forest warehouse forest_10m (default all,\n"
     "forest_10m not with --quick; tb3 needs tb3_world_data: $LASER_RAYCAST_SHARED_DATA, the\n"
-    "ROS package, or ../shared/data beside the source). --method: only these rows (default\n"
+    "ROS package, or ../shared/data beside the source). --workload: only these workloads\n"
+    "(default all). --method: only these rows (default\n"
     "all; --list-methods names them). --quick: fewer poses, scans and repetitions (a few\n"
     "minutes). --threads N: a second pipeline row cast with N threads (0: every core); every\n"
     "other row is single-threaded.\n"
@@ -55,6 +56,7 @@ struct Options {
   bool quick = false;
   std::string out_dir = "bench_results";
   std::vector<std::string> scenes;   // empty: all
+  std::vector<std::string> workloads;  // empty: all
   std::vector<std::string> methods;  // empty: all
   int threads = 1;                   // the second pipeline row's; 1: no second row
   bool list_methods = false, list_scenes = false;
@@ -78,6 +80,12 @@ std::vector<std::string> allMethodNames() {
   std::vector<std::string> names = bench::coreMethodNames();
   const std::vector<std::string> peers = bench::peerMethodNames();
   names.insert(names.end(), peers.begin(), peers.end());
+  return names;
+}
+
+std::vector<std::string> workloadNames() {
+  std::vector<std::string> names;
+  for (const bench::Workload& workload : bench::workloads()) names.push_back(workload.name);
   return names;
 }
 
@@ -126,6 +134,8 @@ po::options_description flags(Options* options) {
       "where the results go (default bench_results)");
   add("scene", nameList("scene", bench::sceneNames(), &options->scenes),
       "the scenes to run (default all)");
+  add("workload", nameList("workload", workloadNames(), &options->workloads),
+      "the workloads to run (default all)");
   add("method", nameList("method", allMethodNames(), &options->methods),
       "the rows to run (default all)");
   add("threads",
@@ -220,6 +230,7 @@ std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settin
               << scene->scene.bodies().size() << " bodies, range max " << scene->range_max
               << " m, built in " << bench::secondsSince(build_start) << " s\n";
     for (const bench::Workload& workload : bench::workloads()) {
+      if (!options.workloads.empty() && !contains(options.workloads, workload.name)) continue;
       const int poses = options.quick ? workload.quick_poses : workload.full_poses;
       bench::runWorkload(settings, poses, *scene, geometry, methods, workload, &rows);
     }

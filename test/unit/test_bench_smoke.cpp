@@ -145,6 +145,8 @@ TEST(BenchSmoke, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runCommand(kBench + " --method nothing 2>/dev/null").status, 2);
   EXPECT_EQ(runCommand(kBench + " --method 2>/dev/null").status, 2);
   EXPECT_EQ(runCommand(kBench + " --method pipeline --scene 2>/dev/null").status, 2);
+  EXPECT_EQ(runCommand(kBench + " --workload sweeping 2>/dev/null").status, 2);
+  EXPECT_EQ(runCommand(kBench + " --workload 2>/dev/null").status, 2);
 }
 
 TEST(BenchSmoke, ListsTheScenes) {
@@ -158,8 +160,8 @@ TEST(BenchSmoke, ListsTheScenes) {
 TEST(BenchSmoke, HelpListsEveryFlag) {
   const auto result = runCommand(kBench + " --help");
   ASSERT_EQ(result.status, 0);
-  for (const char* flag : {"--quick", "--out", "--scene", "--method", "--threads", "--list-methods",
-                           "--list-scenes", "Exit status"}) {
+  for (const char* flag : {"--quick", "--out", "--scene", "--workload", "--method", "--threads",
+                           "--list-methods", "--list-scenes", "Exit status"}) {
     EXPECT_NE(result.output.find(flag), std::string::npos) << flag << "\n" << result.output;
   }
   EXPECT_EQ(runCommand(kBench + " --qui 2>/dev/null").status, 2);
@@ -294,6 +296,32 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
                       "pattern_rosette watertight_bvh", "pattern_rosette pipeline",
                       "vlp16_calibrated watertight_bvh", "vlp16_calibrated pipeline",
                       "os1_64_metadata watertight_bvh", "os1_64_metadata pipeline"}));
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(log);
+}
+
+TEST(BenchSmoke, WorkloadKeepsOnlyTheWorkloadsAskedFor) {
+  const std::string dir = tempDir("bench_workload");
+  const std::string log = dir + ".log";
+  const auto run = runCommand("timeout 300 " + kBench +
+                              " --quick --scene sphere box_room --workload sweep_fan fan2d "
+                              "--method pipeline --out " +
+                              dir + " 2>" + log);
+  ASSERT_EQ(run.status, 0) << readFile(log);
+  const auto lines = splitLines(readFile(dir + "/results.csv"));
+  std::multiset<std::string> rows;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const auto f = splitFields(lines[i]);
+    ASSERT_EQ(f.size(), kFields) << lines[i];
+    rows.insert(f[0] + " " + f[1] + " " + f[2]);
+  }
+  // Workload-major, in the benchmark's order of workloads, whatever the order asked in.
+  EXPECT_EQ(rows, (std::multiset<std::string>{"fan2d sphere pipeline", "fan2d box_room pipeline",
+                                              "sweep_fan sphere pipeline",
+                                              "sweep_fan box_room pipeline"}));
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(splitFields(lines[1])[0], "fan2d");
+  EXPECT_EQ(splitFields(lines[4])[0], "sweep_fan");
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
 }
