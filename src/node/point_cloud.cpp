@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace laser_raycast {
 namespace {
@@ -126,13 +127,14 @@ void checkSizes(const core::ScanPattern& pattern, const core::MeasuredScan& scan
 
 namespace {
 
-// The cloud of `beams` beams as height x width (organized) or one row of the valid returns: beam b
-// with a valid range r is the point at(b, r), with ring ring(b) and time time(b). With last (dual
-// returns), each beam's return in last follows its own in scan, and a `return` field says which.
-template <class At, class Ring, class Time>
+// The cloud of `beams` beams as height x width (organized) or one row of the valid returns, in the
+// order beam(0), beam(1), ...: beam b with a valid range r is the point at(b, r), with ring ring(b)
+// and time time(b). With last (dual returns), each beam's return in last follows its own in scan,
+// and a `return` field says which.
+template <class Order, class At, class Ring, class Time>
 void fillCloud(int beams, int height, int width, const core::MeasuredScan& scan,
-               const std_msgs::Header& header, const CloudOptions& options, At&& at, Ring&& ring,
-               Time&& time, sensor_msgs::PointCloud2* cloud,
+               const std_msgs::Header& header, const CloudOptions& options, Order&& beam_at,
+               At&& at, Ring&& ring, Time&& time, sensor_msgs::PointCloud2* cloud,
                const core::MeasuredScan* last = nullptr) {
   const int returns = last ? 2 : 1;
   int points = beams * returns;
@@ -182,7 +184,8 @@ void fillCloud(int beams, int height, int width, const core::MeasuredScan& scan,
   withPointLayout(options.layout, [&](auto ref) {
     using Ref = decltype(ref);
     const auto each_field = std::make_index_sequence<Ref::table.fields.size()>();
-    for (int b = 0; b < beams; ++b) {
+    for (int p = 0; p < beams; ++p) {
+      const int b = beam_at(p);
       for (int k = 0; k < returns; ++k) {
         const core::MeasuredScan& from = k == 0 ? scan : *last;
         const float range = from.ranges[b];
@@ -220,7 +223,7 @@ void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan&
   if (last) checkSizes(pattern, *last, column_times, options.layout);
   const int azimuths = pattern.azimuthCount();
   fillCloud(
-      pattern.size(), pattern.ringCount(), azimuths, scan, header, options,
+      pattern.size(), pattern.ringCount(), azimuths, scan, header, options, [](int p) { return p; },
       [&](int b, double range) -> Eigen::Vector3d { return pattern.directions()[b] * range; },
       [&](int b) { return b / azimuths; },
       [&](int b) { return column_times.empty() ? 0.0 : column_times[b % azimuths]; }, cloud,
@@ -249,8 +252,27 @@ void buildBeamCloud(const core::BeamList& beams, const core::MeasuredScan& scan,
     throw std::invalid_argument("buildBeamCloud: " + problem + " for " + std::to_string(n) +
                                 " beams");
   }
+  // Organized, a row per line where every line has as many beams (a calibrated Velodyne's rings
+  // or an Ouster's beams, as their drivers lay out their images: row r line r, its beams in firing
+  // order); one row of every beam otherwise (a pattern file's lines).
+  std::vector<int> order;
+  int height = 1, width = beams.size();
+  if (options.organized && !beams.lines.empty()) {
+    const int lines = *std::max_element(beams.lines.begin(), beams.lines.end()) + 1;
+    std::vector<std::vector<int>> by_line(lines);
+    for (int b = 0; b < beams.size(); ++b) by_line[beams.line(b)].push_back(b);
+    const std::size_t per_line = by_line.front().size();
+    bool uniform = per_line > 0;
+    for (const auto& line : by_line) uniform = uniform && line.size() == per_line;
+    if (uniform) {
+      height = lines;
+      width = static_cast<int>(per_line);
+      for (const auto& line : by_line) order.insert(order.end(), line.begin(), line.end());
+    }
+  }
   fillCloud(
-      beams.size(), 1, beams.size(), scan, header, options,
+      beams.size(), height, width, scan, header, options,
+      [&](int p) { return order.empty() ? p : order[p]; },
       [&](int b, double range) -> Eigen::Vector3d {
         return beams.origin(b) + beams.directions[b] * range;
       },

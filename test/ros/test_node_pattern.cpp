@@ -133,7 +133,9 @@ TEST(NodePattern, CalibratedVelodyne) {
 // column b / 64, taken at column * 0.1 s / 1024; its direction and origin worked out here from the
 // file's angles with Ouster's formulas (encoder angle 2 pi (1 - c / 1024) less the row's azimuth
 // offset, the beam origin 12.163 mm out along the encoder angle, then the file's half turn about z
-// and 36.18 mm up into os_sensor), its point on the room's faces, its ring the row.
+// and 36.18 mm up into os_sensor), its point on the room's faces, its ring the row, its range (mm)
+// from its beam origin. Organized, the cloud is ouster-ros's image: 64 rows of 1024 columns, row r
+// column c beam r of firing c.
 TEST(NodePattern, OusterMetadata) {
   const core::OusterHead head = laser_raycast::loadOusterMetadata(
       ros::package::getPath("laser_raycast") + "/config/ouster/os1_64_nominal.json");
@@ -143,9 +145,11 @@ TEST(NodePattern, OusterMetadata) {
   const auto cloud = firstMessage<sensor_msgs::PointCloud2>("/ouster/points", 30.0);
   ASSERT_TRUE(cloud);
   expectDriverLayout(*cloud, laser_raycast::PointLayout::kOuster);
-  ASSERT_EQ(cloud->width * cloud->height, 1024u * 64u);
+  ASSERT_EQ(cloud->height, 64u);
+  ASSERT_EQ(cloud->width, 1024u);
   for (int b = 0; b < 1024 * 64; b += 37) {
     const int c = b / 64, r = b % 64;
+    const int pixel = r * 1024 + c;
     const double encoder = 2 * M_PI * (1 - c / 1024.0);
     const double azimuth = encoder - head.azimuths_deg[r] * M_PI / 180;
     const double altitude = head.altitudes_deg[r] * M_PI / 180;
@@ -154,11 +158,14 @@ TEST(NodePattern, OusterMetadata) {
                             -std::sin(azimuth) * std::cos(altitude), std::sin(altitude));
     const Eigen::Vector3d origin(-0.012163 * std::cos(encoder), -0.012163 * std::sin(encoder),
                                  0.03618);
-    const Eigen::Vector3d expected = origin + roomDistance(kSensor + origin, d) * d;
-    const Eigen::Vector3d p = pointAt(*cloud, b);
+    const double range = roomDistance(kSensor + origin, d);
+    const Eigen::Vector3d expected = origin + range * d;
+    const Eigen::Vector3d p = pointAt(*cloud, pixel);
     EXPECT_LT((p - expected).norm(), kTolerance) << "point " << b;
-    EXPECT_EQ(fieldValue<std::uint16_t>(*cloud, b, "ring"), r) << "point " << b;
-    EXPECT_EQ(fieldValue<std::uint32_t>(*cloud, b, "t"), std::llround(c * 0.1 / 1024 * 1e9))
+    EXPECT_EQ(fieldValue<std::uint16_t>(*cloud, pixel, "ring"), r) << "point " << b;
+    EXPECT_EQ(fieldValue<std::uint32_t>(*cloud, pixel, "t"), std::llround(c * 0.1 / 1024 * 1e9))
+        << "point " << b;
+    EXPECT_NEAR(fieldValue<std::uint32_t>(*cloud, pixel, "range"), range * 1000, 1.0)
         << "point " << b;
   }
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cloud_scan.h"
+#include "laser_raycast/core/beam_list.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/node/point_cloud.h"
@@ -224,6 +225,63 @@ TEST(PointCloud, MismatchedSizesThrow) {
     EXPECT_NE(std::string(e.what()).find("2 column times"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("2 rings x 3 azimuths"), std::string::npos) << e.what();
   }
+}
+
+// Beams off a grid, three lines of two beams, listed column by column as the calibration and
+// metadata readers list them (line 0, 1, 2 of the first firing, then of the second), from their own
+// origins: organized, the cloud is the drivers' image, row r line r's beams in firing order; with
+// lines of unequal counts (a pattern file's), one row of every beam in list order.
+TEST(PointCloud, BeamCloudRowsAreLines) {
+  BeamList beams;
+  for (int column = 0; column < 2; ++column) {
+    for (int line = 0; line < 3; ++line) {
+      beams.directions.push_back(beamDirection(0.1 * column, 0.05 * line));
+      beams.origins.push_back(Eigen::Vector3d(0.01 * line, 0.02 * column, 0.03));
+      beams.times.push_back(1e-4 * column + 1e-6 * line);
+      beams.lines.push_back(line);
+    }
+  }
+  MeasuredScan scan;
+  scan.ranges = {1.0f, 2.0f, kNan, 4.0f, 5.0f, 6.0f};
+  scan.intensities = {10, 20, 30, 40, 50, 60};
+  CloudOptions organized;
+  organized.organized = true;
+  sensor_msgs::PointCloud2 cloud;
+  laser_raycast::buildBeamCloud(beams, scan, header(), organized, &cloud);
+  EXPECT_EQ(cloud.height, 3u);
+  EXPECT_EQ(cloud.width, 2u);
+  EXPECT_FALSE(cloud.is_dense);
+  const std::vector<ReadPoint> points = readAll(cloud);
+  ASSERT_EQ(points.size(), 6u);
+  const int beam_of[6] = {0, 3, 1, 4, 2, 5};  // row-major: (line 0: beams 0, 3), (line 1: 1, 4), ...
+  for (int p = 0; p < 6; ++p) {
+    const int b = beam_of[p];
+    EXPECT_EQ(points[p].ring, beams.lines[b]) << p;
+    EXPECT_FLOAT_EQ(points[p].time, static_cast<float>(beams.times[b])) << p;
+    if (std::isnan(scan.ranges[b])) {
+      EXPECT_TRUE(std::isnan(points[p].x)) << p;
+      continue;
+    }
+    const Eigen::Vector3d at = beams.origins[b] + beams.directions[b] * scan.ranges[b];
+    EXPECT_NEAR(points[p].x, at.x(), 1e-6) << p;
+    EXPECT_NEAR(points[p].y, at.y(), 1e-6) << p;
+    EXPECT_NEAR(points[p].z, at.z(), 1e-6) << p;
+    EXPECT_EQ(points[p].intensity, scan.intensities[b]) << p;
+  }
+  // A line with one beam more: one row of every beam, in the list's order.
+  beams.append(beams, 0);
+  scan.ranges.push_back(7.0f);
+  scan.intensities.push_back(70);
+  laser_raycast::buildBeamCloud(beams, scan, header(), organized, &cloud);
+  EXPECT_EQ(cloud.height, 1u);
+  EXPECT_EQ(cloud.width, 7u);
+  const std::vector<ReadPoint> row = readAll(cloud);
+  ASSERT_EQ(row.size(), 7u);
+  for (int b = 0; b < 7; ++b) EXPECT_EQ(row[b].ring, beams.lines[b]) << b;
+  // Dense: the valid returns in list order.
+  laser_raycast::buildBeamCloud(beams, scan, header(), CloudOptions{}, &cloud);
+  EXPECT_EQ(cloud.height, 1u);
+  EXPECT_EQ(cloud.width, 6u);
 }
 
 // End to end with the caster: a wall 4 m ahead (a box whose near face is x = 4) seen by 5 rings of

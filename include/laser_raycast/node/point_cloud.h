@@ -47,9 +47,13 @@ void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan&
 // The name of the dual returns' field (buildPointCloud's last).
 inline constexpr const char* kReturnField = "return";
 
-// The cloud of beams off any grid (a pattern file's, core::BeamList): beam b with a valid range r is
-// the point origin(b) + r * direction(b), with its line as the ring and its time (s after
-// header.stamp); organized: one row of every beam. Throws std::invalid_argument as buildPointCloud.
+// The cloud of beams off any grid (a calibration's, a metadata file's or a pattern file's,
+// core::BeamList): beam b with a valid range r is the point origin(b) + r * direction(b), with its
+// line as the ring, its time (s after header.stamp) and r as its range (from its own origin).
+// Organized: if lines 0 .. H - 1 each have W beams (a Velodyne calibration's rings, an Ouster's
+// beams), H rows of W, row r line r's beams in the list's order (the drivers' images: an Ouster
+// column not destaggered); else one row of every beam. Throws std::invalid_argument as
+// buildPointCloud.
 void buildBeamCloud(const core::BeamList& beams, const core::MeasuredScan& scan,
                     const std_msgs::Header& header, const CloudOptions& options,
                     sensor_msgs::PointCloud2* cloud);
