@@ -51,14 +51,25 @@ std::int64_t stampNanoseconds(std::int64_t stamp_ns, double time) {
   return stamp_ns + std::llround(time * 1e9);
 }
 
+// PointValue::kReflectivity of an intensity (rho cos(theta)): NaN stays NaN.
+double reflectivityValue(double intensity) {
+  if (std::isnan(intensity)) return intensity;
+  return std::clamp(std::round(100.0 * intensity), 0.0, 255.0);
+}
+
 // Value V of `beam` as a double, for writeField to convert to the field's type.
 template <PointValue V>
 double valueOf(const Beam& beam, std::int64_t stamp_ns) {
   if constexpr (V == PointValue::kX) return beam.xyz.x();
   if constexpr (V == PointValue::kY) return beam.xyz.y();
   if constexpr (V == PointValue::kZ) return beam.xyz.z();
-  if constexpr (V == PointValue::kIntensity || V == PointValue::kReflectivity) {
-    return beam.intensity;
+  if constexpr (V == PointValue::kIntensity) return beam.intensity;
+  if constexpr (V == PointValue::kReflectivity) return reflectivityValue(beam.intensity);
+  if constexpr (V == PointValue::kSignal) {
+    const double reflectivity = reflectivityValue(beam.intensity);
+    if (std::isnan(reflectivity) || reflectivity == 0) return reflectivity;
+    const double scale = 10.0 / beam.range;
+    return std::min(65535.0, std::round(reflectivity * scale * scale));
   }
   if constexpr (V == PointValue::kRing) return beam.ring;
   if constexpr (V == PointValue::kTimeSeconds) return beam.time;

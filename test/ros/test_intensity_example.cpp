@@ -26,7 +26,15 @@ TEST(IntensityExample, TheCloudShowsTheWorldsSurfaces) {
   for (std::size_t i = 0; i < std::size_t{cloud->width} * cloud->height; ++i) {
     const Eigen::Vector3d p = pointAt(*cloud, i);
     if (!std::isfinite(p.x())) continue;
-    const double intensity = fieldValue<float>(*cloud, i, "intensity");
+    // ouster-ros's reflectivity: the calibrated reflectivity, 100 x rho cos(theta), rounded; its
+    // intensity the signal, that times (10 m / range)^2.
+    const double reflectivity = fieldValue<std::uint16_t>(*cloud, i, "reflectivity");
+    const double range = fieldValue<std::uint32_t>(*cloud, i, "range") / 1000.0;
+    EXPECT_NEAR(fieldValue<float>(*cloud, i, "intensity"), reflectivity * 100 / (range * range),
+                0.5 + 0.01 * reflectivity)
+        << "point " << i;
+    const double intensity = reflectivity / 100;
+    constexpr double kRounding = 0.005 + 1e-5;  // half a unit of the reflectivity, over 100
     const Eigen::Vector3d d = p.normalized();
     if (std::abs(p.x() - 3) < 1e-3 && std::abs(p.y()) < 0.999 && std::abs(p.z()) < 0.999) {
       const double column = (p.y() + 1) / 2 * 8, row = (1 - (p.z() + 1) / 2) * 8;
@@ -35,19 +43,19 @@ TEST(IntensityExample, TheCloudShowsTheWorldsSurfaces) {
         continue;
       }
       const bool is_white = (static_cast<int>(column) + static_cast<int>(row)) % 2 == 0;
-      EXPECT_NEAR(intensity, is_white ? std::abs(d.x()) : 0.0, 1e-4) << "wall point " << i;
+      EXPECT_NEAR(intensity, is_white ? std::abs(d.x()) : 0.0, kRounding) << "wall point " << i;
       ++wall;
       white += is_white;
     } else if (std::hypot(p.x() - 2.2, p.y() + 1.8) < 0.2 + 1e-3 && p.z() > -1.2 + 1e-3 &&
                p.z() < 1.2 - 1e-3) {
       // The pillar's side (radius 0.2 m about x = 2.2, y = -1.8): its outward normal there.
       const Eigen::Vector3d n = Eigen::Vector3d(p.x() - 2.2, p.y() + 1.8, 0).normalized();
-      EXPECT_NEAR(intensity, kLuminanceRed * std::abs(d.dot(n)), 1e-4) << "pillar point " << i;
+      EXPECT_NEAR(intensity, kLuminanceRed * std::abs(d.dot(n)), kRounding) << "pillar point " << i;
       ++pillar;
     } else if (std::abs(p.x() - 1.9) < 1e-3 && std::abs(p.y() - 1.8) < 0.3 && p.z() < -0.4) {
       // The dark box's face x = 1.9 (a 0.6 m cube-ish box about x = 2.2, y = 1.8, z 0 to 0.8 in
       // the world: z below -0.4 in the lidar's frame).
-      EXPECT_NEAR(intensity, 0.08 * std::abs(d.x()), 1e-4) << "box point " << i;
+      EXPECT_NEAR(intensity, 0.08 * std::abs(d.x()), kRounding) << "box point " << i;
       ++box;
     }
   }

@@ -90,6 +90,15 @@ double expectOnTheRoom(const sensor_msgs::PointCloud2& cloud, std::size_t i, con
 
 double columnTime(std::size_t i) { return static_cast<int>(i) % kAzimuths * kTimeIncrement; }
 
+// The calibrated reflectivity the drivers report for point i: 100 x its surface's reflectivity 0.9
+// x the cosine of the beam's incidence on the room's face, rounded (so within half a unit).
+double reflectivityOf(std::size_t i) {
+  const int ring = static_cast<int>(i) / kAzimuths, column = static_cast<int>(i) % kAzimuths;
+  const double el = kElevations[ring], az = -M_PI + column * M_PI / 18;
+  const Eigen::Vector3d dir(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+  return 90 * std::abs(dir[roomFaceAxis(kSensor, dir)]);
+}
+
 // The cloud of sensor `name`, checked against its driver's layout, dense with every beam.
 sensor_msgs::PointCloud2::ConstPtr cloudOf(const std::string& name, PointLayout layout) {
   const auto cloud = clouds->first(name);
@@ -110,20 +119,26 @@ TEST(NodeLayouts, VelodyneByDefault) {
   for (std::size_t i = 0; i < 3 * kAzimuths; ++i) {
     expectOnTheRoom(*cloud, i, "ring", false);
     EXPECT_NEAR(fieldValue<float>(*cloud, i, "time"), columnTime(i), 1e-7) << i;
-    EXPECT_GE(fieldValue<float>(*cloud, i, "intensity"), 0.0f) << i;
+    // velodyne_pointcloud's intensity: the calibrated reflectivity, a whole number.
+    const float intensity = fieldValue<float>(*cloud, i, "intensity");
+    EXPECT_NEAR(intensity, reflectivityOf(i), 0.5 + 1e-3) << i;
+    EXPECT_EQ(intensity, std::round(intensity)) << i;
   }
 }
 
-// The ouster layouts: t in ns after the stamp, range in mm, reflectivity the intensity rounded
-// (reflectivity 100 x cos incidence), ambient and noise 0.
+// The ouster layouts: t in ns after the stamp, range in mm, reflectivity the calibrated
+// reflectivity, intensity the signal (the reflectivity times (10 m / range)^2, rounded), ambient
+// and noise 0.
 void expectOusterValues(const sensor_msgs::PointCloud2& cloud, bool legacy) {
   for (std::size_t i = 0; i < 3 * kAzimuths; ++i) {
     const double range = expectOnTheRoom(cloud, i, "ring", legacy);
     EXPECT_NEAR(fieldValue<std::uint32_t>(cloud, i, "t"), columnTime(i) * 1e9, 1.0) << i;
     EXPECT_NEAR(fieldValue<std::uint32_t>(cloud, i, "range"), range * 1000, 1.0) << i;
-    const float intensity = fieldValue<float>(cloud, i, "intensity");
-    EXPECT_GT(intensity, 0.0f) << i;
-    EXPECT_EQ(fieldValue<std::uint16_t>(cloud, i, "reflectivity"), std::lround(intensity)) << i;
+    const int reflectivity = fieldValue<std::uint16_t>(cloud, i, "reflectivity");
+    EXPECT_NEAR(reflectivity, reflectivityOf(i), 0.5 + 1e-3) << i;
+    EXPECT_NEAR(fieldValue<float>(cloud, i, "intensity"), reflectivity * 100 / (range * range),
+                0.5 + 1e-3)
+        << i;
     EXPECT_EQ(fieldValue<std::uint16_t>(cloud, i, "ambient"), 0) << i;
     if (legacy) {
       EXPECT_EQ(fieldValue<std::uint16_t>(cloud, i, "noise"), 0) << i;
@@ -154,6 +169,8 @@ TEST(NodeLayouts, Livox) {
     EXPECT_NEAR(fieldValue<double>(*cloud, i, "timestamp"), stamp_ns + columnTime(i) * 1e9, 512)
         << i;
     EXPECT_EQ(fieldValue<std::uint8_t>(*cloud, i, "tag"), 0) << i;
+    // livox_ros_driver2's scale is not modelled: the intensity as cast, 0.9 cos incidence.
+    EXPECT_NEAR(fieldValue<float>(*cloud, i, "intensity"), reflectivityOf(i) / 100, 1e-5) << i;
   }
 }
 
@@ -169,6 +186,8 @@ TEST(NodeLayouts, HesaiOrganized) {
     EXPECT_NEAR(fieldValue<double>(*cloud, i, "timestamp"),
                 cloud->header.stamp.toSec() + columnTime(i), 1e-6)
         << i;
+    // Hesai's reflectivity: linear in percent, as the calibrated reflectivity.
+    EXPECT_NEAR(fieldValue<float>(*cloud, i, "intensity"), reflectivityOf(i), 0.5 + 1e-3) << i;
   }
 }
 

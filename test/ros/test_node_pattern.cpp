@@ -123,8 +123,10 @@ TEST(NodePattern, CalibratedVelodyne) {
     EXPECT_NEAR(fieldValue<float>(*cloud, b, "time"), s * 55.296e-6 + i * 2.304e-6, 1e-7)
         << "point " << b;
     // ~intensity: the default reflectivity 1 times the cosine of the incidence on the face hit,
-    // the beam's own direction against the face's normal.
-    EXPECT_NEAR(fieldValue<float>(*cloud, b, "intensity"), std::abs(d[roomFaceAxis(o, d)]), 1e-5)
+    // the beam's own direction against the face's normal, as velodyne_pointcloud reports it: the
+    // calibrated reflectivity, 100 x that, rounded.
+    EXPECT_NEAR(fieldValue<float>(*cloud, b, "intensity"), 100 * std::abs(d[roomFaceAxis(o, d)]),
+                0.5 + 1e-3)
         << "point " << b;
   }
 }

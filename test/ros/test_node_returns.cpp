@@ -45,9 +45,10 @@ TEST(NodeReturns, AStraddlingBeamIsTwoPoints) {
     const int column = azimuth < 0.1 ? 0 : 1;
     EXPECT_NEAR(azimuth, column == 0 ? 0.002 : 0.202, 1e-5) << i;
     EXPECT_NEAR(elevation, ring == 0 ? -0.01 : 0.01, 1e-5) << i;
+    // The calibrated reflectivity of a return's share of the footprint: 0-100.
     const float intensity = fieldValue<float>(*cloud, i, "intensity");
     EXPECT_GT(intensity, 0.0f) << i;
-    EXPECT_LE(intensity, 1.0f) << i;
+    EXPECT_LE(intensity, 100.0f) << i;
     found[{ring, column}][which] = p.norm();
   }
   for (int ring = 0; ring < 2; ++ring) {

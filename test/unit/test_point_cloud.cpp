@@ -99,18 +99,20 @@ TEST(PointCloud, DenseHoldsTheValidReturns) {
   EXPECT_NEAR(p[0].y, -2 * std::cos(0.3), 1e-6);
   EXPECT_EQ(p[0].ring, 0);
   EXPECT_EQ(p[0].time, 0.0f);
-  EXPECT_EQ(p[0].intensity, 0.5f);
+  // velodyne_pointcloud's intensity is the sensor's calibrated reflectivity, 0-100 for diffuse
+  // targets: 100 x the scan's intensity (rho cos(theta)) 0.5, rounded.
+  EXPECT_EQ(p[0].intensity, 50.0f);
   // Ring 0, azimuth pi/2 at 1.5 m, taken 0.02 s after the stamp.
   expectPoint(p[1], 1.5, -0.3, M_PI / 2);
   EXPECT_EQ(p[1].ring, 0);
   EXPECT_EQ(p[1].time, 0.02f);
-  EXPECT_EQ(p[1].intensity, 0.25f);
+  EXPECT_EQ(p[1].intensity, 25.0f);
   // Ring 1 (0.2 rad), azimuth 0 at 3 m: (3 cos 0.2, 0, 3 sin 0.2).
   expectPoint(p[2], 3.0, 0.2, 0.0);
   EXPECT_NEAR(p[2].x, 3 * std::cos(0.2), 1e-6);
   EXPECT_EQ(p[2].ring, 1);
   EXPECT_EQ(p[2].time, 0.01f);
-  EXPECT_EQ(p[2].intensity, 0.75f);
+  EXPECT_EQ(p[2].intensity, 75.0f);
 }
 
 // Every beam: rows are rings, columns azimuths; no return is a NaN point that keeps ring and time.
@@ -175,7 +177,7 @@ TEST(PointCloud, DualReturnsFollowEachBeamsStrongest) {
   // beam 4: 3 m then 3.5 m.
   expectPoint(p[0], 2.0, -0.3, -M_PI / 2);
   expectPoint(p[1], 2.5, -0.3, -M_PI / 2);
-  EXPECT_EQ(p[1].intensity, 0.125f);
+  EXPECT_EQ(p[1].intensity, 13.0f);  // 12.5 rounded half away from zero
   expectPoint(p[2], 1.5, -0.3, M_PI / 2);
   expectPoint(p[3], 4.0, 0.2, -M_PI / 2);
   EXPECT_EQ(p[3].ring, 1);
@@ -243,7 +245,7 @@ TEST(PointCloud, BeamCloudRowsAreLines) {
   }
   MeasuredScan scan;
   scan.ranges = {1.0f, 2.0f, kNan, 4.0f, 5.0f, 6.0f};
-  scan.intensities = {10, 20, 30, 40, 50, 60};
+  scan.intensities = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f};
   CloudOptions organized;
   organized.organized = true;
   sensor_msgs::PointCloud2 cloud;
@@ -266,12 +268,12 @@ TEST(PointCloud, BeamCloudRowsAreLines) {
     EXPECT_NEAR(points[p].x, at.x(), 1e-6) << p;
     EXPECT_NEAR(points[p].y, at.y(), 1e-6) << p;
     EXPECT_NEAR(points[p].z, at.z(), 1e-6) << p;
-    EXPECT_EQ(points[p].intensity, scan.intensities[b]) << p;
+    EXPECT_EQ(points[p].intensity, 10.0f * (b + 1)) << p;  // 100 x the intensity
   }
   // A line with one beam more: one row of every beam, in the list's order.
   beams.append(beams, 0);
   scan.ranges.push_back(7.0f);
-  scan.intensities.push_back(70);
+  scan.intensities.push_back(0.7f);
   laser_raycast::buildBeamCloud(beams, scan, header(), organized, &cloud);
   EXPECT_EQ(cloud.height, 1u);
   EXPECT_EQ(cloud.width, 7u);

@@ -183,11 +183,11 @@ using laser_raycast::rotatingColumnTimes;
 using namespace laser_raycast::core;
 using sensor_msgs::PointField;
 
-// sixBeams() with intensities that test the reflectivity's rounding (12.4 -> 12) and clamping
-// (70000 -> 65535).
+// sixBeams() with intensities (rho cos(theta)) that test the rounding of the drivers' calibrated
+// reflectivity, 100 x the intensity (12.4 -> 12, 0.75 -> 1), and its clamping (300 -> 255).
 MeasuredScan sixBeamsBright() {
   MeasuredScan scan = sixBeams();
-  scan.intensities = {12.4f, 0.0f, 70000.0f, 0.0f, 0.75f, 0.0f};
+  scan.intensities = {0.124f, 0.0f, 3.0f, 0.0f, 0.0075f, 0.0f};
   return scan;
 }
 
@@ -268,13 +268,19 @@ pcl::PointCloud<PointT> readAs(const sensor_msgs::PointCloud2& cloud) {
   return points;
 }
 
-// The three valid returns in beam order: (ring, column, range, intensity).
+// The three valid returns in beam order: (ring, column, range, intensity as cast, the drivers'
+// calibrated reflectivity of it, Ouster's signal: the reflectivity times (10 m / range)^2, rounded:
+// 12 x 25, 255 x 44.4, 1 x 11.1).
 struct Return {
   int ring, column;
   double range;
   float intensity;
+  float reflectivity;
+  float signal;
 };
-const Return kReturns[3] = {{0, 0, 2.0, 12.4f}, {0, 2, 1.5, 70000.0f}, {1, 1, 3.0, 0.75f}};
+const Return kReturns[3] = {{0, 0, 2.0, 0.124f, 12, 300},
+                            {0, 2, 1.5, 3.0f, 255, 11333},
+                            {1, 1, 3.0, 0.0075f, 1, 11}};
 
 // x y z of return r, by hand: r (cos el cos az, cos el sin az, sin el).
 template <typename PointT>
@@ -298,11 +304,11 @@ TEST(PointLayouts, VelodyneIsReadByLioSamAndFastLio) {
     const Return& r = kReturns[i];
     const float time = static_cast<float>(r.column * kColumnTime);  // s after the stamp
     expectPosition(lio_sam[i], r);
-    EXPECT_EQ(lio_sam[i].intensity, r.intensity);
+    EXPECT_EQ(lio_sam[i].intensity, r.reflectivity);
     EXPECT_EQ(lio_sam[i].ring, r.ring);
     EXPECT_EQ(lio_sam[i].time, time);
     expectPosition(fast_lio[i], r);
-    EXPECT_EQ(fast_lio[i].intensity, r.intensity);
+    EXPECT_EQ(fast_lio[i].intensity, r.reflectivity);
     EXPECT_EQ(fast_lio[i].ring, r.ring);
     EXPECT_EQ(fast_lio[i].time, time);
   }
@@ -325,20 +331,19 @@ TEST(PointLayouts, OusterAsOusterRosPublishesItsPoint) {
   EXPECT_EQ(cloud.point_step, sizeof(ouster_ros::Point));
 }
 
-// What the ouster layouts hold: t in ns after the stamp, reflectivity the intensity rounded and
-// clamped to uint16, range in mm, ambient (and noise) 0.
+// What the ouster layouts hold: intensity the signal, t in ns after the stamp, reflectivity the
+// calibrated reflectivity, range in mm, ambient (and noise) 0.
 template <typename PointT>
 void expectOusterValues(const pcl::PointCloud<PointT>& points) {
   ASSERT_EQ(points.size(), 3u);
-  const std::uint16_t reflectivity[3] = {12, 65535, 1};
   const std::uint32_t range_mm[3] = {2000, 1500, 3000};
   for (int i = 0; i < 3; ++i) {
     const Return& r = kReturns[i];
     expectPosition(points[i], r);
-    EXPECT_EQ(points[i].intensity, r.intensity);
+    EXPECT_EQ(points[i].intensity, r.signal);
     EXPECT_EQ(points[i].ring, r.ring);
     EXPECT_EQ(points[i].t, r.column * kColumnTimeNs);
-    EXPECT_EQ(points[i].reflectivity, reflectivity[i]);
+    EXPECT_EQ(points[i].reflectivity, r.reflectivity);
     EXPECT_EQ(points[i].range, range_mm[i]);
   }
 }
@@ -398,7 +403,7 @@ TEST(PointLayouts, HesaiAsHesaiRosDriverPublishesIt) {
   for (int i = 0; i < 3; ++i) {
     const Return& r = kReturns[i];
     expectPosition(points[i], r);
-    EXPECT_EQ(points[i].intensity, r.intensity);
+    EXPECT_EQ(points[i].intensity, r.reflectivity);
     EXPECT_EQ(points[i].ring, r.ring);
     // 1700000000.123456789 s + 5 ms per column; a double holds it to 2.4e-7 s.
     EXPECT_NEAR(points[i].timestamp, 1700000000.123456789 + r.column * kColumnTime, 3e-7);

@@ -35,10 +35,16 @@ enum class PointValue {
   kX,
   kY,
   kZ,          // m, in the sensor frame; NaN for a beam without a return (organized clouds)
-  kIntensity,  // the scan's intensity (0 without intensities); NaN without a return
-  // The intensity rounded to the field's integer type and clamped to it; 0 without a return.
-  // Reflectance is not modelled apart from intensity.
+  kIntensity,  // the scan's intensity as is (0 without intensities); NaN without a return
+  // Calibrated reflectivity as Velodyne, Hesai and Ouster report it: 0-100 for diffuse targets (a
+  // percent of a white Lambertian target seen head-on), above for retro-reflectors, at most 255:
+  // 100 x the scan's intensity (rho cos(theta)), rounded and clamped to 0..255. NaN without a
+  // return (0 in an integer field).
   kReflectivity,
+  // Ouster's signal, the received light, which falls with the square of the range: the
+  // reflectivity value times (10 m / range)^2 (the same at 10 m), rounded and clamped to 0..65535
+  // (the packet's 16 bits). NaN without a return.
+  kSignal,
   kRing,              // the ring, 0 lowest
   kTimeSeconds,       // the point's time, s after header.stamp
   kTimeNanoseconds,   // the same in ns, rounded
@@ -76,7 +82,7 @@ inline constexpr PointLayoutTable<6> kVelodyne = {
         {"x", 0, F::FLOAT32, V::kX},
         {"y", 4, F::FLOAT32, V::kY},
         {"z", 8, F::FLOAT32, V::kZ},
-        {"intensity", 12, F::FLOAT32, V::kIntensity},
+        {"intensity", 12, F::FLOAT32, V::kReflectivity},
         {"ring", 16, F::UINT16, V::kRing},
         {"time", 18, F::FLOAT32, V::kTimeSeconds},
     }},
@@ -91,7 +97,7 @@ inline constexpr PointLayoutTable<9> kOuster = {
         {"x", 0, F::FLOAT32, V::kX},
         {"y", 4, F::FLOAT32, V::kY},
         {"z", 8, F::FLOAT32, V::kZ},
-        {"intensity", 16, F::FLOAT32, V::kIntensity},
+        {"intensity", 16, F::FLOAT32, V::kSignal},
         {"t", 20, F::UINT32, V::kTimeNanoseconds},
         {"reflectivity", 24, F::UINT16, V::kReflectivity},
         {"ring", 26, F::UINT16, V::kRing},
@@ -110,7 +116,7 @@ inline constexpr PointLayoutTable<10> kOusterLegacy = {
         {"x", 0, F::FLOAT32, V::kX},
         {"y", 4, F::FLOAT32, V::kY},
         {"z", 8, F::FLOAT32, V::kZ},
-        {"intensity", 16, F::FLOAT32, V::kIntensity},
+        {"intensity", 16, F::FLOAT32, V::kSignal},
         {"t", 20, F::UINT32, V::kTimeNanoseconds},
         {"reflectivity", 24, F::UINT16, V::kReflectivity},
         {"ring", 26, F::UINT8, V::kRing},
@@ -144,7 +150,7 @@ inline constexpr PointLayoutTable<6> kHesai = {
         {"x", 0, F::FLOAT32, V::kX},
         {"y", 4, F::FLOAT32, V::kY},
         {"z", 8, F::FLOAT32, V::kZ},
-        {"intensity", 12, F::FLOAT32, V::kIntensity},
+        {"intensity", 12, F::FLOAT32, V::kReflectivity},
         {"ring", 16, F::UINT16, V::kRing},
         {"timestamp", 18, F::FLOAT64, V::kStampSeconds},
     }},
