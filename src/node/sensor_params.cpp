@@ -66,16 +66,18 @@ void readElevations(ParamReader* r, core::ScanSpec* scan) {
   scan->elevations = r->numberList("elevations", scan->elevations, "rad");
 }
 
-// ~sensor_model: a preset's pattern, range limits and rate, before the explicit parameters.
+// ~sensor_model: a preset's pattern, range limits and rate (and a realistic variant's detection
+// pair, divergence and returns), before the explicit parameters.
 void readSensorModel(ParamReader* r, SensorParams* s) {
   s->sensor_model = r->text("sensor_model", s->sensor_model);
   if (s->sensor_model.empty()) return;
   const std::optional<core::SensorModel> model = core::findSensorModel(s->sensor_model);
   if (!model) {
-    r->fail("sensor_model", core::kSensorModelNames.notOneOf(s->sensor_model));
+    r->fail("sensor_model", core::sensorModelProblem(s->sensor_model));
     return;
   }
   model->apply(&s->scan, &s->rate);
+  model->applyReturns(&s->returns);
 }
 
 // What the sensor reports: range limits, min-range policy, noise, intensity; and how it casts.

@@ -206,7 +206,13 @@ struct Pattern {
 
   static Pattern fromPreset(const std::string& name) {
     const std::optional<core::SensorModel> model = core::findSensorModel(name);
-    if (!model) throw py::value_error("name: " + core::kSensorModelNames.notOneOf(name));
+    if (!model) throw py::value_error("name: " + core::sensorModelProblem(name));
+    if (model->realistic) {
+      throw py::value_error("name: '" + name + "' is a realistic variant (detection pair, beam " +
+                            "divergence and returns: the node's and simulate_bag's); its pattern " +
+                            "is " + toString(model->id) + "'s: Pattern.preset(\"" +
+                            toString(model->id) + "\")");
+    }
     Pattern p;
     p.fan = model->fan;
     p.elevations = model->elevations;

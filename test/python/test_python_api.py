@@ -197,6 +197,8 @@ def test_bad_arguments_raise_errors_that_name_them(walls):
         (lambda: lr.Pattern.fan(1, -1, samples=3), ValueError, "angle_max"),
         (lambda: lr.Pattern.rings(-1, 1, [0.1, 0.1], samples=3), ValueError, "elevations"),
         (lambda: lr.Pattern.preset("VLP-17"), ValueError, "VLP-17"),
+        (lambda: lr.Pattern.preset("OS1-64-realistic"), ValueError, 'Pattern.preset("OS1-64")'),
+        (lambda: lr.Pattern.preset("VLP-16-realistic"), ValueError, "no realistic variant"),
         (lambda: lr.Measurement(noise_stddev=-1), ValueError, "noise_stddev"),
         (lambda: lr.Caster(threads=-2), ValueError, "threads"),
         (lambda: lr.Scene.from_urdf(WALL_URDF, geometry="both"), ValueError, "both"),

@@ -131,6 +131,14 @@ TEST(LaunchArgs, EveryArgumentReachesItsParameter) {
   ASSERT_TRUE(ouster.params.sensors.at(0).calibrated);
   EXPECT_EQ(ouster.params.sensors.at(0).calibrated->size(), 64 * 1024);
 
+  const Parsed realistic = parseFromMaster("/realistic/laser_raycast");
+  ASSERT_EQ(realistic.error, "");
+  EXPECT_EQ(realistic.params.sensors.at(0).sensor_model, "OS1-64-realistic");
+  EXPECT_EQ(realistic.params.sensors.at(0).scan.output.detection_range, 40.0);
+  EXPECT_EQ(realistic.params.sensors.at(0).scan.output.detection_reflectivity, 0.1);
+  EXPECT_EQ(realistic.params.sensors.at(0).returns.beam_samples, 7);
+  EXPECT_EQ(realistic.params.sensors.at(0).returns.min_return_separation, 0.012);
+
   const Parsed samples = parseFromMaster("/samples/laser_raycast");
   ASSERT_EQ(samples.error, "");
   EXPECT_EQ(samples.params.sensors.at(0).scan.fan.samples, 100);

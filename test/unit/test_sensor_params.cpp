@@ -111,7 +111,40 @@ TEST(SensorParams, APresetSetsThePatternRangesAndRateAndExplicitValuesWin) {
 
 TEST(SensorParams, AnUnknownPresetNamesTheChoices) {
   expectRefused(values({{"sensor_model", "VLP-15"}}),
-                {"~sensor_model", "'VLP-15' is not one of", "VLP-16", "LDS-01"});
+                {"~sensor_model", "'VLP-15' is not one of", "VLP-16", "LDS-01",
+                 "OS1-64-realistic"});
+  expectRefused(values({{"sensor_model", "LDS-01-realistic"}}),
+                {"~sensor_model", "'LDS-01-realistic'", "no realistic variant"});
+}
+
+// A realistic variant: the preset's pattern with its datasheet's detection pair, divergence and
+// return; explicit values still win.
+TEST(SensorParams, ARealisticVariantSetsTheDetectionPairDivergenceAndReturn) {
+  Parsed parsed = parse(values({{"sensor_model", "OS1-64-realistic"}}));
+  ASSERT_EQ(parsed.error, "");
+  const laser_raycast::SensorParams& s = parsed.params.sensors.at(0);
+  EXPECT_EQ(s.scan.elevations.size(), 64u);
+  EXPECT_EQ(s.scan.output.detection_range, 40.0);
+  EXPECT_EQ(s.scan.output.detection_reflectivity, 0.1);
+  EXPECT_NEAR(s.returns.beam_divergence, 0.13 * M_PI / 180, 1e-15);
+  EXPECT_EQ(s.returns.beam_samples, 7);
+  EXPECT_EQ(s.returns.min_return_separation, 0.012);
+
+  parsed = parse(values({{"sensor_model", "OS1-64-realistic"},
+                         {"detection_range", 50.0},
+                         {"beam_samples", 1},
+                         {"return_mode", "dual"}}));
+  ASSERT_EQ(parsed.error, "");
+  const laser_raycast::SensorParams& t = parsed.params.sensors.at(0);
+  EXPECT_EQ(t.scan.output.detection_range, 50.0);
+  EXPECT_EQ(t.scan.output.detection_reflectivity, 0.1);  // the variant's
+  EXPECT_EQ(t.returns.beam_samples, 1);
+  EXPECT_EQ(t.returns.return_mode, laser_raycast::core::ReturnMode::kDual);
+
+  parsed = parse(values({{"sensor_model", "OS1-64"}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.params.sensors.at(0).scan.output.detection_range, 0.0);
+  EXPECT_EQ(parsed.params.sensors.at(0).returns.beam_samples, 1);
 }
 
 XmlRpcValue sensor(const std::vector<std::pair<std::string, XmlRpcValue>>& entries) {

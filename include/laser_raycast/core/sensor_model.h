@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "laser_raycast/core/enum_names.h"
+#include "laser_raycast/core/returns.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scan_spec.h"
 
@@ -43,21 +44,45 @@ struct SensorModel {
   double range_min = 0;  // m
   double range_max = 0;  // m
   double rate = 0;       // Hz: scans (head turns) per second
+  // What the datasheet gives of the sensor's returns, where it gives it all: the detection pair
+  // (range R at reflectivity rho of a Lambertian target), the beam's divergence and the return it
+  // reports. The preset's "-realistic" variant applies them.
+  struct Realism {
+    double detection_range;         // m
+    double detection_reflectivity;  // (0, 1]
+    double beam_divergence;         // rad, full angle
+    int beam_samples;               // sub-rays over the footprint (ReturnsConfig)
+    ReturnMode return_mode;
+    double min_return_separation;  // m: the datasheet's range resolution
+  };
+  std::optional<Realism> realism;
+  bool realistic = false;  // this is the "-realistic" variant (realism is set)
 
-  const char* name() const { return toString(id); }
+  // "VLP-16", or "OS1-64-realistic" for the variant.
+  std::string name() const;
 
-  // Sets spec->fan, spec->elevations, spec->output.range_min and range_max, and *rate; leaves
+  // Sets spec->fan, spec->elevations, spec->output.range_min and range_max, and *rate, and for
+  // the realistic variant spec->output.detection_range and detection_reflectivity; leaves
   // everything else in spec (min-range policy, noise, intensity, method) as it was. Explicit
   // settings are applied afterwards by the caller; one that sets samples must clear
   // fan.angle_increment (and vice versa), since a FanSpec takes exactly one of them.
   void apply(ScanSpec* spec, double* rate) const;
+  // For the realistic variant, sets the beam divergence, sub-rays, return mode and separation;
+  // otherwise leaves returns as it was.
+  void applyReturns(ReturnsConfig* returns) const;
 };
 
 // The preset of that sensor.
 SensorModel sensorModel(SensorModelId id);
-// The preset named `name` (exactly one of kSensorModelNames); nullopt for anything else. The
-// error message for an unknown name: kSensorModelNames.notOneOf(name) lists the known ones.
+// The suffix of a preset's realistic variant.
+inline constexpr const char* kRealisticSuffix = "-realistic";
+// The preset named `name` (exactly one of kSensorModelNames), or its realistic variant (the name
+// and kRealisticSuffix, for a preset with realism); nullopt for anything else. The error message
+// for an unknown name: sensorModelProblem(name).
 std::optional<SensorModel> findSensorModel(const std::string& name);
+// Why `name` names no preset: the names there are, or that the preset has no realistic variant and
+// why.
+std::string sensorModelProblem(const std::string& name);
 
 }  // namespace core
 }  // namespace laser_raycast
