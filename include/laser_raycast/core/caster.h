@@ -55,6 +55,19 @@ class Caster {
   const ScanResult& castBeamsSweep(const Scene& scene, const PoseSamples& samples,
                                    const BeamList& beams, const CastConfig& config);
 
+  // A bundle: the 3D patterns `patterns`, all of the same rings and azimuths with sub-ray k of each
+  // beam at patterns[k]'s (row, column) (a divergent beam's footprint: the same pattern shifted a
+  // little in azimuth and elevation), cast from one pose in one walk of the scene: culled as
+  // patterns[0] with windows widened by the farthest a sub-ray is from it, each sub-ray tested
+  // exactly as a cast of its pattern tests it. Result k is cast(.., patterns[k], ..)'s (ranges,
+  // bodies, triangles and, with compute_incidence, normals and incidence; one stats for all). Never
+  // reused. Throws std::invalid_argument for patterns that are empty, planar or of other sizes or
+  // ring orders.
+  const std::vector<ScanResult>& castBundle(const Scene& scene, const FramePoses& poses,
+                                            const Eigen::Isometry3d& world_from_sensor,
+                                            const std::vector<ScanPattern>& patterns,
+                                            const CastConfig& config);
+
   // Drops the remembered inputs, so that the next cast() computes even if nothing moved (timing).
   // Kept slices of meshes by scan planes (CastConfig::keep_slices) stay: like the meshes' BVHs,
   // they hold geometry, not results.

@@ -55,6 +55,15 @@ struct ReturnsConfig {
 struct PulseReturns {
   ScanResult first, second;
   SurfaceSamples first_surface, second_surface;
+  // The sub-ray patterns of the last call, which the next with the same fan, rings and footprint
+  // reuses (building them works out every sub-ray's direction).
+  struct SubRays {
+    FanSpec fan;
+    std::vector<double> elevations;
+    double divergence = 0;
+    int samples = 0;
+    std::vector<ScanPattern> patterns;
+  } sub_rays;
 };
 
 // Casts the beam_samples shifted patterns from world_from_sensor and forms the returns. The

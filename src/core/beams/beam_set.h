@@ -7,6 +7,9 @@
 // split between threads).
 #pragma once
 
+#include <algorithm>
+#include <vector>
+
 #include "beams/beam_grid.h"
 #include "beams/occlusion_tiles.h"
 #include "geometry/hit_order.h"
@@ -20,9 +23,19 @@ namespace core {
 
 class BeamSet {
  public:
-  // Starts a scan: every beam open (result's ranges as resetResult left them), the grid prepared
-  // for pattern and config.
-  void reset(const ScanPattern& pattern, const CastConfig& config, ScanResult* result);
+  // A bundle (Caster::castBundle): each beam of the grid stands for the beams at its row and
+  // column of `patterns` (its sub-rays, all from the sensor), each kept in its own result; the
+  // grid's own ranges then hold the farthest of a beam's sub-ray ranges, which is what culling
+  // reads, and the walks test each sub-ray where they would test the beam.
+  struct Bundle {
+    std::vector<const ScanPattern*> patterns;
+    std::vector<ScanResult*> results;
+  };
+
+  // Starts a scan: every beam open (result's ranges as resetResult left them, and a bundle's
+  // results'), the grid prepared for pattern and config.
+  void reset(const ScanPattern& pattern, const CastConfig& config, ScanResult* result,
+             const Bundle* bundle = nullptr);
 
   const BeamGrid& grid() const { return grid_; }
   double range(int row, int col) const { return result_->range[grid_.beam(row, col)]; }
@@ -48,8 +61,25 @@ class BeamSet {
   template <class Normal>
   bool keepNearestHit(int row, int col, double t, int body, int triangle, Normal&& normal);
 
+  // The bundle being cast, or null.
+  const Bundle* bundle() const { return bundle_; }
+  int subRays() const { return static_cast<int>(bundle_->patterns.size()); }
+  // Sub-ray k of the beam at (row, col): its direction (sensor frame) and its range so far.
+  const Eigen::Vector3d& subDirection(int k, int row, int col) const {
+    return bundle_->patterns[k]->directions()[grid_.beam(row, col)];
+  }
+  double subRange(int k, int row, int col) const {
+    return bundle_->results[k]->range[grid_.beam(row, col)];
+  }
+  // keepNearestHit for sub-ray k, by the same order; the beam's culling range follows the
+  // farthest of its sub-rays'.
+  template <class Normal>
+  bool keepNearestSubHit(int k, int row, int col, double t, int body, int triangle,
+                         Normal&& normal);
+
  private:
   BeamGrid grid_;
+  const Bundle* bundle_ = nullptr;
   ScanResult* result_ = nullptr;
   bool with_normals_ = false;
   bool occlusion_culling_ = true;
@@ -68,6 +98,25 @@ bool BeamSet::keepNearestHit(int row, int col, double t, int body, int triangle,
   hit_triangle = triangle;
   if (with_normals_) result_->normal[i] = normal();
   tiles_.lower(row, col, floatAbove(t));
+  return true;
+}
+
+template <class Normal>
+bool BeamSet::keepNearestSubHit(int k, int row, int col, double t, int body, int triangle,
+                                Normal&& normal) {
+  const int i = grid_.beam(row, col);
+  ScanResult& sub = *bundle_->results[k];
+  if (!hitBefore(t, body, triangle, sub.range[i], sub.body[i], sub.triangle[i])) return false;
+  sub.range[i] = t;
+  sub.body[i] = body;
+  sub.triangle[i] = triangle;
+  if (with_normals_) sub.normal[i] = normal();
+  double farthest = 0;
+  for (const ScanResult* r : bundle_->results) farthest = std::max(farthest, r->range[i]);
+  if (farthest < result_->range[i]) {
+    result_->range[i] = farthest;
+    tiles_.lower(row, col, floatAbove(farthest));
+  }
   return true;
 }
 

@@ -8,7 +8,7 @@ namespace laser_raycast {
 namespace core {
 
 ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column,
-                           double steepest)
+                           double steepest, double extra_turn)
     : col_lo_(col_lo), ref_from_column_(std::move(ref_from_column)) {
   double shift2 = 0, frobenius2 = 0, z_move2 = 0;
   for (const Eigen::Isometry3d& m : ref_from_column_) {
@@ -31,7 +31,7 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
   // the angle, so the largest gives the largest angle.
   const double turn = 2 * std::asin(std::min(1.0, std::sqrt(frobenius2) / (2 * std::sqrt(2.0))));
   const double tilt = 2 * std::asin(std::min(1.0, std::sqrt(z_move2) / 2));
-  spread_ = Spread::of(std::sqrt(shift2), turn, tilt, steepest);
+  spread_ = Spread::of(std::sqrt(shift2), turn + extra_turn, tilt, steepest);
 }
 
 }  // namespace core

@@ -19,8 +19,11 @@ namespace core {
 class ColumnMotion {
  public:
   // A block of columns [col_lo, col_lo + ref_from_column.size()); steepest: the largest angle of a
-  // pattern direction from the horizontal (rad).
-  ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column, double steepest);
+  // pattern direction from the horizontal (rad). extra_turn (rad): how far more the beams' rays may
+  // turn from their pattern directions (a bundle's sub-rays, Caster::castBundle), added to the
+  // spread's turn.
+  ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column, double steepest,
+               double extra_turn = 0);
 
   int colLo() const { return col_lo_; }
   int colHi() const { return col_lo_ + static_cast<int>(ref_from_column_.size()) - 1; }

@@ -29,6 +29,12 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
   const Eigen::Vector3d m[3] = {b.cross(c), c.cross(a), a.cross(b)};
   // The plane's distance: its normal (b - a) x (c - a) is the edge normals' sum, whose dot product
   // with a is a . (b x c).
+  if (shift == 0) {
+    // Every beam from the sensor (a bundle's sub-rays, or a turn alone): the reference's edge
+    // planes, widened by the turn.
+    init(beams, a, b, c, m, std::sin(std::min(M_PI / 2, turn)), 0, turn);
+    return;
+  }
   const double plane = std::abs(a.dot(m[0])) / (m[0] + m[1] + m[2]).norm() * (1 - 1e-9);
   if (std::isfinite(plane) && plane > 2 * shift) {
     motion_ = &motion;

@@ -218,8 +218,9 @@ void CasterState::castBodies(const Scene& scene, const ScanPattern& pattern,
 
 void CasterState::castOnThreads(const Scene& scene, const ScanPattern& pattern,
                                   const CastConfig& config, ScanResult* result,
-                                  const std::function<void(const BeamRect&)>& castWithin) {
-  beams.reset(pattern, config, result);
+                                  const std::function<void(const BeamRect&)>& castWithin,
+                                  const BeamSet::Bundle* bundle) {
+  beams.reset(pattern, config, result, bundle);
   const std::size_t bodies = scene.bodies().size();
   if (cast.size() != bodies) cast = std::vector<std::atomic<char>>(bodies);
   for (auto& mark : cast) mark.store(0, std::memory_order_relaxed);

@@ -99,6 +99,7 @@ struct CasterState {
   std::unique_ptr<ThreadPool> pool;     // for CastConfig::threads > 1
   std::unique_ptr<KeptSlices> planes;   // CastConfig::keep_slices
   std::optional<ReuseKey> previous;     // the inputs of the result, if it is complete
+  std::vector<ScanResult> bundle;       // Caster::castBundle's results, one per sub-ray pattern
 
   // The scene's index for this scene version.
   const SceneIndex& indexOf(const Scene& scene);
@@ -119,7 +120,8 @@ struct CasterState {
   // Starts a cast (the beams open as result holds them, no body marked), runs
   // castWithin(rect) over the pattern's beams on config's threads, and counts the bodies culled.
   void castOnThreads(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,
-                     ScanResult* result, const std::function<void(const BeamRect&)>& castWithin);
+                     ScanResult* result, const std::function<void(const BeamRect&)>& castWithin,
+                     const BeamSet::Bundle* bundle = nullptr);
 };
 
 }  // namespace core

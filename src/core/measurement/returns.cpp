@@ -84,16 +84,41 @@ void castReturns(Caster* caster, const Scene& scene, const FramePoses& poses,
   std::vector<SubHit> hits;
   std::vector<int> hit_count;
   SurfaceSamples surface;
+  PulseReturns::SubRays& sub = out->sub_rays;
+  const bool same_fan = sub.fan.angle_min == fan.angle_min && sub.fan.angle_max == fan.angle_max &&
+                        sub.fan.angle_increment == fan.angle_increment &&
+                        sub.fan.samples == fan.samples;
+  if (!(same_fan && sub.elevations == elevations &&
+        sub.divergence == returns.beam_divergence && sub.samples == samples)) {
+    sub.patterns.clear();
+    sub.patterns.reserve(samples);
+    for (int k = 0; k < samples; ++k) {
+      const Eigen::Vector2d offset = returns.offset(k);
+      FanSpec shifted = fan;
+      shifted.angle_min += offset.x();
+      shifted.angle_max += offset.x();
+      std::vector<double> rings = elevations;
+      // Clamped at the poles: a sub-ray cannot lean past straight up or down.
+      for (double& e : rings) e = std::clamp(e + offset.y(), -M_PI / 2, M_PI / 2);
+      sub.patterns.emplace_back(shifted, rings);
+    }
+    sub.fan = fan;
+    sub.elevations = elevations;
+    sub.divergence = returns.beam_divergence;
+    sub.samples = samples;
+  }
+  const std::vector<ScanPattern>& patterns = sub.patterns;
+  // A 3D pattern's sub-rays are cast as one bundle (Caster::castBundle: the same results as a cast
+  // of each pattern, in one walk of the scene); a planar fan's (whose sub-rays leave its plane)
+  // one pattern at a time.
+  bool bundled = samples > 1;
+  for (const ScanPattern& p : patterns) bundled = bundled && !p.planar();
+  const std::vector<ScanResult>* bundle =
+      bundled ? &caster->castBundle(scene, poses, world_from_sensor, patterns, cast) : nullptr;
   for (int k = 0; k < samples; ++k) {
-    const Eigen::Vector2d offset = returns.offset(k);
-    FanSpec shifted = fan;
-    shifted.angle_min += offset.x();
-    shifted.angle_max += offset.x();
-    std::vector<double> rings = elevations;
-    // Clamped at the poles: a sub-ray cannot lean past straight up or down.
-    for (double& e : rings) e = std::clamp(e + offset.y(), -M_PI / 2, M_PI / 2);
-    const ScanPattern pattern(shifted, rings);
-    const ScanResult& result = caster->cast(scene, poses, world_from_sensor, pattern, cast);
+    const ScanPattern& pattern = patterns[k];
+    const ScanResult& result =
+        bundle ? (*bundle)[k] : caster->cast(scene, poses, world_from_sensor, pattern, cast);
     if (k == 0) {
       n = result.range.size();
       hits.resize(n * samples);

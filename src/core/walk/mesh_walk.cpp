@@ -220,13 +220,34 @@ class MeshWalk {
   // sweep's block the column's own.
   Eigen::Vector3d columnNormal(int col, std::uint32_t triangle) const {
     const Eigen::Vector3d n = sensorNormal(triangle);
-    return motion_ ? motion_->toColumn(col, n) : n;
+    // A bundle's block does not move: every column's frame is the sensor's.
+    return motion_ && !bundle_ ? motion_->toColumn(col, n) : n;
   }
 
   void offer(int row, int col, const Best& best) {
     beams_.keepNearestHit(row, col, best.t, active_.index, static_cast<int>(best.triangle), [&] {
       return slicing_ ? slicer_->sensorNormal(best.slot) : columnNormal(col, best.triangle);
     });
+  }
+
+  // Sub-ray k of a bundle's beam: as offer() for the beam.
+  void offerSub(int k, int row, int col, const Best& best) {
+    beams_.keepNearestSubHit(k, row, col, best.t, active_.index, static_cast<int>(best.triangle),
+                             [&] { return columnNormal(col, best.triangle); });
+  }
+
+  // Sub-ray k of a bundle's beam as a ray for the triangle tests: from the sensor (a bundle has
+  // no motion of its own: its block's poses are the sensor's), as a cast of its pattern tests it.
+  PreparedRay<double, M> subRay(int k, int row, int col) const {
+    Ray ray;
+    ray.origin.setZero();
+    ray.dir = beams_.subDirection(k, row, col);
+    ray.tmin = config_.tmin;
+    return PreparedRay<double, M>(ray, config_.cull_backfaces);
+  }
+  // Its ray in the body's frame for box tests.
+  WideBoxRay subBoxRay(int k, int row, int col) const {
+    return WideBoxRay(origin_, active_.body_from_sensor_rot * beams_.subDirection(k, row, col));
   }
 
   // A beam as a ray for the triangle tests: from the sensor, or for a sweep's block from its
@@ -244,6 +265,20 @@ class MeshWalk {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
         if (!(range >= e.near)) continue;  // a hit nearer than this node can be
+        if (bundle_) {
+          // Each sub-ray traced on its own: the boxes it enters are its own.
+          for (int k = 0; k < beams_.subRays(); ++k) {
+            double sub_tmax = std::min(config_.tmax, beams_.subRange(k, row, col));
+            if (!(sub_tmax >= e.near)) continue;
+            Best sub_best;
+            const auto ray = subRay(k, row, col);
+            traceWide(wide_, e.ref, subBoxRay(k, row, col), &sub_tmax, [&](std::uint32_t slot) {
+              if (!hidden(slot)) testSlot(ray, slot, &sub_tmax, &sub_best);
+            });
+            if (sub_best.found()) offerSub(k, row, col, sub_best);
+          }
+          continue;
+        }
         double tmax = std::min(config_.tmax, range);
         Best best;
         if (slicing_) {
@@ -310,19 +345,30 @@ class MeshWalk {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
         if (!(range >= e.near)) continue;
-        const auto ray = beamRay(row, col);
-        double tmax = std::min(config_.tmax, range);
-        Best best;
-        for (std::uint32_t i = 0; i < e.ref.count; ++i) {
-          const std::uint32_t slot = e.ref.index + i;
-          if (hidden(slot)) continue;
-          const SensorTriangle s = i < count ? tris[i] : sensorTriangle(slot);
-          const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
-          if (hit && best.improves(hit->t, ids_[slot])) {
-            best = Best{hit->t, ids_[slot], slot};
-            tmax = hit->t;
+        // The beam, or each of a bundle's sub-rays, against every triangle of the leaf.
+        auto testRay = [&](const PreparedRay<double, M>& ray, double tmax, Best* best) {
+          for (std::uint32_t i = 0; i < e.ref.count; ++i) {
+            const std::uint32_t slot = e.ref.index + i;
+            if (hidden(slot)) continue;
+            const SensorTriangle s = i < count ? tris[i] : sensorTriangle(slot);
+            const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
+            if (hit && best->improves(hit->t, ids_[slot])) {
+              *best = Best{hit->t, ids_[slot], slot};
+              tmax = hit->t;
+            }
           }
+        };
+        if (bundle_) {
+          for (int k = 0; k < beams_.subRays(); ++k) {
+            Best sub_best;
+            testRay(subRay(k, row, col), std::min(config_.tmax, beams_.subRange(k, row, col)),
+                    &sub_best);
+            if (sub_best.found()) offerSub(k, row, col, sub_best);
+          }
+          continue;
         }
+        Best best;
+        testRay(beamRay(row, col), std::min(config_.tmax, range), &best);
         if (best.found()) offer(row, col, best);
       }
     }
@@ -342,6 +388,17 @@ class MeshWalk {
         // hit it lets through beyond the exact range is turned down by keepNearestHit().
         const double range = beams_.rangeAbove(row)[col];
         if (!(range >= e.near)) return;
+        if (bundle_) {
+          for (int k = 0; k < beams_.subRays(); ++k) {
+            const auto hit = subRay(k, row, col).intersect(
+                s.a, s.b, s.c, std::min(config_.tmax, beams_.subRange(k, row, col)));
+            if (!hit) continue;
+            beams_.keepNearestSubHit(k, row, col, hit->t, active_.index,
+                                     static_cast<int>(triangle),
+                                     [&] { return columnNormal(col, triangle); });
+          }
+          return;
+        }
         const auto hit = beamRay(row, col).intersect(s.a, s.b, s.c, std::min(config_.tmax, range));
         if (!hit) return;
         beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
@@ -425,6 +482,7 @@ class MeshWalk {
   const Eigen::Matrix3d rot_, abs_rot_;
   const Eigen::Vector3d trans_;
   const ColumnMotion* motion_;  // a sweep's block, or null
+  const BeamSet::Bundle* bundle_ = beams_.bundle();  // a bundle's sub-rays, or null
   const Spread spread_;
   const bool planar_, slicing_, tracing_only_;
   SlotCache<SensorTriangle, 64> triangles_;

@@ -110,6 +110,21 @@ class BoxPrefilter {
 template <class Primitive>
 void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
               const CastConfig& config, int row, int col, double current) {
+  if (beams.bundle()) {
+    // Each of a bundle's sub-rays, from the sensor (its block's poses are the sensor's).
+    for (int k = 0; k < beams.subRays(); ++k) {
+      Ray ray;
+      ray.origin = a.sensor_in_body;
+      ray.dir = a.body_from_sensor_rot * beams.subDirection(k, row, col);
+      ray.tmin = config.tmin;
+      ray.tmax = std::min(config.tmax, beams.subRange(k, row, col));
+      const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
+      if (!hit) continue;
+      beams.keepNearestSubHit(k, row, col, hit->t, a.index, -1,
+                              [&] { return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal); });
+    }
+    return;
+  }
   Ray ray;
   ray.origin = a.sensor_in_body;
   ray.dir = a.body_from_sensor_rot * beams.grid().direction(row, col);

@@ -1,0 +1,130 @@
+// Caster::castBundle: the sub-ray patterns of divergent beams cast in one walk of the scene.
+//
+// A bundle is cast as a rotating sweep's block whose columns never move (every column's pose the
+// sensor's: beams/column_motion.h) but whose beams may turn from the culling pattern's directions
+// by the farthest a sub-ray lies from its beam: the walks widen every window by that turn (the
+// Spread of beams/beam_window.h), and wherever they would test a beam they test each of its
+// sub-rays exactly as a cast of the sub-ray's pattern tests it (BeamSet::Bundle), each keeping its
+// own nearest hit. So each result is that cast's, and the walk through the trees, the windows and
+// the occlusion culling are paid once for all the sub-rays.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "caster/caster_state.h"
+#include "laser_raycast/core/caster.h"
+#include "laser_raycast/core/pose.h"
+#include "walk/frame_walk.h"
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+// The rings of a pattern in ascending order, as indices into its elevations.
+std::vector<int> ringOrder(const ScanPattern& pattern) {
+  const std::vector<double>& e = pattern.elevations();
+  std::vector<int> order(e.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return e[a] < e[b]; });
+  return order;
+}
+
+// Throws std::invalid_argument unless the patterns can be cast as a bundle.
+void checkBundle(const std::vector<ScanPattern>& patterns) {
+  std::ostringstream msg;
+  if (patterns.empty()) {
+    msg << "castBundle: no patterns";
+  } else {
+    const ScanPattern& first = patterns.front();
+    const std::vector<int> order = ringOrder(first);
+    for (std::size_t k = 0; k < patterns.size() && msg.str().empty(); ++k) {
+      const ScanPattern& p = patterns[k];
+      if (p.planar()) {
+        msg << "castBundle: pattern " << k << " is planar (a bundle is cast in 3D; cast a planar "
+            << "fan's sub-rays one pattern at a time)";
+      } else if (p.ringCount() != first.ringCount() || p.azimuthCount() != first.azimuthCount()) {
+        msg << "castBundle: pattern " << k << " has " << p.ringCount() << " rings x "
+            << p.azimuthCount() << " azimuths, pattern 0 " << first.ringCount() << " x "
+            << first.azimuthCount();
+      } else if (ringOrder(p) != order) {
+        msg << "castBundle: pattern " << k << "'s rings are not in pattern 0's order";
+      }
+    }
+  }
+  if (!msg.str().empty()) throw std::invalid_argument(msg.str());
+}
+
+// The farthest any beam of a pattern lies from the culling pattern's beam at its row and column:
+// a beam at azimuth A + a, elevation E + e is within |e| + |a| of the one at (A, E) (along a
+// meridian by |e|, then along a parallel, whose arc |a| cos is at most |a|). The azimuth offset of
+// column c is the difference of the two fans' azimuths, the same for every column but for rounding.
+double bundleTurn(const std::vector<ScanPattern>& patterns) {
+  const ScanPattern& first = patterns.front();
+  const int last = first.azimuthCount() - 1;
+  double turn = 0;
+  for (const ScanPattern& p : patterns) {
+    double azimuth = std::max(std::abs(p.angleMin() - first.angleMin()),
+                              std::abs((p.angleMin() + last * p.angleIncrement()) -
+                                       (first.angleMin() + last * first.angleIncrement())));
+    double elevation = 0;
+    for (int r = 0; r < first.ringCount(); ++r) {
+      elevation = std::max(elevation, std::abs(p.elevations()[r] - first.elevations()[r]));
+    }
+    turn = std::max(turn, azimuth + elevation);
+  }
+  return turn * (1 + 1e-9);
+}
+
+}  // namespace
+
+const std::vector<ScanResult>& Caster::castBundle(const Scene& scene, const FramePoses& poses,
+                                                  const Eigen::Isometry3d& world_from_sensor,
+                                                  const std::vector<ScanPattern>& patterns,
+                                                  const CastConfig& config) {
+  config.validate();
+  checkFramePoses(scene, poses);
+  checkBundle(patterns);
+  forget();  // result_ is only the bundle's culling ranges now
+  const ScanPattern& culling = patterns.front();
+  const bool sensor_ok = isValidPose(world_from_sensor);
+  const int bodies = static_cast<int>(scene.bodies().size());
+  std::vector<ScanResult>& results = state_->bundle;
+  results.resize(patterns.size());
+  for (ScanResult& r : results) resetResult(culling.size(), bodies, sensor_ok, config.compute_incidence, &r);
+  resetResult(culling.size(), bodies, sensor_ok, false, &result_);
+  if (!sensor_ok) return results;
+
+  const ReuseKey key = relativeInputs(scene, poses, world_from_sensor, culling, config);
+  state_->placeGroups(scene, key, culling, &state_->placed, &result_.stats.bodies_skipped);
+  double steepest = 0;
+  for (double e : culling.elevations()) steepest = std::max(steepest, std::abs(e));
+  const ColumnMotion motion(
+      0, std::vector<Eigen::Isometry3d>(culling.azimuthCount(), Eigen::Isometry3d::Identity()),
+      steepest, bundleTurn(patterns));
+  BeamSet::Bundle bundle;
+  for (std::size_t k = 0; k < patterns.size(); ++k) {
+    bundle.patterns.push_back(&patterns[k]);
+    bundle.results.push_back(&results[k]);
+  }
+  state_->castOnThreads(
+      scene, culling, config, &result_,
+      [&](const BeamRect& within) {
+        for (const PlacedGroup& p : state_->placed) {
+          walkFrame(state_->beams, scene, *p.group, *p.sensor_from_frame, config, within,
+                    &state_->cast, &motion);
+        }
+      },
+      &bundle);
+  for (std::size_t k = 0; k < patterns.size(); ++k) {
+    results[k].stats = result_.stats;
+    if (config.compute_incidence) computeIncidence(patterns[k], &results[k]);
+  }
+  return results;
+}
+
+}  // namespace core
+}  // namespace laser_raycast
