@@ -10,6 +10,7 @@
 
 #include "bench_paths.h"
 #include "laser_raycast/core/pattern_file.h"
+#include "laser_raycast/core/returns.h"
 #include "laser_raycast/core/velodyne_beams.h"
 #include "laser_raycast/loader/ouster_metadata.h"
 
@@ -93,6 +94,15 @@ Pass pipelinePass(const BenchScene& scene, int threads, bool keep_slices) {
     const std::size_t beams = static_cast<std::size_t>(w.beamCount());
     for (std::size_t p = 0; p < w.scans(); ++p) {
       caster->forget();
+      if (!w.sub_patterns.empty()) {
+        // Divergent beams: every sub-ray pattern in one bundle, as castReturns casts them.
+        const std::vector<core::ScanResult>& results =
+            caster->castBundle(scene.scene, scene.frame_poses, w.sensors[p], w.sub_patterns,
+                               config);
+        auto at = out->begin() + p * beams;
+        for (const core::ScanResult& r : results) at = std::copy(r.range.begin(), r.range.end(), at);
+        continue;
+      }
       const core::ScanResult& result =
           w.offGrid()
               ? caster->castBeams(scene.scene, scene.frame_poses, w.sensors[p], w.beams, config)
@@ -227,6 +237,11 @@ const std::vector<Workload>& workloads() {
     tilted.tilt_sigma = 0.4 * kDeg;
     all.push_back(tilted);
     all.push_back(moving("rings_path", fullTurn(1800), vlp16Rings(), Motion::kPath, 10, 30, 2));
+    Workload divergent =
+        moving("rings_divergent", fullTurn(1800), vlp16Rings(), Motion::kPath, 10, 30, 2);
+    divergent.beam_samples = 7;
+    divergent.beam_divergence = 0.003;
+    all.push_back(divergent);
     all.push_back(moving("sweep_fan", fullTurn(360), {0.0}, Motion::kSweep, 5, 40, 3));
     all.push_back(moving("sweep_rings", fullTurn(1800), vlp16Rings(), Motion::kSweep, 10, 20, 1));
     Workload rosette = stillWorkloads()[1];
@@ -260,6 +275,23 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
     w.beams = file.scan(0, file.size(), 1.0);
   }
   if (workload.calibrated_vlp16) w.beams = core::nominalVlp16().scan(0.1);
+  if (workload.beam_samples > 1) {
+    // As castReturns shifts the pattern for each sub-ray.
+    core::ReturnsConfig returns;
+    returns.beam_samples = workload.beam_samples;
+    returns.beam_divergence = workload.beam_divergence;
+    for (int k = 0; k < workload.beam_samples; ++k) {
+      const Eigen::Vector2d offset = returns.offset(k);
+      core::FanSpec shifted = workload.fan;
+      shifted.angle_min += offset.x();
+      shifted.angle_max += offset.x();
+      std::vector<double> rings = workload.elevations;
+      for (double& e : rings) e = std::clamp(e + offset.y(), -M_PI / 2, M_PI / 2);
+      w.sub_patterns.emplace_back(shifted, rings);
+      const auto& d = w.sub_patterns.back().directions();
+      w.beams.directions.insert(w.beams.directions.end(), d.begin(), d.end());
+    }
+  }
   if (!workload.ouster_metadata.empty()) {
     w.beams = loadOusterMetadata(std::string(LASER_RAYCAST_SOURCE_DIR "/config/ouster/") +
                                  workload.ouster_metadata)

@@ -43,6 +43,11 @@ struct Workload {
   // its columns, each row at its own azimuth offset and from its beam origin), by
   // Caster::castBeams; "" for none.
   std::string ouster_metadata;
+  // Divergent beams: each beam of the fan and elevations as this many sub-rays over a footprint of
+  // this full angle (core::ReturnsConfig's pattern), all cast from each pose by
+  // Caster::castBundle; 1: the ideal ray.
+  int beam_samples = 1;
+  double beam_divergence = 0;  // rad
 };
 
 // Still, from the scene's sensor poses: fan2d, 1081 beams over 270 degrees; rings3d, 64 rings
@@ -53,7 +58,9 @@ struct Workload {
 // sweep_rings, a rotating VLP-16 at 10 Hz. Still, beams off any grid: pattern_rosette, the
 // 10000 points of config/patterns/rosette_4line.csv (a Livox-like rosette) from the scene's poses;
 // vlp16_calibrated, a VLP-16's 1808 x 16 beams as a calibrated head fires them; os1_64_metadata,
-// the 1024 x 64 beams of config/ouster/os1_64_nominal.json.
+// the 1024 x 64 beams of config/ouster/os1_64_nominal.json. Moving, divergent: rings_divergent,
+// rings_path's VLP-16 with each beam 7 sub-rays over a 3 mrad footprint (the VLS-128 manual's
+// horizontal divergence), 7 x 28,800 rays a scan.
 const std::vector<Workload>& workloads();
 
 // Every beam of a workload from each sensor pose, pose-major, as the triangle methods and peers get
@@ -63,6 +70,9 @@ struct WorkloadRays {
   const Workload* workload = nullptr;
   std::unique_ptr<core::ScanPattern> pattern;  // the grid (a pattern file's workload: unused)
   core::BeamList beams;  // a pattern file's beams (Workload::pattern_file), else empty
+  // Divergent beams (Workload::beam_samples > 1): the sub-ray patterns, whose directions, pattern
+  // after pattern, are also beams' (so that the peers cast each sub-ray as a ray of its own).
+  std::vector<core::ScanPattern> sub_patterns;
   std::vector<SensorPose> poses;
   std::vector<Eigen::Isometry3d> sensors;  // the poses rounded to double (what the pipeline gets)
   std::vector<core::Ray> rays;

@@ -85,6 +85,7 @@ const std::map<std::string, long> kWorkloadBeams = {{"fan2d", 1081},
                                                     {"fan_path", 1081},
                                                     {"fan_path_tilted", 1081},
                                                     {"rings_path", 16 * 1800},
+                                                    {"rings_divergent", 7 * 16 * 1800},
                                                     {"sweep_fan", 360},
                                                     {"sweep_rings", 16 * 1800},
                                                     {"pattern_rosette", 10000},
@@ -280,8 +281,8 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  // header, 5 still workloads x 2 rows, 5 moving ones x the pipeline's row
-  ASSERT_EQ(lines.size(), 16u) << readFile(dir + "/results.csv");
+  // header, 5 still workloads x 2 rows, 6 moving ones x the pipeline's row
+  ASSERT_EQ(lines.size(), 17u) << readFile(dir + "/results.csv");
   std::multiset<std::string> rows;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const auto f = splitFields(lines[i]);
@@ -292,7 +293,8 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
   EXPECT_EQ(rows, (std::multiset<std::string>{
                       "fan2d watertight_bvh", "fan2d pipeline", "rings3d watertight_bvh",
                       "rings3d pipeline", "fan_path pipeline", "fan_path_tilted pipeline",
-                      "rings_path pipeline", "sweep_fan pipeline", "sweep_rings pipeline",
+                      "rings_path pipeline", "rings_divergent pipeline", "sweep_fan pipeline",
+                      "sweep_rings pipeline",
                       "pattern_rosette watertight_bvh", "pattern_rosette pipeline",
                       "vlp16_calibrated watertight_bvh", "vlp16_calibrated pipeline",
                       "os1_64_metadata watertight_bvh", "os1_64_metadata pipeline"}));
@@ -336,9 +338,9 @@ TEST(BenchSmoke, NewPlaneRowHasThePipelinesRanges) {
       " --quick --scene forest --method pipeline pipeline_new_plane --out " + dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  // header, fan2d x 2 rows, rings3d x 1 row, the pipeline's 5 moving rows, then one row each of
+  // header, fan2d x 2 rows, rings3d x 1 row, the pipeline's 6 moving rows, then one row each of
   // pattern_rosette, vlp16_calibrated and os1_64_metadata
-  ASSERT_EQ(lines.size(), 12u) << readFile(dir + "/results.csv");
+  ASSERT_EQ(lines.size(), 13u) << readFile(dir + "/results.csv");
   const auto kept = splitFields(lines[1]), fresh = splitFields(lines[2]);
   ASSERT_EQ(kept.size(), kFields);
   ASSERT_EQ(fresh.size(), kFields);
@@ -362,7 +364,7 @@ TEST(BenchSmoke, ThreadsAddsAPipelineRowWithTheSameRanges) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  ASSERT_EQ(lines.size(), 21u) << readFile(dir + "/results.csv");  // header, 10 workloads x 2
+  ASSERT_EQ(lines.size(), 23u) << readFile(dir + "/results.csv");  // header, 11 workloads x 2
   for (std::size_t i = 1; i + 1 < lines.size(); i += 2) {
     const auto one = splitFields(lines[i]), two = splitFields(lines[i + 1]);
     ASSERT_EQ(one.size(), kFields) << lines[i];
@@ -409,7 +411,7 @@ TEST(BenchSmoke, MovingRowsAreTheSameInEveryRun) {
       EXPECT_EQ(a[k], b[k]) << "field " << k << ": " << runs[0][i] << " / " << runs[1][i];
     }
   }
-  EXPECT_EQ(moving, 5);
+  EXPECT_EQ(moving, 6);
 }
 
 }  // namespace
