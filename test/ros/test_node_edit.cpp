@@ -76,7 +76,9 @@ class Scans {
     labels_sub_ = nh_.subscribe("scan_labels", kKept, &Scans::onLabels, this);
   }
 
-  // The first scan stamped after t.
+  // The first scan stamped after t whose labels come too: the two topics connect one after the
+  // other, so a scan published before the labels' connection is up never gets its labels here;
+  // once a labels message has arrived, every later scan's labels follow it.
   sensor_msgs::LaserScan after(const ros::Time& t) {
     const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(20.0);
     while (ros::ok() && ros::WallTime::now() < give_up) {
@@ -84,7 +86,10 @@ class Scans {
       {
         std::lock_guard<std::mutex> lock(mutex_);
         for (const auto& scan : scans_) {
-          if (scan.header.stamp > t) return scan;
+          if (scan.header.stamp > t && !labels_.empty() &&
+              scan.header.stamp >= labels_.front().header.stamp) {
+            return scan;
+          }
         }
       }
       ros::WallDuration(0.005).sleep();
