@@ -276,20 +276,14 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
   }
   if (workload.calibrated_vlp16) w.beams = core::nominalVlp16().scan(0.1);
   if (workload.beam_samples > 1) {
-    // As castReturns shifts the pattern for each sub-ray.
+    // The sub-ray patterns castReturns casts.
     core::ReturnsConfig returns;
     returns.beam_samples = workload.beam_samples;
     returns.beam_divergence = workload.beam_divergence;
-    for (int k = 0; k < workload.beam_samples; ++k) {
-      const Eigen::Vector2d offset = returns.offset(k);
-      core::FanSpec shifted = workload.fan;
-      shifted.angle_min += offset.x();
-      shifted.angle_max += offset.x();
-      std::vector<double> rings = workload.elevations;
-      for (double& e : rings) e = std::clamp(e + offset.y(), -M_PI / 2, M_PI / 2);
-      w.sub_patterns.emplace_back(shifted, rings);
-      const auto& d = w.sub_patterns.back().directions();
-      w.beams.directions.insert(w.beams.directions.end(), d.begin(), d.end());
+    w.sub_patterns = core::subRayPatterns(workload.fan, workload.elevations, returns);
+    for (const core::ScanPattern& p : w.sub_patterns) {
+      w.beams.directions.insert(w.beams.directions.end(), p.directions().begin(),
+                                p.directions().end());
     }
   }
   if (!workload.ouster_metadata.empty()) {

@@ -66,6 +66,11 @@ struct PulseReturns {
   } sub_rays;
 };
 
+// The pattern of each sub-ray k of returns (returns.offset(k)): (fan, elevations) shifted by its
+// azimuth and elevation offsets, the elevations clamped at the poles.
+std::vector<ScanPattern> subRayPatterns(const FanSpec& fan, const std::vector<double>& elevations,
+                                        const ReturnsConfig& returns);
+
 // Casts the beam_samples shifted patterns from world_from_sensor and forms the returns. The
 // reflectance of each sub-ray hit is the surface's (sampleSurfaces, with reflectance_from_color and
 // label_fixed) where it gives one, else reflectivity[label] (missing entries 1). config's

@@ -68,6 +68,23 @@ Eigen::Vector2d ReturnsConfig::offset(int k) const {
   return Eigen::Vector2d(radius * std::cos(angle), radius * std::sin(angle));
 }
 
+std::vector<ScanPattern> subRayPatterns(const FanSpec& fan, const std::vector<double>& elevations,
+                                        const ReturnsConfig& returns) {
+  std::vector<ScanPattern> patterns;
+  patterns.reserve(returns.beam_samples);
+  for (int k = 0; k < returns.beam_samples; ++k) {
+    const Eigen::Vector2d offset = returns.offset(k);
+    FanSpec shifted = fan;
+    shifted.angle_min += offset.x();
+    shifted.angle_max += offset.x();
+    std::vector<double> rings = elevations;
+    // Clamped at the poles: a sub-ray cannot lean past straight up or down.
+    for (double& e : rings) e = std::clamp(e + offset.y(), -M_PI / 2, M_PI / 2);
+    patterns.emplace_back(shifted, rings);
+  }
+  return patterns;
+}
+
 void castReturns(Caster* caster, const Scene& scene, const FramePoses& poses,
                  const Eigen::Isometry3d& world_from_sensor, const FanSpec& fan,
                  const std::vector<double>& elevations, const CastConfig& config,
@@ -90,18 +107,7 @@ void castReturns(Caster* caster, const Scene& scene, const FramePoses& poses,
                         sub.fan.samples == fan.samples;
   if (!(same_fan && sub.elevations == elevations &&
         sub.divergence == returns.beam_divergence && sub.samples == samples)) {
-    sub.patterns.clear();
-    sub.patterns.reserve(samples);
-    for (int k = 0; k < samples; ++k) {
-      const Eigen::Vector2d offset = returns.offset(k);
-      FanSpec shifted = fan;
-      shifted.angle_min += offset.x();
-      shifted.angle_max += offset.x();
-      std::vector<double> rings = elevations;
-      // Clamped at the poles: a sub-ray cannot lean past straight up or down.
-      for (double& e : rings) e = std::clamp(e + offset.y(), -M_PI / 2, M_PI / 2);
-      sub.patterns.emplace_back(shifted, rings);
-    }
+    sub.patterns = subRayPatterns(fan, elevations, returns);
     sub.fan = fan;
     sub.elevations = elevations;
     sub.divergence = returns.beam_divergence;
