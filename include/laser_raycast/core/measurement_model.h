@@ -53,6 +53,11 @@ struct MeasurementConfig {
 
   // Whether the measurement needs each hit's reflectance and incidence.
   bool needsIncidence() const { return intensity || detection_range > 0; }
+  // No bias, noise, quantization, dropout or detection limit: a measured range is the cast's.
+  bool isIdeal() const {
+    return range_bias == 0 && noise_stddev == 0 && range_resolution == 0 &&
+           dropout_probability == 0 && detection_range == 0;
+  }
 
   // Throws std::invalid_argument naming the field and its value.
   void validate() const;

@@ -123,6 +123,16 @@ void MeasurementModel::measure(const Scene& scene, const ScanResult& result,
     out->intensities.clear();
   }
   constexpr double kNoReturn = std::numeric_limits<double>::infinity();
+  if (!radiometry && config_.isIdeal()) {
+    // Nothing to degrade or detect (the defaults): a valid range is kept as it is, which is what
+    // degrade() returns for it (classifyRange keeps only ranges in [range_min, range_max]).
+    for (std::size_t i = 0; i < n; ++i) {
+      const int body = result.body[i];
+      out->labels[i] = body >= 0 ? scene.bodies()[body].label : -1;
+      out->ranges[i] = static_cast<float>(classifyRange(result.range[i], config_));
+    }
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const int body = result.body[i];
     const int label = body >= 0 ? scene.bodies()[body].label : -1;
