@@ -61,7 +61,6 @@ void ColumnRaster::init(const BeamSet& beams, const Eigen::Vector3d& a, const Ei
          !(abs_det > kSmallest) || !(widen < 0.5);
   if (all_) return;
   const double sign = det > 0 ? 1 : -1;
-  const __m128 ones = _mm_castsi128_ps(_mm_set1_epi32(-1)), none = _mm_setzero_ps();
   // The edges whose cross product with a column's origin moves m (m - o x e).
   const Eigen::Vector3d e[3] = {c - b, a - c, b - a};
   double moves = 0;  // the most |o x e|_2 <= shift |e|_1 moves a scaled normal
@@ -71,16 +70,18 @@ void ColumnRaster::init(const BeamSet& beams, const Eigen::Vector3d& a, const Ei
     mx_[k] = _mm_set1_ps(static_cast<float>(m[k].x() * scale));
     my_[k] = _mm_set1_ps(static_cast<float>(m[k].y() * scale));
     inv_mz_[k] = _mm_set1_ps(z != 0 ? 1 / z : 0.0f);
-    lower_[k] = z > 0 ? ones : none;
-    upper_[k] = z < 0 ? ones : none;
-    flat_[k] = z == 0 ? ones : none;
+    kind_[k] = z > 0 ? EdgeKind::kLower : z < 0 ? EdgeKind::kUpper : EdgeKind::kFlat;
     if (motion_) {
       const Eigen::Vector3d scaled = e[k] * scale;
       mz_[k] = _mm_set1_ps(z);
       ex_[k] = _mm_set1_ps(static_cast<float>(scaled.x()));
       ey_[k] = _mm_set1_ps(static_cast<float>(scaled.y()));
       ez_[k] = _mm_set1_ps(static_cast<float>(scaled.z()));
-      moves = std::max(moves, shift * scaled.lpNorm<1>());
+      const double edge_moves = shift * scaled.lpNorm<1>();
+      moves = std::max(moves, edge_moves);
+      // Every column's m_z = z - (o x e)_z, which moves by at most edge_moves: with room to
+      // spare for float, its sign is the reference's in every column.
+      column_kind_[k] = std::abs(z) > 2 * edge_moves * (1 + 1e-6) ? kind_[k] : EdgeKind::kAny;
     }
   }
   // A column's normal's |m'|_1 <= 1 + |o x e|_1 <= 1 + sqrt(3) |o x e|_2.

@@ -111,12 +111,17 @@ class ColumnRaster {
   bool all_ = false;  // seen edge-on, or too small for float: every beam of the rect is a candidate
   // Per edge: (m_x, m_y) scaled, and what the bound on tan E does: lower (m_z > 0), upper
   // (m_z < 0) or nothing (m_z = 0: the edge decides by h(A) alone).
-  __m128 mx_[3], my_[3], inv_mz_[3], lower_[3], upper_[3], flat_[3];
+  // What an edge's bound on tan E is: lower (m_z > 0), upper (m_z < 0), none (m_z = 0: h decides
+  // alone), or any of these by column (kAny: a column's own normal may change the sign).
+  enum class EdgeKind : char { kLower, kUpper, kFlat, kAny };
+  __m128 mx_[3], my_[3], inv_mz_[3];
+  EdgeKind kind_[3];
   __m128 edge_margin_;  // the margin over the smallest cos E of the pattern
   // Following the columns' origins: the block, each edge's m_z scaled and its (c - b, a - c,
   // b - a) scaled as m is.
   const ColumnMotion* motion_ = nullptr;
   __m128 mz_[3], ex_[3], ey_[3], ez_[3];
+  EdgeKind column_kind_[3];  // kLower or kUpper where every column's m_z has the reference's sign
   // The margin of the reference's normals that lets through every column whose own normals do:
   // edge_margin_ plus the most any normal moves (|o x e|_2 <= shift |e|_1), a first cheap test.
   __m128 reference_margin_;
@@ -194,20 +199,39 @@ inline void ColumnRaster::referenceBounds(__m128 ca, __m128 sa, __m128 margin, _
                                           __m128* hi) const {
   const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
   const __m128 neg_margin = _mm_sub_ps(_mm_setzero_ps(), margin);
-  *lo = _mm_sub_ps(_mm_setzero_ps(), inf);
-  *hi = inf;
+  __m128 l = _mm_sub_ps(_mm_setzero_ps(), inf), u = inf;
+  // As edgeBounds with every column's masks equal (the reference's normals): each edge bounds
+  // one side, or, flat, keeps a column by h alone. The kind is the same for every group of the
+  // triangle, so the branch is predicted.
   for (int k = 0; k < 3; ++k) {
-    edgeBounds(_mm_add_ps(_mm_mul_ps(mx_[k], ca), _mm_mul_ps(my_[k], sa)), inv_mz_[k], lower_[k],
-               upper_[k], flat_[k], neg_margin, lo, hi);
+    const __m128 h = _mm_add_ps(_mm_mul_ps(mx_[k], ca), _mm_mul_ps(my_[k], sa));
+    switch (kind_[k]) {
+      case EdgeKind::kLower:
+        l = _mm_max_ps(l, _mm_mul_ps(_mm_sub_ps(neg_margin, h), inv_mz_[k]));
+        break;
+      case EdgeKind::kUpper:
+        u = _mm_min_ps(u, _mm_mul_ps(_mm_sub_ps(neg_margin, h), inv_mz_[k]));
+        break;
+      case EdgeKind::kFlat: {
+        const __m128 out = _mm_cmplt_ps(h, neg_margin);
+        l = _mm_or_ps(_mm_and_ps(out, inf), _mm_andnot_ps(out, l));
+        break;
+      }
+      case EdgeKind::kAny:  // never the reference's
+        break;
+    }
   }
+  *lo = l;
+  *hi = u;
 }
 
-inline void ColumnRaster::columnBounds(int base, __m128 ca, __m128 sa, __m128* lo,
-                                       __m128* hi) const {
+inline void ColumnRaster::columnBounds(int base, __m128 ca, __m128 sa, __m128* lo_out,
+                                       __m128* hi_out) const {
   const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
   const __m128 zero = _mm_setzero_ps(), neg_margin = _mm_sub_ps(zero, edge_margin_);
-  *lo = _mm_sub_ps(zero, inf);
-  *hi = inf;
+  // Kept in registers until the end (written through the pointers, every step would be stored
+  // and loaded again).
+  __m128 lo = _mm_sub_ps(zero, inf), hi = inf;
   const __m128 ox = _mm_loadu_ps(motion_->originX(base));
   const __m128 oy = _mm_loadu_ps(motion_->originY(base));
   const __m128 oz = _mm_loadu_ps(motion_->originZ(base));
@@ -219,12 +243,24 @@ inline void ColumnRaster::columnBounds(int base, __m128 ca, __m128 sa, __m128* l
         _mm_sub_ps(my_[k], _mm_sub_ps(_mm_mul_ps(oz, ex_[k]), _mm_mul_ps(ox, ez_[k])));
     const __m128 mz =
         _mm_sub_ps(mz_[k], _mm_sub_ps(_mm_mul_ps(ox, ey_[k]), _mm_mul_ps(oy, ex_[k])));
+    const __m128 h = _mm_add_ps(_mm_mul_ps(mx, ca), _mm_mul_ps(my, sa));
+    // As edgeBounds does it, without the masks where every column bounds the same side.
+    if (column_kind_[k] == EdgeKind::kLower) {
+      lo = _mm_max_ps(lo, _mm_mul_ps(_mm_sub_ps(neg_margin, h), _mm_div_ps(_mm_set1_ps(1.0f), mz)));
+      continue;
+    }
+    if (column_kind_[k] == EdgeKind::kUpper) {
+      hi = _mm_min_ps(hi, _mm_mul_ps(_mm_sub_ps(neg_margin, h), _mm_div_ps(_mm_set1_ps(1.0f), mz)));
+      continue;
+    }
     const __m128 flat = _mm_cmpeq_ps(mz, zero);
     // 1 / m_z where it is not 0 (there the bound is not used).
     const __m128 inv_mz = _mm_andnot_ps(flat, _mm_div_ps(_mm_set1_ps(1.0f), mz));
-    edgeBounds(_mm_add_ps(_mm_mul_ps(mx, ca), _mm_mul_ps(my, sa)), inv_mz, _mm_cmpgt_ps(mz, zero),
-               _mm_cmplt_ps(mz, zero), flat, neg_margin, lo, hi);
+    edgeBounds(h, inv_mz, _mm_cmpgt_ps(mz, zero), _mm_cmplt_ps(mz, zero), flat, neg_margin, &lo,
+               &hi);
   }
+  *lo_out = lo;
+  *hi_out = hi;
 }
 
 template <class F>
@@ -232,14 +268,29 @@ void ColumnRaster::scanRows(const BeamSet& beams, const BeamRect& rect, const Gr
                             F&& f) const {
   const __m128 margin = _mm_set1_ps(along_margin_), distance = _mm_set1_ps(plane_distance_);
   const __m128 nz = _mm_set1_ps(nz_);
-  for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-    const __m128 tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(row));
-    const __m128 tan_hi = _mm_set1_ps(beams.grid().rowTanAbove(row));
-    const __m128 cos_e = _mm_set1_ps(beams.grid().rowCos(row));
-    const __m128 z = _mm_mul_ps(nz, _mm_set1_ps(beams.grid().rowSin(row)));
-    const float* range = beams.rangeAbove(row);
-    for (int i = 0; i < n; ++i) {
-      const Group& g = groups[i];
+  for (int i = 0; i < n; ++i) {
+    const Group& g = groups[i];
+    // Only the rows some column's bounds hold: a triangle thinner than the rows' spacing (a
+    // shelf's edge between two rings) often holds none of a rect's rows.
+    alignas(16) float lo_v[4], hi_v[4];
+    _mm_store_ps(lo_v, g.lo);
+    _mm_store_ps(hi_v, g.hi);
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (int mask = g.mask; mask; mask &= mask - 1) {
+      const int j = __builtin_ctz(static_cast<unsigned>(mask));
+      lo = std::min(lo, lo_v[j]);
+      hi = std::max(hi, hi_v[j]);
+    }
+    int row_lo, row_hi;
+    beams.grid().rowsWithTan(lo, hi, &row_lo, &row_hi);
+    row_lo = std::max(row_lo, rect.row_lo);
+    row_hi = std::min(row_hi, rect.row_hi);
+    for (int row = row_lo; row <= row_hi; ++row) {
+      const __m128 tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(row));
+      const __m128 tan_hi = _mm_set1_ps(beams.grid().rowTanAbove(row));
+      const __m128 cos_e = _mm_set1_ps(beams.grid().rowCos(row));
+      const __m128 z = _mm_mul_ps(nz, _mm_set1_ps(beams.grid().rowSin(row)));
+      const float* range = beams.rangeAbove(row);
       // The row's tan E within the column's bounds, as scanColumns looks rows up: for a float
       // bound x, tan E >= x exactly iff tan E rounded down is, and <= x iff rounded up is. And
       // not clearly beyond the beam's range; written so that a NaN range is never held back.
