@@ -268,29 +268,14 @@ void ColumnRaster::scanRows(const BeamSet& beams, const BeamRect& rect, const Gr
                             F&& f) const {
   const __m128 margin = _mm_set1_ps(along_margin_), distance = _mm_set1_ps(plane_distance_);
   const __m128 nz = _mm_set1_ps(nz_);
-  for (int i = 0; i < n; ++i) {
-    const Group& g = groups[i];
-    // Only the rows some column's bounds hold: a triangle thinner than the rows' spacing (a
-    // shelf's edge between two rings) often holds none of a rect's rows.
-    alignas(16) float lo_v[4], hi_v[4];
-    _mm_store_ps(lo_v, g.lo);
-    _mm_store_ps(hi_v, g.hi);
-    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    for (int mask = g.mask; mask; mask &= mask - 1) {
-      const int j = __builtin_ctz(static_cast<unsigned>(mask));
-      lo = std::min(lo, lo_v[j]);
-      hi = std::max(hi, hi_v[j]);
-    }
-    int row_lo, row_hi;
-    beams.grid().rowsWithTan(lo, hi, &row_lo, &row_hi);
-    row_lo = std::max(row_lo, rect.row_lo);
-    row_hi = std::min(row_hi, rect.row_hi);
-    for (int row = row_lo; row <= row_hi; ++row) {
-      const __m128 tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(row));
-      const __m128 tan_hi = _mm_set1_ps(beams.grid().rowTanAbove(row));
-      const __m128 cos_e = _mm_set1_ps(beams.grid().rowCos(row));
-      const __m128 z = _mm_mul_ps(nz, _mm_set1_ps(beams.grid().rowSin(row)));
-      const float* range = beams.rangeAbove(row);
+  for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
+    const __m128 tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(row));
+    const __m128 tan_hi = _mm_set1_ps(beams.grid().rowTanAbove(row));
+    const __m128 cos_e = _mm_set1_ps(beams.grid().rowCos(row));
+    const __m128 z = _mm_mul_ps(nz, _mm_set1_ps(beams.grid().rowSin(row)));
+    const float* range = beams.rangeAbove(row);
+    for (int i = 0; i < n; ++i) {
+      const Group& g = groups[i];
       // The row's tan E within the column's bounds, as scanColumns looks rows up: for a float
       // bound x, tan E >= x exactly iff tan E rounded down is, and <= x iff rounded up is. And
       // not clearly beyond the beam's range; written so that a NaN range is never held back.
