@@ -233,12 +233,28 @@ void buildPointCloud(const core::ScanPattern& pattern, const core::MeasuredScan&
   checkSizes(pattern, scan, column_times, options.layout);
   if (last) checkSizes(pattern, *last, column_times, options.layout);
   const int azimuths = pattern.azimuthCount();
+  // fillCloud asks for beams in ascending order: their ring and column follow by counting, with
+  // no division per point.
+  int row = 0, row_start = 0;
+  auto locate = [&](int b) {
+    while (b >= row_start + azimuths) {
+      ++row;
+      row_start += azimuths;
+    }
+    return b - row_start;
+  };
   fillCloud(
       pattern.size(), pattern.ringCount(), azimuths, scan, header, options, [](int p) { return p; },
       [&](int b, double range) -> Eigen::Vector3d { return pattern.directions()[b] * range; },
-      [&](int b) { return b / azimuths; },
-      [&](int b) { return column_times.empty() ? 0.0 : column_times[b % azimuths]; }, cloud,
-      last);
+      [&](int b) {
+        locate(b);
+        return row;
+      },
+      [&](int b) {
+        const int col = locate(b);
+        return column_times.empty() ? 0.0 : column_times[col];
+      },
+      cloud, last);
 }
 
 void buildBeamCloud(const core::BeamList& beams, const core::MeasuredScan& scan,
