@@ -106,6 +106,9 @@ void BeamGrid::prepareRows() {
     row_tan_below_.push_back(floatBelow(t));
     row_tan_above_.push_back(floatAbove(t));
   }
+  // Room to read kRowBlock values from any row (NaN: no comparison holds).
+  row_tan_below_.resize(row_tan_below_.size() + kRowBlock, std::numeric_limits<float>::quiet_NaN());
+  row_tan_above_.resize(row_tan_above_.size() + kRowBlock, std::numeric_limits<float>::quiet_NaN());
   row_elevation_.build(std::move(elevations));
   row_tan_.build(std::move(tangents));
   column_cos_.assign(padded_cols_, 0.0f);

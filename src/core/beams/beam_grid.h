@@ -125,6 +125,11 @@ class BeamGrid {
   // A row's tan of the elevation rounded to float down and up.
   float rowTanBelow(int row) const { return row_tan_below_[row]; }
   float rowTanAbove(int row) const { return row_tan_above_[row]; }
+  // The same from row on, readable kRowBlock values on from any row (those past the last row are
+  // NaN).
+  static constexpr int kRowBlock = 16;
+  const float* rowTansBelow(int row) const { return row_tan_below_.data() + row; }
+  const float* rowTansAbove(int row) const { return row_tan_above_.data() + row; }
   void rowsWithTan(double lo, double hi, int* row_lo, int* row_hi) const {
     row_tan_.find(lo, hi, row_lo, row_hi);
   }

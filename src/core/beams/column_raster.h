@@ -76,6 +76,7 @@ class ColumnRaster {
   // Rects of fewer rows than this are scanned row by row, four columns at a time; taller ones
   // column by column, each column's rows looked up from its bounds. Only speed depends on it.
   static constexpr int kRowMajorRows = 16;
+  static_assert(kRowMajorRows <= BeamGrid::kRowBlock, "scanRows reads a rect's rows at once");
   // Four columns' bounds on tan E, their h(A) for the plane, and which of them are candidates.
   struct Group {
     __m128 lo, hi, hn;
@@ -263,19 +264,53 @@ inline void ColumnRaster::columnBounds(int base, __m128 ca, __m128 sa, __m128* l
   *hi_out = hi;
 }
 
+// All ones in the lanes of the bits of mask (bit j: lane j).
+inline __m128 laneMask(int mask) {
+  return _mm_castsi128_ps(_mm_cmpeq_epi32(
+      _mm_and_si128(_mm_set1_epi32(mask), _mm_setr_epi32(1, 2, 4, 8)), _mm_setr_epi32(1, 2, 4, 8)));
+}
+
+// The rows of rect (at most BeamGrid::kRowBlock) whose tan E lies within [lo, hi], as a bit mask
+// (bit i: row rect.row_lo + i), four rows a compare, no branches.
+inline unsigned rowsWithin(const BeamGrid& grid, const BeamRect& rect, __m128 lo, __m128 hi) {
+  const float* below = grid.rowTansBelow(rect.row_lo);
+  const float* above = grid.rowTansAbove(rect.row_lo);
+  const int rows = rect.row_hi - rect.row_lo + 1;
+  unsigned mask = 0;
+  for (int i = 0; i < rows; i += 4) {
+    const __m128 in = _mm_and_ps(_mm_cmpge_ps(_mm_loadu_ps(below + i), lo),
+                                 _mm_cmple_ps(_mm_loadu_ps(above + i), hi));
+    mask |= static_cast<unsigned>(_mm_movemask_ps(in)) << i;
+  }
+  return mask & ((2u << (rows - 1)) - 1);
+}
+
 template <class F>
 void ColumnRaster::scanRows(const BeamSet& beams, const BeamRect& rect, const Group* groups, int n,
                             F&& f) const {
   const __m128 margin = _mm_set1_ps(along_margin_), distance = _mm_set1_ps(plane_distance_);
   const __m128 nz = _mm_set1_ps(nz_);
-  for (int row = rect.row_lo; row <= rect.row_hi; ++row) {
-    const __m128 tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(row));
-    const __m128 tan_hi = _mm_set1_ps(beams.grid().rowTanAbove(row));
-    const __m128 cos_e = _mm_set1_ps(beams.grid().rowCos(row));
-    const __m128 z = _mm_mul_ps(nz, _mm_set1_ps(beams.grid().rowSin(row)));
-    const float* range = beams.rangeAbove(row);
-    for (int i = 0; i < n; ++i) {
-      const Group& g = groups[i];
+  const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  for (int i = 0; i < n; ++i) {
+    const Group& g = groups[i];
+    // Only the rows within some column's bounds (a triangle thinner than the rows' spacing, as a
+    // shelf's edge between two rings, holds none of them): the smallest lo and largest hi of the
+    // group's columns, the others' lanes set to +inf and -inf (and a column with a NaN bound,
+    // which no row's test passes).
+    const __m128 keep = _mm_and_ps(laneMask(g.mask), _mm_cmpord_ps(g.lo, g.hi));
+    __m128 lo = _mm_or_ps(_mm_and_ps(keep, g.lo), _mm_andnot_ps(keep, inf));
+    __m128 hi = _mm_or_ps(_mm_and_ps(keep, g.hi), _mm_andnot_ps(keep, _mm_sub_ps(_mm_setzero_ps(), inf)));
+    lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(2, 3, 0, 1)));
+    lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(1, 0, 3, 2)));
+    hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(2, 3, 0, 1)));
+    hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(1, 0, 3, 2)));
+    for (unsigned rows = rowsWithin(beams.grid(), rect, lo, hi); rows; rows &= rows - 1) {
+      const int row = rect.row_lo + __builtin_ctz(rows);
+      const __m128 tan_lo = _mm_set1_ps(beams.grid().rowTanBelow(row));
+      const __m128 tan_hi = _mm_set1_ps(beams.grid().rowTanAbove(row));
+      const __m128 cos_e = _mm_set1_ps(beams.grid().rowCos(row));
+      const __m128 z = _mm_mul_ps(nz, _mm_set1_ps(beams.grid().rowSin(row)));
+      const float* range = beams.rangeAbove(row);
       // The row's tan E within the column's bounds, as scanColumns looks rows up: for a float
       // bound x, tan E >= x exactly iff tan E rounded down is, and <= x iff rounded up is. And
       // not clearly beyond the beam's range; written so that a NaN range is never held back.
