@@ -375,6 +375,11 @@ int main(int argc, char** argv) {
                   core::Caster(),
                   laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment()),
                   {},
+                  {},
+                  {},
+                  {},
+                  {},
+                  {},
                   {}};
   casting.config.threads = args.threads;
   try {
