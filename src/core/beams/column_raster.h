@@ -110,11 +110,10 @@ class ColumnRaster {
                    F&& f) const;
 
   bool all_ = false;  // seen edge-on, or too small for float: every beam of the rect is a candidate
-  // Per edge: (m_x, m_y) scaled, and what the bound on tan E does: lower (m_z > 0), upper
-  // (m_z < 0) or nothing (m_z = 0: the edge decides by h(A) alone).
   // What an edge's bound on tan E is: lower (m_z > 0), upper (m_z < 0), none (m_z = 0: h decides
   // alone), or any of these by column (kAny: a column's own normal may change the sign).
   enum class EdgeKind : char { kLower, kUpper, kFlat, kAny };
+  // Per edge: (m_x, m_y) scaled, 1 / m_z (0 if m_z = 0) and its kind.
   __m128 mx_[3], my_[3], inv_mz_[3];
   EdgeKind kind_[3];
   __m128 edge_margin_;  // the margin over the smallest cos E of the pattern
@@ -299,7 +298,8 @@ void ColumnRaster::scanRows(const BeamSet& beams, const BeamRect& rect, const Gr
     // which no row's test passes).
     const __m128 keep = _mm_and_ps(laneMask(g.mask), _mm_cmpord_ps(g.lo, g.hi));
     __m128 lo = _mm_or_ps(_mm_and_ps(keep, g.lo), _mm_andnot_ps(keep, inf));
-    __m128 hi = _mm_or_ps(_mm_and_ps(keep, g.hi), _mm_andnot_ps(keep, _mm_sub_ps(_mm_setzero_ps(), inf)));
+    __m128 hi =
+        _mm_or_ps(_mm_and_ps(keep, g.hi), _mm_andnot_ps(keep, _mm_sub_ps(_mm_setzero_ps(), inf)));
     lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(2, 3, 0, 1)));
     lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(1, 0, 3, 2)));
     hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(2, 3, 0, 1)));
