@@ -112,14 +112,21 @@ TEST(MeasurementConfig, ValidateNamesFieldAndValue) {
 // -------------------------------------------------------------------------------------------------
 // MeasurementModel
 
-// Each beam kind by hand: valid ranges rounded once to float, +Inf, -Inf, NaN; labels from the
-// body's label (also for too-close hits), -1 where nothing was hit.
-TEST(MeasurementModel, Rep117AndLabels) {
-  const Scene scene = labelledScene();
+// Each beam kind once (for range_min 0.5, range_max 10): valid, both bounds, no hit, too close,
+// NaN; bodies of four labels and none.
+ScanResult rep117Result() {
   ScanResult r;
   r.range = {1.2345678901234567, 0.5, 10.0, kInf, 0.25, kNan, 3.0, 7.777777777777777};
   r.body = {0, 1, 2, -1, 3, -1, 3, 1};
   r.triangle.assign(r.range.size(), -1);
+  return r;
+}
+
+// Each beam kind by hand: valid ranges rounded once to float, +Inf, -Inf, NaN; labels from the
+// body's label (also for too-close hits), -1 where nothing was hit.
+TEST(MeasurementModel, Rep117AndLabels) {
+  const Scene scene = labelledScene();
+  const ScanResult r = rep117Result();
   for (const MinRangePolicy policy :
        {MinRangePolicy::kNegInf, MinRangePolicy::kNan, MinRangePolicy::kPassThrough}) {
     MeasurementModel model(measurementConfig(0.5, 10.0, policy));
@@ -325,6 +332,30 @@ TEST(MeasurementModel, NoNoiseIsExact) {
     MeasuredScan out;
     model.measure(scene, r, {}, &out);
     for (int i = 0; i < 50; ++i) EXPECT_EQ(out.ranges[i], static_cast<float>(r.range[i])) << i;
+  }
+}
+
+// With nothing configured to degrade or detect, measure() takes a path of its own per beam; it must
+// give what the general path gives. The general one is forced by a dropout of 1e-300 (a draw below
+// it would have to be exactly 0: none of these 8 seeded draws is).
+TEST(MeasurementModel, IdealPathIsTheGeneralOne) {
+  const Scene scene = labelledScene();
+  const ScanResult r = rep117Result();
+  for (const MinRangePolicy policy :
+       {MinRangePolicy::kNegInf, MinRangePolicy::kNan, MinRangePolicy::kPassThrough}) {
+    MeasurementConfig ideal = measurementConfig(0.5, 10.0, policy);
+    ASSERT_TRUE(ideal.isIdeal());
+    MeasurementConfig general = ideal;
+    general.dropout_probability = 1e-300;
+    ASSERT_FALSE(general.isIdeal());
+    MeasuredScan a, b;
+    MeasurementModel(ideal).measure(scene, r, {}, &a);
+    MeasurementModel(general).measure(scene, r, {}, &b);
+    ASSERT_EQ(a.ranges.size(), b.ranges.size());
+    for (std::size_t i = 0; i < a.ranges.size(); ++i) {
+      EXPECT_TRUE(sameFloat(a.ranges[i], b.ranges[i])) << toString(policy) << " beam " << i;
+    }
+    EXPECT_EQ(a.labels, b.labels) << toString(policy);
   }
 }
 
