@@ -100,7 +100,9 @@ Pass pipelinePass(const BenchScene& scene, int threads, bool keep_slices) {
             caster->castBundle(scene.scene, scene.frame_poses, w.sensors[p], w.sub_patterns,
                                config);
         auto at = out->begin() + p * beams;
-        for (const core::ScanResult& r : results) at = std::copy(r.range.begin(), r.range.end(), at);
+        for (const core::ScanResult& r : results) {
+          at = std::copy(r.range.begin(), r.range.end(), at);
+        }
         continue;
       }
       const core::ScanResult& result =

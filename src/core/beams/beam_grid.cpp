@@ -7,14 +7,18 @@
 namespace laser_raycast {
 namespace core {
 
+void ringsByElevation(const ScanPattern& pattern, std::vector<int>* order) {
+  const std::vector<double>& elevations = pattern.elevations();
+  order->resize(elevations.size());
+  std::iota(order->begin(), order->end(), 0);
+  std::stable_sort(order->begin(), order->end(),
+                   [&](int a, int b) { return elevations[a] < elevations[b]; });
+}
+
 void BeamGrid::reset(const ScanPattern& pattern, const CastConfig& config) {
   pattern_ = &pattern;
   planar_ = pattern.planar();
-  const auto& elevations = pattern.elevations();
-  beam_of_row_.resize(elevations.size());
-  std::iota(beam_of_row_.begin(), beam_of_row_.end(), 0);
-  std::stable_sort(beam_of_row_.begin(), beam_of_row_.end(),
-                   [&](int a, int b) { return elevations[a] < elevations[b]; });
+  ringsByElevation(pattern, &beam_of_row_);
   col_start_ = pattern.angleMin();
   col_inv_increment_ = 1 / pattern.angleIncrement();
   col_turn_ = 2 * M_PI * col_inv_increment_;

@@ -58,6 +58,10 @@ class RowTable {
   float base_ = 0, scale_ = 0;
 };
 
+// The rings of pattern in ascending elevation (ties in ring order), as ring indices, into order:
+// the rows of its grid.
+void ringsByElevation(const ScanPattern& pattern, std::vector<int>* order);
+
 class BeamGrid {
  public:
   // Patterns whose rows all lie within this elevation (rad, 80 degrees) can be rasterised column

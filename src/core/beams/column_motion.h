@@ -8,13 +8,23 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "beams/beam_window.h"
 #include "laser_raycast/core/ray.h"
+#include "laser_raycast/core/scan_pattern.h"
 
 namespace laser_raycast {
 namespace core {
+
+// The largest angle of pattern's directions from the horizontal (rad): ColumnMotion's steepest.
+inline double steepestElevation(const ScanPattern& pattern) {
+  double steepest = 0;
+  for (double e : pattern.elevations()) steepest = std::max(steepest, std::abs(e));
+  return steepest;
+}
 
 class ColumnMotion {
  public:

@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
-#include <numeric>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -24,15 +23,6 @@ namespace laser_raycast {
 namespace core {
 namespace {
 
-// The rings of a pattern in ascending order, as indices into its elevations.
-std::vector<int> ringOrder(const ScanPattern& pattern) {
-  const std::vector<double>& e = pattern.elevations();
-  std::vector<int> order(e.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return e[a] < e[b]; });
-  return order;
-}
-
 // Throws std::invalid_argument unless the patterns can be cast as a bundle.
 void checkBundle(const std::vector<ScanPattern>& patterns) {
   std::ostringstream msg;
@@ -40,7 +30,8 @@ void checkBundle(const std::vector<ScanPattern>& patterns) {
     msg << "castBundle: no patterns";
   } else {
     const ScanPattern& first = patterns.front();
-    const std::vector<int> order = ringOrder(first);
+    std::vector<int> order, order_k;
+    ringsByElevation(first, &order);
     for (std::size_t k = 0; k < patterns.size() && msg.str().empty(); ++k) {
       const ScanPattern& p = patterns[k];
       if (p.planar()) {
@@ -50,8 +41,11 @@ void checkBundle(const std::vector<ScanPattern>& patterns) {
         msg << "castBundle: pattern " << k << " has " << p.ringCount() << " rings x "
             << p.azimuthCount() << " azimuths, pattern 0 " << first.ringCount() << " x "
             << first.azimuthCount();
-      } else if (ringOrder(p) != order) {
-        msg << "castBundle: pattern " << k << "'s rings are not in pattern 0's order";
+      } else {
+        ringsByElevation(p, &order_k);
+        if (order_k != order) {
+          msg << "castBundle: pattern " << k << "'s rings are not in pattern 0's order";
+        }
       }
     }
   }
@@ -64,12 +58,10 @@ void checkBundle(const std::vector<ScanPattern>& patterns) {
 // column c is the difference of the two fans' azimuths, the same for every column but for rounding.
 double bundleTurn(const std::vector<ScanPattern>& patterns) {
   const ScanPattern& first = patterns.front();
-  const int last = first.azimuthCount() - 1;
   double turn = 0;
   for (const ScanPattern& p : patterns) {
-    double azimuth = std::max(std::abs(p.angleMin() - first.angleMin()),
-                              std::abs((p.angleMin() + last * p.angleIncrement()) -
-                                       (first.angleMin() + last * first.angleIncrement())));
+    const double azimuth = std::max(std::abs(p.angleMin() - first.angleMin()),
+                                    std::abs(p.angleMax() - first.angleMax()));
     double elevation = 0;
     for (int r = 0; r < first.ringCount(); ++r) {
       elevation = std::max(elevation, std::abs(p.elevations()[r] - first.elevations()[r]));
@@ -94,17 +86,17 @@ const std::vector<ScanResult>& Caster::castBundle(const Scene& scene, const Fram
   const int bodies = static_cast<int>(scene.bodies().size());
   std::vector<ScanResult>& results = state_->bundle;
   results.resize(patterns.size());
-  for (ScanResult& r : results) resetResult(culling.size(), bodies, sensor_ok, config.compute_incidence, &r);
+  for (ScanResult& r : results) {
+    resetResult(culling.size(), bodies, sensor_ok, config.compute_incidence, &r);
+  }
   resetResult(culling.size(), bodies, sensor_ok, false, &result_);
   if (!sensor_ok) return results;
 
   const ReuseKey key = relativeInputs(scene, poses, world_from_sensor, culling, config);
   state_->placeGroups(scene, key, culling, &state_->placed, &result_.stats.bodies_skipped);
-  double steepest = 0;
-  for (double e : culling.elevations()) steepest = std::max(steepest, std::abs(e));
   const ColumnMotion motion(
       0, std::vector<Eigen::Isometry3d>(culling.azimuthCount(), Eigen::Isometry3d::Identity()),
-      steepest, bundleTurn(patterns));
+      steepestElevation(culling), bundleTurn(patterns));
   BeamSet::Bundle bundle;
   for (std::size_t k = 0; k < patterns.size(); ++k) {
     bundle.patterns.push_back(&patterns[k]);

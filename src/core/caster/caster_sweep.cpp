@@ -250,7 +250,7 @@ class BlockPlanner {
   BlockPlanner(const Scene& scene, const ColumnPoses& poses, const ScanPattern& pattern,
                const CastConfig& config)
       : scene_(scene), poses_(poses), pattern_(pattern), config_(config) {
-    for (double e : pattern.elevations()) steepest_ = std::max(steepest_, std::abs(e));
+    steepest_ = steepestElevation(pattern);
     limits_ = pattern.planar() ? kLimitsPlanar : kLimits3d;
   }
 

@@ -47,6 +47,27 @@ void resetResult(std::size_t n, ScanResult* result, SurfaceSamples* surface) {
   surface->cos_incidence.assign(n, 0.0);
 }
 
+// subRayPatterns(fan, elevations, returns), built again only if one of them changed since the last
+// call with `kept`.
+const std::vector<ScanPattern>& keptSubRayPatterns(const FanSpec& fan,
+                                                   const std::vector<double>& elevations,
+                                                   const ReturnsConfig& returns,
+                                                   PulseReturns::SubRays* kept) {
+  const bool same_fan = kept->fan.angle_min == fan.angle_min &&
+                        kept->fan.angle_max == fan.angle_max &&
+                        kept->fan.angle_increment == fan.angle_increment &&
+                        kept->fan.samples == fan.samples;
+  if (!(same_fan && kept->elevations == elevations &&
+        kept->divergence == returns.beam_divergence && kept->samples == returns.beam_samples)) {
+    kept->patterns = subRayPatterns(fan, elevations, returns);
+    kept->fan = fan;
+    kept->elevations = elevations;
+    kept->divergence = returns.beam_divergence;
+    kept->samples = returns.beam_samples;
+  }
+  return kept->patterns;
+}
+
 }  // namespace
 
 void ReturnsConfig::validate() const {
@@ -101,19 +122,8 @@ void castReturns(Caster* caster, const Scene& scene, const FramePoses& poses,
   std::vector<SubHit> hits;
   std::vector<int> hit_count;
   SurfaceSamples surface;
-  PulseReturns::SubRays& sub = out->sub_rays;
-  const bool same_fan = sub.fan.angle_min == fan.angle_min && sub.fan.angle_max == fan.angle_max &&
-                        sub.fan.angle_increment == fan.angle_increment &&
-                        sub.fan.samples == fan.samples;
-  if (!(same_fan && sub.elevations == elevations &&
-        sub.divergence == returns.beam_divergence && sub.samples == samples)) {
-    sub.patterns = subRayPatterns(fan, elevations, returns);
-    sub.fan = fan;
-    sub.elevations = elevations;
-    sub.divergence = returns.beam_divergence;
-    sub.samples = samples;
-  }
-  const std::vector<ScanPattern>& patterns = sub.patterns;
+  const std::vector<ScanPattern>& patterns =
+      keptSubRayPatterns(fan, elevations, returns, &out->sub_rays);
   // A 3D pattern's sub-rays are cast as one bundle (Caster::castBundle: the same results as a cast
   // of each pattern, in one walk of the scene); a planar fan's (whose sub-rays leave its plane)
   // one pattern at a time.

@@ -10,6 +10,7 @@
 #include "beams/edge_filter.h"
 #include "slice/slicer.h"
 #include "util/walk_stack.h"
+#include "walk/slot_cache.h"
 #include "accel/wide_bvh.h"
 
 namespace laser_raycast {
@@ -35,29 +36,6 @@ constexpr long long kLeafDirectBeams = 8;
 // window is sliced whole (planar fans), without windows or occlusion tests on the way.
 constexpr std::uint32_t kPlainSliceTriangles = 64;
 constexpr double kPlainSliceBeamsPerTriangle = 0.5;
-
-// The last values computed for triangle slots, by slot (a direct-mapped cache of N entries), for
-// a walk whose beams ask about the same slots again and again.
-template <class T, std::uint32_t N>
-class SlotCache {
- public:
-  template <class Make>
-  const T& get(std::uint32_t slot, Make&& make) {
-    Entry& e = entries_[slot % N];
-    if (e.slot != slot) {
-      e.slot = slot;
-      e.value = make();
-    }
-    return e.value;
-  }
-
- private:
-  struct Entry {
-    std::uint32_t slot = std::numeric_limits<std::uint32_t>::max();
-    T value{};
-  };
-  std::array<Entry, N> entries_;
-};
 
 template <TriangleMethod M>
 class MeshWalk {
@@ -261,6 +239,14 @@ class MeshWalk {
 
   // Each open beam of the rect through the node's subtree, one ray at a time.
   void traceRect(const Entry& e) {
+    // One ray through the node's subtree, its boxes entered as box_ray, each triangle tested
+    // exactly as ray: its nearest hit into best.
+    auto trace = [&](const PreparedRay<double, M>& ray, const WideBoxRay& box_ray, double tmax,
+                     Best* best) {
+      traceWide(wide_, e.ref, box_ray, &tmax, [&](std::uint32_t slot) {
+        if (!hidden(slot)) testSlot(ray, slot, &tmax, best);
+      });
+    };
     for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
@@ -268,28 +254,22 @@ class MeshWalk {
         if (bundle_) {
           // Each sub-ray traced on its own: the boxes it enters are its own.
           for (int k = 0; k < beams_.subRays(); ++k) {
-            double sub_tmax = std::min(config_.tmax, beams_.subRange(k, row, col));
+            const double sub_tmax = std::min(config_.tmax, beams_.subRange(k, row, col));
             if (!(sub_tmax >= e.near)) continue;
             Best sub_best;
-            const auto ray = subRay(k, row, col);
-            traceWide(wide_, e.ref, subBoxRay(k, row, col), &sub_tmax, [&](std::uint32_t slot) {
-              if (!hidden(slot)) testSlot(ray, slot, &sub_tmax, &sub_best);
-            });
+            trace(subRay(k, row, col), subBoxRay(k, row, col), sub_tmax, &sub_best);
             if (sub_best.found()) offerSub(k, row, col, sub_best);
           }
           continue;
         }
-        double tmax = std::min(config_.tmax, range);
         Best best;
         if (slicing_) {
+          double tmax = std::min(config_.tmax, range);
           traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
             if (!hidden(slot)) sliceOne(slot, col, &tmax, &best);
           });
         } else {
-          const auto ray = beamRay(row, col);
-          traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
-            if (!hidden(slot)) testSlot(ray, slot, &tmax, &best);
-          });
+          trace(beamRay(row, col), boxRay(row, col), std::min(config_.tmax, range), &best);
         }
         if (best.found()) offer(row, col, best);
       }

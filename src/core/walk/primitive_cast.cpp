@@ -120,8 +120,9 @@ void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
       ray.tmax = std::min(config.tmax, beams.subRange(k, row, col));
       const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
       if (!hit) continue;
-      beams.keepNearestSubHit(k, row, col, hit->t, a.index, -1,
-                              [&] { return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal); });
+      beams.keepNearestSubHit(k, row, col, hit->t, a.index, -1, [&] {
+        return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal);
+      });
     }
     return;
   }
