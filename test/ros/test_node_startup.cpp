@@ -182,8 +182,8 @@ TEST(NodeStartup, CorruptMeshMakesTheNodeletFailToLoad) {
       "exit $status");
   EXPECT_NE(run.status, 0) << run.output;
   EXPECT_NE(run.status, 124) << "the load command should fail, not time out:\n" << run.output;
-  for (const std::string& m : {"regression_wall_p_letter.dae", "corrupt_link",
-                               "memory bound of 512 MB", "MANAGER_RUNNING"}) {
+  for (const char* m : {"regression_wall_p_letter.dae", "corrupt_link", "memory bound of 512 MB",
+                        "MANAGER_RUNNING"}) {
     EXPECT_NE(run.output.find(m), std::string::npos) << "the output should say '" << m << "':\n"
                                                      << run.output;
   }

@@ -506,7 +506,9 @@ TEST(OcclusionTiles, AWindowWithAnOpenBeamIsNeverClosed) {
         }
       }
       const bool said = tiles.anyOpen(rect, near);
-      if (open) ASSERT_TRUE(said) << "step " << step;
+      if (open) {
+        ASSERT_TRUE(said) << "step " << step;
+      }
       // A narrow window of one row is read beam by beam: the answer is exact.
       if (rect.row_lo == rect.row_hi && rect.col_hi - rect.col_lo < 16) {
         ASSERT_EQ(said, open) << "step " << step;
@@ -545,7 +547,9 @@ TEST(BeamSet, AWindowWithAnOpenBeamIsNeverClosed) {
       for (int c = rect.col_lo; c <= rect.col_hi; ++c) open |= !(beams.range(r, c) < near);
     }
     const bool said = beams.anyOpen(rect, near);
-    if (open) ASSERT_TRUE(said) << "step " << step;
+    if (open) {
+      ASSERT_TRUE(said) << "step " << step;
+    }
     closed += !said;
   }
   EXPECT_GT(closed, 1000);

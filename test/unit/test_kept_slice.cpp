@@ -26,7 +26,9 @@ void expectSameBits(const core::ScanResult& a, const core::ScanResult& b, const 
         << what << ": beam " << i << " range " << a.range[i] << " vs " << b.range[i] << ", body "
         << a.body[i] << " vs " << b.body[i] << ", triangle " << a.triangle[i] << " vs "
         << b.triangle[i];
-    if (!a.normal.empty()) ASSERT_EQ(a.normal[i], b.normal[i]) << what << ": beam " << i;
+    if (!a.normal.empty()) {
+      ASSERT_EQ(a.normal[i], b.normal[i]) << what << ": beam " << i;
+    }
   }
 }
 
@@ -63,7 +65,9 @@ TEST(KeptSlice, KeptSlicesNeverChangeAResult) {
         caster.forget();
         const core::ScanResult& r = caster.cast(rs.scene, rs.poses, sensor, pattern, cfg);
         // The first cast meets the plane, the second keeps it for both frames.
-        if (cast >= 1) EXPECT_EQ(r.stats.kept_slices, 2) << "cast " << cast;
+        if (cast >= 1) {
+          EXPECT_EQ(r.stats.kept_slices, 2) << "cast " << cast;
+        }
         kept += r.stats.kept_slices;
         expectSameBits(castFresh(rs, sensor, pattern, cfg), r, "kept slices");
         for (const double range : r.range) hits += std::isfinite(range);
