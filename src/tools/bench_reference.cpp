@@ -1,6 +1,7 @@
 #include "bench_reference.h"
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <limits>
@@ -113,18 +114,32 @@ std::optional<Real> ReferenceRay::intersect(const Eigen::Vector3d& a, const Eige
   return t;
 }
 
-Real referenceClosestHit(const core::Bvh& bvh, const RayL& ray) {
+// The nearest hit among the triangle slots that visit(descend, leaf) reaches through a tree of
+// boxes (a Bvh's, or a Mesh's wide BVH).
+template <class Visit>
+Real referenceClosestHit(const std::vector<std::array<Eigen::Vector3d, 3>>& slots, Visit&& visit,
+                         const RayL& ray) {
   Real best = kInfL;
-  if (bvh.empty()) return best;
   const ReferenceRay prepared(ray);
-  const auto& slots = bvh.triangleVertices();
-  bvh.visit([&](const core::Aabb& box) { return mayHit(ray, box, std::min(ray.tmax, best)); },
-            [&](std::uint32_t slot) {
-              const auto& tri = slots[slot];
-              const auto t = prepared.intersect(tri[0], tri[1], tri[2], std::min(ray.tmax, best));
-              if (t && *t < best) best = *t;
-            });
+  visit([&](const core::Aabb& box) { return mayHit(ray, box, std::min(ray.tmax, best)); },
+        [&](std::uint32_t slot) {
+          const auto& tri = slots[slot];
+          const auto t = prepared.intersect(tri[0], tri[1], tri[2], std::min(ray.tmax, best));
+          if (t && *t < best) best = *t;
+        });
   return best;
+}
+
+Real referenceClosestHit(const core::Bvh& bvh, const RayL& ray) {
+  if (bvh.empty()) return kInfL;
+  return referenceClosestHit(
+      bvh.triangleVertices(), [&](auto&& descend, auto&& leaf) { bvh.visit(descend, leaf); }, ray);
+}
+
+Real referenceClosestHit(const core::Mesh& mesh, const RayL& ray) {
+  return referenceClosestHit(
+      mesh.bvh().triangleVertices(),
+      [&](auto&& descend, auto&& leaf) { mesh.visit(descend, leaf); }, ray);
 }
 
 Real referenceHit(const RayL& ray, const core::Box& box) {
@@ -278,7 +293,7 @@ std::vector<Real> referenceBodies(const BenchScene& s, const std::vector<RayL>& 
       const core::Shape& shape = bodies[b].shape;
       Real t;
       if (const auto* mesh = std::get_if<std::shared_ptr<const core::Mesh>>(&shape)) {
-        t = referenceClosestHit((*mesh)->bvh(), ray);
+        t = referenceClosestHit(**mesh, ray);
       } else if (const auto* box = std::get_if<core::Box>(&shape)) {
         t = referenceHit(ray, *box);
       } else if (const auto* cylinder = std::get_if<core::Cylinder>(&shape)) {

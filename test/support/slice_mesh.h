@@ -33,17 +33,17 @@ inline void sliceMesh(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mes
   const auto& ids = mesh.bvh().triangleIds();
   std::vector<double>& range = *buffer.range;
   const int last = fan.azimuthCount() - 1;
-  mesh.bvh().visit([&](const Aabb& box) { return slicer.mayCross(box); },
-                   [&](std::uint32_t slot) {
-                     slicer.sliceSlot(slot, 0, last, [&](int i, double t) {
-                       if (buffer.crossings) ++(*buffer.crossings)[i];
-                       if (!(t < range[i])) return;
-                       range[i] = t;
-                       (*buffer.body)[i] = body_index;
-                       (*buffer.triangle)[i] = static_cast<int>(ids[slot]);
-                       if (buffer.normal) (*buffer.normal)[i] = slicer.sensorNormal(slot);
-                     });
-                   });
+  mesh.visit([&](const Aabb& box) { return slicer.mayCross(box); },
+             [&](std::uint32_t slot) {
+               slicer.sliceSlot(slot, 0, last, [&](int i, double t) {
+                 if (buffer.crossings) ++(*buffer.crossings)[i];
+                 if (!(t < range[i])) return;
+                 range[i] = t;
+                 (*buffer.body)[i] = body_index;
+                 (*buffer.triangle)[i] = static_cast<int>(ids[slot]);
+                 if (buffer.normal) (*buffer.normal)[i] = slicer.sensorNormal(slot);
+               });
+             });
 }
 
 }  // namespace core

@@ -100,7 +100,10 @@ TEST(Bvh, DegenerateTrianglesAreExcluded) {
   const Mesh mesh(s.vertices, s.triangles);
   EXPECT_EQ(mesh.degenerateTriangleCount(), 3u);
   EXPECT_EQ(mesh.triangles().size(), s.triangles.size());
-  const Bvh& bvh = mesh.bvh();
+  // The mesh's slots, and its tree as it built it (the mesh keeps only its wide BVH's).
+  EXPECT_FALSE(mesh.bvh().hasTree());
+  const Bvh bvh = Bvh::build(s.vertices, s.triangles, {}, mesh.components());
+  EXPECT_EQ(bvh.triangleIds(), mesh.bvh().triangleIds());
   const BvhF bvhf = BvhF::build(s.vertices, s.triangles);
   EXPECT_EQ(bvh.triangleIds().size(), s.triangles.size() - 3);
   EXPECT_EQ(bvhf.triangleIds().size(), s.triangles.size() - 4);

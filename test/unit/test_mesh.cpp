@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -55,6 +56,50 @@ TEST(Mesh, RejectsBadInput) {
 }
 
 // The bounding sphere holds every vertex, near the origin and far from it, small and large.
+// A mesh keeps only its wide BVH's tree: the binary tree's queries throw and say where to go, and
+// Mesh::visit reaches every slot once, and every slot whose triangle meets a query's region.
+TEST(Mesh, KeepsOnlyTheWideTreeAndVisitsThroughIt) {
+  Rng rng(61);
+  const Soup s = clusteredSoup(rng, 3000);
+  const Mesh mesh(s.vertices, s.triangles);
+  EXPECT_FALSE(mesh.bvh().hasTree());
+  EXPECT_THROW(mesh.bvh().closestHit<TriangleMethod::kWatertight>(Ray()), std::logic_error);
+  try {
+    mesh.bvh().visit([](const Aabb&) { return true; }, [](std::uint32_t) {});
+    ADD_FAILURE() << "visit on a released tree did not throw";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("Mesh::visit"), std::string::npos) << e.what();
+  }
+  const std::size_t slots = mesh.bvh().triangleIds().size();
+  std::vector<int> seen(slots, 0);
+  mesh.visit([](const Aabb&) { return true; }, [&](std::uint32_t slot) { ++seen[slot]; });
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(slots));
+  // Slabs of z: every slot whose triangle reaches into the slab is visited (the boxes contain
+  // their triangles), and a thin slab skips most of the others.
+  const auto& tris = mesh.bvh().triangleVertices();
+  for (int i = 0; i < 20; ++i) {
+    const double lo = uniform(rng, mesh.bounds().lo.z(), mesh.bounds().hi.z());
+    const double hi = lo + 0.01 * (mesh.bounds().hi.z() - mesh.bounds().lo.z());
+    std::vector<char> visited(slots, 0);
+    mesh.visit([&](const Aabb& box) { return box.hi.z() >= lo && box.lo.z() <= hi; },
+               [&](std::uint32_t slot) { visited[slot] = 1; });
+    std::size_t meets = 0, missed = 0, extra = 0;
+    for (std::size_t slot = 0; slot < slots; ++slot) {
+      double z_lo = kInf, z_hi = -kInf;
+      for (const auto& v : tris[slot]) {
+        z_lo = std::min(z_lo, v.z());
+        z_hi = std::max(z_hi, v.z());
+      }
+      const bool meet = z_hi >= lo && z_lo <= hi;
+      meets += meet;
+      missed += meet && !visited[slot];
+      extra += !meet && visited[slot];
+    }
+    EXPECT_EQ(missed, 0u) << "slab " << lo << " .. " << hi;
+    EXPECT_LT(extra, slots / 2) << "slab " << lo << " .. " << hi << ", " << meets << " meet it";
+  }
+}
+
 TEST(Mesh, BoundingSphereContainsEveryVertex) {
   Rng rng(17);
   for (const double offset : {0.0, 1e6, -3.7e7}) {

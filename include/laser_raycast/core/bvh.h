@@ -102,10 +102,15 @@ class BvhT {
   bool anyHit(const RayT<T>& ray, bool cull_backfaces = false) const;
 
   // Depth-first walk over the subtrees whose box satisfies descend(box); calls leaf(slot) for each
-  // triangle slot of every such leaf. Used by queries that are not rays (the planar fan slices
-  // meshes with it).
+  // triangle slot of every such leaf. Used by queries that are not rays.
   template <class Descend, class Leaf>
   void visit(Descend&& descend, Leaf&& leaf) const;
+
+  // Frees the tree's nodes, keeping the triangle slots, their ids and the bounds: for an owner that
+  // walks the slots through a tree of its own (a Mesh keeps only its wide BVH, built from this
+  // tree). After it, hasTree() is false, and closestHit, anyHit and visit throw std::logic_error.
+  void releaseTree();
+  bool hasTree() const { return !tree_released_; }
 
  private:
   template <TriangleMethod M, bool kAnyHit>
@@ -128,6 +133,9 @@ class BvhT {
   std::vector<std::uint32_t> triangle_ids_;
   std::vector<std::array<Vec3<T>, 3>> vertices_;
   int depth_ = 0;
+  bool tree_released_ = false;
+
+  void requireTree() const;
 };
 
 using Bvh = BvhT<double>;
@@ -146,6 +154,7 @@ std::optional<MeshHitT<T>> bruteForceClosestHit(TriangleMethod method,
 template <typename T>
 template <TriangleMethod M, bool kAnyHit>
 std::optional<MeshHitT<T>> BvhT<T>::traverse(const RayT<T>& ray, bool cull_backfaces) const {
+  requireTree();
   std::optional<MeshHitT<T>> best;
   if (empty()) return best;
   const PreparedRay<T, M> prepared(ray, cull_backfaces);
@@ -232,6 +241,7 @@ bool BvhT<T>::anyHit(const RayT<T>& ray, bool cull_backfaces) const {
 template <typename T>
 template <class Descend, class Leaf>
 void BvhT<T>::visit(Descend&& descend, Leaf&& leaf) const {
+  requireTree();
   if (empty() || !descend(bounds_)) return;
   Child stack[64];
   int top = 0;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -31,10 +32,17 @@ class Mesh {
 
   const std::vector<Eigen::Vector3d>& vertices() const { return vertices_; }
   const std::vector<TriangleIndices>& triangles() const { return triangles_; }
+  // The triangles' BVH slots (triangleVertices, triangleIds) and bounds. Its binary tree is
+  // released once the wide BVH is built from it (Bvh::releaseTree): walk the mesh's boxes with
+  // visit().
   const Bvh& bvh() const { return bvh_; }
   // The caster's BVH: 4-wide, over the same triangle slots (src/core/accel/wide_bvh.h, private to
   // the core); a leaf holds the triangles of one connected component where the binary BVH allows.
   const WideBvh& wideBvh() const { return *wide_; }
+  // Depth-first walk over the wide BVH's subtrees whose box (mesh frame, containing the exact box of
+  // what is below) satisfies descend(box); calls leaf(slot) for each BVH slot of every such leaf.
+  void visit(const std::function<bool(const Aabb&)>& descend,
+             const std::function<void(std::uint32_t)>& leaf) const;
   // The connected component of each triangle, numbered from 0, and how many there are.
   const std::vector<std::uint32_t>& components() const { return component_; }
   std::uint32_t componentCount() const { return component_count_; }

@@ -268,6 +268,20 @@ void BvhT<T>::adoptTree(Tree tree, int depth) {
   depth_ = depth;
 }
 
+template <typename T>
+void BvhT<T>::releaseTree() {
+  std::vector<Node>().swap(nodes_);
+  tree_released_ = true;
+}
+
+template <typename T>
+void BvhT<T>::requireTree() const {
+  if (tree_released_) {
+    throw std::logic_error(
+        "this BVH's tree was released (a Mesh keeps only its wide BVH): walk it with Mesh::visit");
+  }
+}
+
 void BvhConfig::validate() const {
   std::ostringstream msg;
   if (max_leaf_size < 1) {

@@ -89,6 +89,34 @@ class WideBvh {
   }
   std::uint32_t rootTriangles() const { return root_triangles_; }
 
+  // Depth-first walk over the subtrees whose box satisfies descend(box) (the root's: the binary
+  // BVH's bounds; below it, the nodes' float boxes, which contain the exact ones); calls leaf(slot)
+  // for each triangle slot of every such leaf. For queries that are not rays (a plane's slice).
+  template <class Descend, class Leaf>
+  void visit(Descend&& descend, Leaf&& leaf) const {
+    if (empty() || !descend(bvh_->bounds())) return;
+    Ref stack[64 * (kWidth - 1) + 1];
+    int top = 0;
+    stack[top++] = root_;
+    while (top > 0) {
+      const Ref ref = stack[--top];
+      if (ref.isLeaf()) {
+        for (std::uint32_t slot = ref.index; slot < ref.index + ref.count; ++slot) leaf(slot);
+        continue;
+      }
+      const Node& node = nodes_[ref.index];
+      for (int k = kWidth - 1; k >= 0; --k) {  // the first child on top
+        if (node.index[k] == kEmpty) continue;
+        Aabb box;
+        for (int a = 0; a < 3; ++a) {
+          box.lo[a] = node.lo[a][k];
+          box.hi[a] = node.hi[a][k];
+        }
+        if (descend(box)) stack[top++] = node.child(k);
+      }
+    }
+  }
+
  private:
   class Builder;  // the collapse of the binary BVH (wide_bvh.cpp)
 

@@ -55,7 +55,14 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
   slot_component.reserve(bvh_.triangleIds().size());
   for (const std::uint32_t id : bvh_.triangleIds()) slot_component.push_back(component_[id]);
   wide_ = std::make_unique<const WideBvh>(bvh_, slot_component);
+  // Everything walks the wide BVH from here on.
+  bvh_.releaseTree();
   findClosedComponents();
+}
+
+void Mesh::visit(const std::function<bool(const Aabb&)>& descend,
+                 const std::function<void(std::uint32_t)>& leaf) const {
+  wide_->visit(descend, leaf);
 }
 
 Mesh::~Mesh() = default;

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <functional>
 
+#include "accel/wide_bvh.h"
+
 namespace laser_raycast {
 namespace core {
 namespace {
@@ -13,14 +15,14 @@ namespace {
 void addMeshSegments(const Mesh& mesh, int body, const Eigen::Isometry3d& frame_from_mesh,
                      const ScanPlane& plane, std::vector<KeptSlice::Item>* items) {
   const auto& slots = mesh.bvh().triangleVertices();
-  mesh.bvh().visit([&](const Aabb& box) { return plane.mayMeet(frame_from_mesh, box); },
-                   [&](std::uint32_t slot) {
-                     Eigen::Vector3d v[3];
-                     for (int k = 0; k < 3; ++k) v[k] = frame_from_mesh * slots[slot][k];
-                     Eigen::Vector2d p, q;
-                     if (!plane.crossing(v, &p, &q) || p == q) return;
-                     items->push_back(KeptSlice::Item{p, q, body, slot});
-                   });
+  mesh.wideBvh().visit([&](const Aabb& box) { return plane.mayMeet(frame_from_mesh, box); },
+                       [&](std::uint32_t slot) {
+                         Eigen::Vector3d v[3];
+                         for (int k = 0; k < 3; ++k) v[k] = frame_from_mesh * slots[slot][k];
+                         Eigen::Vector2d p, q;
+                         if (!plane.crossing(v, &p, &q) || p == q) return;
+                         items->push_back(KeptSlice::Item{p, q, body, slot});
+                       });
 }
 
 // A primitive body whose box may meet the plane, with the bounds of its box's corners in plane
