@@ -131,7 +131,6 @@ Real referenceClosestHit(const std::vector<std::array<Eigen::Vector3d, 3>>& slot
 }
 
 Real referenceClosestHit(const core::Bvh& bvh, const RayL& ray) {
-  if (bvh.empty()) return kInfL;
   return referenceClosestHit(
       bvh.triangleVertices(), [&](auto&& descend, auto&& leaf) { bvh.visit(descend, leaf); }, ray);
 }

@@ -9,6 +9,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cast_path.h"
@@ -120,6 +121,9 @@ LoadedScene loadScene(const Args& args) {
 // The scans' pattern and settings, and the one caster that casts them all, as the node's sensor
 // keeps one from scan to scan: a scan is reused only if nothing moved relative to the sensor.
 struct Casting {
+  Casting(core::ScanPattern pattern_in, const core::CastConfig& config_in, double increment)
+      : pattern(std::move(pattern_in)), config(config_in), time_increment(increment) {}
+
   core::ScanPattern pattern;
   core::CastConfig config;
   core::Caster caster;
@@ -370,17 +374,8 @@ int main(int argc, char** argv) {
     std::cerr << "cast_scan: " << e.what() << "\n";
     return kExitBadArguments;
   }
-  Casting casting{args.scan.pattern(),
-                  args.scan.castConfig(),
-                  core::Caster(),
-                  laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment()),
-                  {},
-                  {},
-                  {},
-                  {},
-                  {},
-                  {},
-                  {}};
+  Casting casting(args.scan.pattern(), args.scan.castConfig(),
+                  laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment()));
   casting.config.threads = args.threads;
   try {
     labelReflectivity(args, loaded, &casting);

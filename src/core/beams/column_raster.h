@@ -245,12 +245,13 @@ inline void ColumnRaster::columnBounds(int base, __m128 ca, __m128 sa, __m128* l
         _mm_sub_ps(mz_[k], _mm_sub_ps(_mm_mul_ps(ox, ey_[k]), _mm_mul_ps(oy, ex_[k])));
     const __m128 h = _mm_add_ps(_mm_mul_ps(mx, ca), _mm_mul_ps(my, sa));
     // As edgeBounds does it, without the masks where every column bounds the same side.
-    if (column_kind_[k] == EdgeKind::kLower) {
-      lo = _mm_max_ps(lo, _mm_mul_ps(_mm_sub_ps(neg_margin, h), _mm_div_ps(_mm_set1_ps(1.0f), mz)));
-      continue;
-    }
-    if (column_kind_[k] == EdgeKind::kUpper) {
-      hi = _mm_min_ps(hi, _mm_mul_ps(_mm_sub_ps(neg_margin, h), _mm_div_ps(_mm_set1_ps(1.0f), mz)));
+    if (column_kind_[k] != EdgeKind::kAny) {
+      const __m128 bound = _mm_mul_ps(_mm_sub_ps(neg_margin, h), _mm_div_ps(_mm_set1_ps(1.0f), mz));
+      if (column_kind_[k] == EdgeKind::kLower) {
+        lo = _mm_max_ps(lo, bound);
+      } else {
+        hi = _mm_min_ps(hi, bound);
+      }
       continue;
     }
     const __m128 flat = _mm_cmpeq_ps(mz, zero);
