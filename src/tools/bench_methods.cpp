@@ -293,9 +293,9 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
                                  workload.ouster_metadata)
                   .scan(0.1);
   }
-  // Still workloads: every beam from the pose's one time.
+  // Still workloads: every beam from the pose's one time. The lines stay, as the node's and
+  // cast_scan's lists have them (a calibrated lidar's list is fitted to grids by its lines).
   w.beams.times.clear();
-  w.beams.lines.clear();
   if (workload.motion == Motion::kPath) {
     w.poses = pathPoses(scene, soup_bvh, workload, count);
   } else if (workload.motion == Motion::kSweep) {

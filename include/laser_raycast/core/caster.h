@@ -43,9 +43,12 @@ class Caster {
                               const ScanPattern& pattern, const CastConfig& config,
                               double time_increment);
 
-  // Beams off any grid (beam_list.h), each cast as its own ray from its origin through the scene's
-  // trees with the exact tests the grid's walks use (src/core/caster/caster_beams.cpp): every beam
-  // from world_from_sensor. Result i is beam i; the same for any thread count. Never reused.
+  // Beams off any grid (beam_list.h), each cast as its own ray from its origin with the exact tests
+  // the grid's walks use: every beam from world_from_sensor. A list that lies on grids (columns of
+  // every laser line from one origin, each line's azimuth advancing by one step: a calibrated
+  // Velodyne's or Ouster's, src/core/beams/beam_list_grid.h) is cast through the grid's walks,
+  // others one ray at a time through the scene's trees (src/core/caster/caster_beams.cpp). Result
+  // i is beam i; the same for any thread count. Never reused.
   const ScanResult& castBeams(const Scene& scene, const FramePoses& poses,
                               const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
                               const CastConfig& config);

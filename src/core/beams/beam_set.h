@@ -23,12 +23,14 @@ namespace core {
 
 class BeamSet {
  public:
-  // A bundle (Caster::castBundle): each beam of the grid stands for the beams at its row and
-  // column of `patterns` (its sub-rays, all from the sensor), each kept in its own result; the
-  // grid's own ranges then hold the farthest of a beam's sub-ray ranges, which is what culling
-  // reads, and the walks test each sub-ray where they would test the beam.
+  // A bundle: each beam of the grid stands for the beams at its index in each of `directions`
+  // (its sub-rays: a divergent beam's, Caster::castBundle, or a calibrated lidar's own beam,
+  // Caster::castBeams), each kept in its own result. The sub-rays leave from the sensor, or with a
+  // ColumnMotion from their column's origin as the grid's beams do. The grid's own ranges then
+  // hold the farthest of a beam's sub-ray ranges, which is what culling reads, and the walks test
+  // each sub-ray where they would test the beam.
   struct Bundle {
-    std::vector<const ScanPattern*> patterns;
+    std::vector<const std::vector<Eigen::Vector3d>*> directions;  // each indexed as the pattern's
     std::vector<ScanResult*> results;
   };
 
@@ -63,10 +65,10 @@ class BeamSet {
 
   // The bundle being cast, or null.
   const Bundle* bundle() const { return bundle_; }
-  int subRays() const { return static_cast<int>(bundle_->patterns.size()); }
+  int subRays() const { return static_cast<int>(bundle_->directions.size()); }
   // Sub-ray k of the beam at (row, col): its direction (sensor frame) and its range so far.
   const Eigen::Vector3d& subDirection(int k, int row, int col) const {
-    return bundle_->patterns[k]->directions()[grid_.beam(row, col)];
+    return (*bundle_->directions[k])[grid_.beam(row, col)];
   }
   double subRange(int k, int row, int col) const {
     return bundle_->results[k]->range[grid_.beam(row, col)];

@@ -1,4 +1,6 @@
-// Caster::castBeams and castBeamsSweep: beams off any grid (beam_list.h), one ray at a time.
+// Caster::castBeams and castBeamsSweep: beams off any grid (beam_list.h), one ray at a time. (A
+// list that lies on grids, a calibrated spinning lidar's, is cast from one pose through the grid's
+// walks instead: caster_beam_grid.cpp.)
 //
 // A grid's walks find the beams each box reaches from the box's view; beams on no grid have no
 // such view, so each beam is traced by itself: through each frame's tree of bodies (the scene
@@ -345,6 +347,12 @@ const ScanResult& Caster::castBeams(const Scene& scene, const FramePoses& poses,
   checkFramePoses(scene, poses);
   state_->previous.reset();
   startResult(scene, beams, config, &result_);
+  if (isValidPose(world_from_sensor)) {
+    if (const BeamListGrid* grid = state_->gridOf(beams)) {
+      state_->castBeamGrids(scene, poses, world_from_sensor, beams, *grid, config, &result_);
+      return result_;
+    }
+  }
   GroupPoses placed;
   placeGroupsAt(
       state_->indexOf(scene), world_from_sensor,

@@ -99,7 +99,7 @@ const std::vector<ScanResult>& Caster::castBundle(const Scene& scene, const Fram
       steepestElevation(culling), bundleTurn(patterns));
   BeamSet::Bundle bundle;
   for (std::size_t k = 0; k < patterns.size(); ++k) {
-    bundle.patterns.push_back(&patterns[k]);
+    bundle.directions.push_back(&patterns[k].directions());
     bundle.results.push_back(&results[k]);
   }
   state_->castOnThreads(

@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "beams/beam_list_grid.h"
 #include "beams/beam_set.h"
 #include "beams/column_motion.h"
 #include "laser_raycast/core/cast_config.h"
@@ -100,6 +101,15 @@ struct CasterState {
   std::unique_ptr<KeptSlices> planes;   // CastConfig::keep_slices
   std::optional<ReuseKey> previous;     // the inputs of the result, if it is complete
   std::vector<ScanResult> bundle;       // Caster::castBundle's results, one per sub-ray pattern
+  // The beam list Caster::castBeams last fitted to grids (its directions, origins and lines), and
+  // what fitBeamGrid found: a node casts the same list scan after scan.
+  struct FittedList {
+    std::vector<Eigen::Vector3d> directions, origins;
+    std::vector<int> lines;
+    std::optional<BeamListGrid> grid;
+  };
+  std::optional<FittedList> fitted;
+  ScanResult grid_culling, grid_own;  // castBeamGrids' results for one part, by its grid beams
 
   // The scene's index for this scene version.
   const SceneIndex& indexOf(const Scene& scene);
@@ -117,6 +127,15 @@ struct CasterState {
   // The blocks of a sweep cast against the beams of result (caster_sweep.cpp).
   void castBlocks(const Scene& scene, const std::vector<SweepBlock>& blocks,
                   const ScanPattern& pattern, const CastConfig& config, ScanResult* result);
+  // beams' grids (beam_list_grid.h), fitted or remembered from the last call; null if it lies on
+  // none.
+  const BeamListGrid* gridOf(const BeamList& beams);
+  // Casts a beam list that lies on `grid` from one pose into result (reset for it, the sensor
+  // pose valid): each part as a bundle of one sub-ray a grid beam, from its column's origin
+  // (caster_beam_grid.cpp).
+  void castBeamGrids(const Scene& scene, const FramePoses& poses,
+                     const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
+                     const BeamListGrid& grid, const CastConfig& config, ScanResult* result);
   // Starts a cast (the beams open as result holds them, no body marked), runs
   // castWithin(rect) over the pattern's beams on config's threads, and counts the bodies culled.
   void castOnThreads(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,

@@ -156,9 +156,20 @@ class MeshWalk {
   // walk.
   WideBoxRay boxRay(int row, int col) const {
     Eigen::Vector3d d = beams_.grid().rebuiltDirection(row, col);
-    // A sweep's beam turns with its column; origin_ holds every column's origin (the block's shift).
+    // A sweep's beam turns with its column.
     if (motion_) d = motion_->refFromColumn(col).linear() * d;
-    return WideBoxRay(origin_, active_.body_from_sensor_rot * d);
+    return columnBoxRay(col, active_.body_from_sensor_rot * d);
+  }
+  // A ray of column col along body-frame direction d for box tests: from the sensor, or for a
+  // sweep's block from the column's own origin. (origin_ holds every column's origin, the box
+  // grown by the block's shift: a centimetre on every box makes a ray traced through small boxes
+  // enter many more of them.)
+  WideBoxRay columnBoxRay(int col, const Eigen::Vector3d& d) const {
+    if (!motion_ || spread_.shift == 0) return WideBoxRay(origin_, d);
+    const Eigen::Vector3d o =
+        active_.body_from_sensor_rot * motion_->refFromColumn(col).translation() +
+        active_.sensor_in_body;
+    return WideBoxRay(WideBoxRay::Origin(o, mesh_.bvh().bounds(), config_.tmin), d);
   }
 
 
@@ -214,18 +225,26 @@ class MeshWalk {
                              [&] { return columnNormal(col, best.triangle); });
   }
 
-  // Sub-ray k of a bundle's beam as a ray for the triangle tests: from the sensor (a bundle has
-  // no motion of its own: its block's poses are the sensor's), as a cast of its pattern tests it.
+  // Sub-ray k of a bundle's beam as a ray for the triangle tests: from its column's pose (a
+  // divergent beam's block has the sensor's at every column, a calibrated lidar's the column's
+  // origin), as a cast of its pattern tests it.
   PreparedRay<double, M> subRay(int k, int row, int col) const {
+    const Eigen::Vector3d& d = beams_.subDirection(k, row, col);
     Ray ray;
-    ray.origin.setZero();
-    ray.dir = beams_.subDirection(k, row, col);
-    ray.tmin = config_.tmin;
+    if (motion_) {
+      ray = motion_->ray(col, d, config_.tmin);
+    } else {
+      ray.origin.setZero();
+      ray.dir = d;
+      ray.tmin = config_.tmin;
+    }
     return PreparedRay<double, M>(ray, config_.cull_backfaces);
   }
   // Its ray in the body's frame for box tests.
   WideBoxRay subBoxRay(int k, int row, int col) const {
-    return WideBoxRay(origin_, active_.body_from_sensor_rot * beams_.subDirection(k, row, col));
+    Eigen::Vector3d d = beams_.subDirection(k, row, col);
+    if (motion_) d = motion_->refFromColumn(col).linear() * d;
+    return columnBoxRay(col, active_.body_from_sensor_rot * d);
   }
 
   // A beam as a ray for the triangle tests: from the sensor, or for a sweep's block from its

@@ -111,11 +111,18 @@ template <class Primitive>
 void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
               const CastConfig& config, int row, int col, double current) {
   if (beams.bundle()) {
-    // Each of a bundle's sub-rays, from the sensor (its block's poses are the sensor's).
+    // Each of a bundle's sub-rays, from its column's pose (the block's motion), as testBeam below
+    // casts a sweep's beam.
     for (int k = 0; k < beams.subRays(); ++k) {
+      const Eigen::Vector3d& d = beams.subDirection(k, row, col);
       Ray ray;
       ray.origin = a.sensor_in_body;
-      ray.dir = a.body_from_sensor_rot * beams.subDirection(k, row, col);
+      ray.dir = a.body_from_sensor_rot * d;
+      if (a.motion) {
+        const Ray column = a.motion->ray(col, d, config.tmin);
+        ray.origin = a.body_from_sensor_rot * column.origin + a.sensor_in_body;
+        ray.dir = a.body_from_sensor_rot * column.dir;
+      }
       ray.tmin = config.tmin;
       ray.tmax = std::min(config.tmax, beams.subRange(k, row, col));
       const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);

@@ -1,0 +1,132 @@
+#include "beams/beam_list_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace laser_raycast {
+namespace core {
+namespace {
+
+// angle wrapped into (-pi, pi].
+double wrapHalfTurn(double angle) {
+  const double a = std::remainder(angle, 2 * M_PI);
+  return a <= -M_PI ? a + 2 * M_PI : a;
+}
+
+// How many beams a column holds: the list up to the first line that comes again (0 if none does).
+int columnHeight(const std::vector<int>& lines) {
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    if (std::find(lines.begin(), lines.begin() + i, lines[i]) != lines.begin() + i) {
+      return static_cast<int>(i);
+    }
+  }
+  return 0;
+}
+
+// Whether every column holds the first column's lines in its order, from one origin.
+bool sameColumns(const BeamList& beams, int height, int columns) {
+  for (int c = 1; c < columns; ++c) {
+    for (int p = 0; p < height; ++p) {
+      if (beams.lines[c * height + p] != beams.lines[p]) return false;
+    }
+  }
+  if (beams.origins.empty()) return true;
+  for (int c = 0; c < columns; ++c) {
+    for (int p = 1; p < height; ++p) {
+      if (beams.origins[c * height + p] != beams.origins[c * height]) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<BeamListGrid> fitBeamGrid(const BeamList& beams) {
+  if (beams.lines.size() != beams.directions.size()) return std::nullopt;
+  const int height = columnHeight(beams.lines);
+  if (height == 0 || beams.size() % height != 0) return std::nullopt;
+  const int columns = beams.size() / height;
+  if (columns < 2 || !sameColumns(beams, height, columns)) return std::nullopt;
+
+  // Each line's azimuths unwrapped along its columns, and its step from column to column.
+  auto beam = [&](int p, int c) { return c * height + p; };
+  auto azimuth = [&](int i) { return std::atan2(beams.directions[i].y(), beams.directions[i].x()); };
+  std::vector<double> start(height), elevation_lo(height, M_PI), elevation_hi(height, -M_PI);
+  double step = 0;
+  for (int p = 0; p < height; ++p) {
+    double u = start[p] = azimuth(beam(p, 0)), previous = u;
+    for (int c = 0; c < columns; ++c) {
+      const Eigen::Vector3d& d = beams.directions[beam(p, c)];
+      const double e = std::asin(std::max(-1.0, std::min(1.0, d.z())));
+      elevation_lo[p] = std::min(elevation_lo[p], e);
+      elevation_hi[p] = std::max(elevation_hi[p], e);
+      if (c == 0) continue;
+      const double a = azimuth(beam(p, c));
+      u += wrapHalfTurn(a - previous);
+      previous = a;
+    }
+    step += (u - start[p]) / (columns - 1) / height;
+  }
+  const double increment = std::abs(step);
+  if (!(increment > 0) || !std::isfinite(increment)) return std::nullopt;
+
+  // The lines by their azimuth offset from line 0, in parts whose offsets lie within a step.
+  std::vector<double> offset(height);
+  for (int p = 0; p < height; ++p) offset[p] = wrapHalfTurn(start[p] - start[0]);
+  std::vector<int> order(height);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return offset[a] < offset[b]; });
+  std::vector<std::vector<int>> part_lines;
+  for (int p : order) {
+    if (part_lines.empty() || offset[p] - offset[part_lines.back().front()] > increment) {
+      part_lines.emplace_back();
+    }
+    part_lines.back().push_back(p);
+  }
+  if (static_cast<int>(part_lines.size()) > kMaxParts) return std::nullopt;
+
+  BeamListGrid grid;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (int c = 0; c < columns; ++c) {
+    const Eigen::Vector3d o = beams.origin(beam(0, c));
+    lo = lo.cwiseMin(o);
+    hi = hi.cwiseMax(o);
+  }
+  grid.center = (lo + hi) / 2;
+  // Azimuth index j is column c counted in ascending azimuth.
+  auto columnOf = [&](int j) { return step > 0 ? j : columns - 1 - j; };
+  for (const std::vector<int>& lines : part_lines) {
+    const double middle = (offset[lines.front()] + offset[lines.back()]) / 2;
+    FanSpec fan;
+    fan.angle_min = wrapHalfTurn(start[0] + middle + (step > 0 ? 0.0 : (columns - 1) * step));
+    fan.angle_max = fan.angle_min + (columns - 1) * increment;
+    fan.samples = columns;
+    std::vector<double> elevations;
+    for (int p : lines) elevations.push_back((elevation_lo[p] + elevation_hi[p]) / 2);
+    BeamListGrid::Part part{ScanPattern(fan, elevations), {}, {}, {}, 0};
+    if (part.culling.planar()) return std::nullopt;
+    const auto& grid_directions = part.culling.directions();
+    for (std::size_t q = 0; q < lines.size(); ++q) {
+      for (int j = 0; j < columns; ++j) {
+        const int i = beam(lines[q], columnOf(j));
+        const Eigen::Vector3d& d = beams.directions[i];
+        const double chord = (d - grid_directions[q * columns + j]).norm();
+        part.turn = std::max(part.turn, 2 * std::asin(std::min(1.0, chord / 2)));
+        part.directions.push_back(d);
+        part.beam.push_back(i);
+      }
+    }
+    // Widened for the rounding of the chord and its arcsine (a few ulps of the turn).
+    part.turn = part.turn * (1 + 1e-9) + 1e-15;
+    if (!(part.turn <= kMaxTurnIncrements * increment)) return std::nullopt;
+    for (int j = 0; j < columns; ++j) {
+      part.column_origin.push_back(beams.origin(beam(0, columnOf(j))) - grid.center);
+    }
+    grid.parts.push_back(std::move(part));
+  }
+  return grid;
+}
+
+}  // namespace core
+}  // namespace laser_raycast

@@ -1,0 +1,200 @@
+// Beam lists that lie on grids (beams/beam_list_grid.h): what fitBeamGrid finds in a calibrated
+// Velodyne's and an Ouster's lists and what it turns down, and Caster::castBeams through the grid's
+// walks against the same beams cast one ray at a time (the list shuffled, which lies on no grid).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "beams/beam_list_grid.h"
+#include "cast_reference.h"
+#include "laser_raycast/core/ouster_beams.h"
+#include "laser_raycast/core/pattern_file.h"
+#include "laser_raycast/core/velodyne_beams.h"
+#include "random_scene.h"
+
+namespace laser_raycast_test {
+namespace {
+
+// An Ouster of 32 rows in four columns of lasers (azimuth offsets 4.2, 1.4, -1.4 and -4.2 deg,
+// far more than a column apart), 512 columns, its beams 15.806 mm off the axis and the lidar
+// frame turned half a turn and raised 36.18 mm in the sensor frame, as Ouster's files have it.
+core::OusterHead ouster() {
+  core::OusterHead head;
+  const double offsets[] = {4.2, 1.4, -1.4, -4.2};
+  for (int r = 0; r < 32; ++r) {
+    head.altitudes_deg.push_back(15.5 - r);
+    head.azimuths_deg.push_back(offsets[r % 4]);
+  }
+  head.beam_origin_x_mm = 15.806;
+  head.lidar_to_sensor(0, 0) = head.lidar_to_sensor(1, 1) = -1;
+  head.lidar_to_sensor(2, 3) = 36.18;
+  head.columns = 512;
+  head.last_column = 511;
+  return head;
+}
+
+// The list's beams in a random order (beam k of the result is beams' order[k]).
+core::BeamList shuffled(const core::BeamList& beams, Rng& rng, std::vector<int>* order) {
+  order->resize(beams.size());
+  std::iota(order->begin(), order->end(), 0);
+  std::shuffle(order->begin(), order->end(), rng);
+  core::BeamList out;
+  for (int i : *order) out.append(beams, i);
+  return out;
+}
+
+// Every beam of the list stands at exactly one grid beam, with its own direction.
+void expectEachBeamOnce(const core::BeamListGrid& grid, const core::BeamList& beams) {
+  std::vector<int> seen(beams.size(), 0);
+  for (const core::BeamListGrid::Part& part : grid.parts) {
+    ASSERT_EQ(part.beam.size(), part.culling.directions().size());
+    for (std::size_t k = 0; k < part.beam.size(); ++k) {
+      ++seen[part.beam[k]];
+      EXPECT_EQ(part.directions[k], beams.directions[part.beam[k]]);
+    }
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), beams.size());
+}
+
+// A VLP-16's sixteen lasers fire 2.304 us apart while the head turns a sequence's step in 55.296
+// us: their azimuths drift by 15 x 2.304 / 55.296 = 0.625 of a step, one part whose grid lies in
+// the middle of the drift. The farthest beams from their grid beams are the first and last lasers
+// (ids 0 and 15, at -15 and 15 deg): half the drift in azimuth, cos 15 deg of that as an angle.
+TEST(FitBeamGrid, Vlp16IsOneGridWithinHalfItsFiringDrift) {
+  const core::BeamList beams = core::nominalVlp16().scan(0.1);
+  const auto grid = core::fitBeamGrid(beams);
+  ASSERT_TRUE(grid);
+  ASSERT_EQ(grid->parts.size(), 1u);
+  const core::BeamListGrid::Part& part = grid->parts[0];
+  EXPECT_EQ(part.culling.ringCount(), 16);
+  EXPECT_EQ(part.culling.azimuthCount(), static_cast<int>(0.1 / 55.296e-6));
+  const double step = 2 * M_PI * 55.296e-6 / 0.1;
+  EXPECT_NEAR(part.culling.angleIncrement(), step, 1e-12);
+  const double farthest = 15 * 2 * M_PI * 2.304e-6 / 0.1 / 2 * std::cos(15 * M_PI / 180);
+  EXPECT_GT(part.turn, farthest * (1 - 1e-6));
+  EXPECT_LT(part.turn, farthest * (1 + 1e-6));
+  EXPECT_EQ(grid->center, Eigen::Vector3d::Zero());
+  for (const Eigen::Vector3d& o : part.column_origin) EXPECT_EQ(o, Eigen::Vector3d::Zero());
+  expectEachBeamOnce(*grid, beams);
+}
+
+// The Ouster's four azimuth offsets make four parts, each exactly on its grid; the columns leave
+// from the circle of 15.806 mm about the lidar's axis, 36.18 mm above the sensor's origin.
+TEST(FitBeamGrid, OusterIsAGridForEachAzimuthOffset) {
+  const core::BeamList beams = ouster().scan(0.1);
+  const auto grid = core::fitBeamGrid(beams);
+  ASSERT_TRUE(grid);
+  ASSERT_EQ(grid->parts.size(), 4u);
+  EXPECT_NEAR((grid->center - Eigen::Vector3d(0, 0, 0.03618)).norm(), 0, 1e-12);
+  for (const core::BeamListGrid::Part& part : grid->parts) {
+    EXPECT_EQ(part.culling.ringCount(), 8);
+    EXPECT_EQ(part.culling.azimuthCount(), 512);
+    EXPECT_LT(part.turn, 1e-12);
+    for (const Eigen::Vector3d& o : part.column_origin) EXPECT_NEAR(o.norm(), 0.015806, 1e-12);
+  }
+  expectEachBeamOnce(*grid, beams);
+}
+
+// Lists on no grid: shuffled, without lines, lasers of one column from different origins (a
+// Velodyne's offset corrections), a rosette, and lines whose offsets spread over more than
+// kMaxParts parts.
+TEST(FitBeamGrid, ListsOnNoGridAreTurnedDown) {
+  Rng rng(3);
+  std::vector<int> order;
+  const core::BeamList vlp16 = core::nominalVlp16().scan(0.1);
+  EXPECT_FALSE(core::fitBeamGrid(shuffled(vlp16, rng, &order)));
+  core::BeamList no_lines = vlp16;
+  no_lines.lines.clear();
+  EXPECT_FALSE(core::fitBeamGrid(no_lines));
+  core::VelodyneHead offset = core::nominalVlp16();
+  offset.lasers[3].horiz_offset = 0.02;
+  EXPECT_FALSE(core::fitBeamGrid(offset.scan(0.1)));
+  const core::PatternFile rosette =
+      core::PatternFile::load(LASER_RAYCAST_SOURCE_DIR "/config/patterns/rosette_4line.csv");
+  EXPECT_FALSE(core::fitBeamGrid(rosette.scan(0, rosette.size(), 1.0)));
+  core::OusterHead spread = ouster();
+  for (int r = 0; r < spread.rows(); ++r) spread.azimuths_deg[r] = 2.0 * r;
+  EXPECT_FALSE(core::fitBeamGrid(spread.scan(0.1)));
+}
+
+void expectSameResult(const core::ScanResult& a, const core::ScanResult& b,
+                      const std::vector<int>& order, double tolerance) {
+  int differing = 0;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const int i = order[k];
+    const bool same_range = tolerance == 0 ? a.range[i] == b.range[k]
+                                           : near(a.range[i], b.range[k], tolerance);
+    const bool same = same_range && a.body[i] == b.body[k] && a.triangle[i] == b.triangle[k] &&
+                      (tolerance > 0 || (a.normal[i] == b.normal[k] &&
+                                         a.cos_incidence[i] == b.cos_incidence[k]));
+    if (!same && differing++ < 5) {
+      ADD_FAILURE() << "beam " << i << ": range " << a.range[i] << " vs " << b.range[k]
+                    << ", body " << a.body[i] << " vs " << b.body[k] << ", triangle "
+                    << a.triangle[i] << " vs " << b.triangle[k];
+    }
+  }
+  EXPECT_EQ(differing, 0);
+}
+
+// Through the grid's walks each beam is its own ray: a Velodyne's (from the sensor's origin) gives
+// the ray-by-ray cast's ranges, bodies, triangles and normals bit for bit, an Ouster's (from its
+// column's origin, relative to the middle of them) its ranges to the rounding of the origins, for
+// any thread count.
+TEST(CastBeamGrid, CalibratedListsGiveTheRayByRayCast) {
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    Rng rng(seed);
+    const RandomScene s = randomScene(rng);
+    const Eigen::Isometry3d sensor =
+        pose(Eigen::Vector3d(uniform(rng, -1, 1), 0, 0.3), randomRotation(rng).toRotationMatrix());
+    core::CastConfig c = config(true, 25.0);
+    c.compute_incidence = true;
+    struct Case {
+      core::BeamList beams;
+      double tolerance;
+    };
+    const Case cases[] = {{core::nominalVlp16().scan(0.1), 0.0},
+                          {core::nominalHdl32e().scan(0.1), 0.0},
+                          {ouster().scan(0.1), 1e-12}};
+    for (const Case& k : cases) {
+      ASSERT_TRUE(core::fitBeamGrid(k.beams));
+      std::vector<int> order;
+      const core::BeamList one_by_one = shuffled(k.beams, rng, &order);
+      core::Caster grid, rays, threaded;
+      const core::ScanResult expected = rays.castBeams(s.scene, s.poses, sensor, one_by_one, c);
+      int hits = 0;
+      for (int b : expected.body) hits += b >= 0;
+      EXPECT_GT(hits, k.beams.size() / 10);
+      expectSameResult(grid.castBeams(s.scene, s.poses, sensor, k.beams, c), expected, order,
+                       k.tolerance);
+      c.threads = 3;
+      expectSameResult(threaded.castBeams(s.scene, s.poses, sensor, k.beams, c), expected, order,
+                       k.tolerance);
+      c.threads = 1;
+    }
+  }
+}
+
+// The caster remembers the last list's grids: a list changed in place (one direction, one origin)
+// is fitted anew, and gives the ray-by-ray cast of its new beams.
+TEST(CastBeamGrid, AChangedListIsFittedAnew) {
+  Rng rng(5);
+  const RandomScene s = randomScene(rng);
+  const Eigen::Isometry3d sensor = pose(Eigen::Vector3d(0.2, 0.1, 0.3), yaw(0.4));
+  core::CastConfig c = config(true, 25.0);
+  c.compute_incidence = true;
+  core::BeamList beams = core::nominalVlp16().scan(0.1);
+  core::Caster caster, rays;
+  caster.castBeams(s.scene, s.poses, sensor, beams, c);
+  beams.directions[100] = Eigen::Vector3d(0, 0, -1);
+  beams.origins[5000] = Eigen::Vector3d(0.01, 0, 0);
+  std::vector<int> order;
+  const core::BeamList one_by_one = shuffled(beams, rng, &order);
+  const core::ScanResult expected = rays.castBeams(s.scene, s.poses, sensor, one_by_one, c);
+  expectSameResult(caster.castBeams(s.scene, s.poses, sensor, beams, c), expected, order, 0.0);
+}
+
+}  // namespace
+}  // namespace laser_raycast_test
