@@ -16,6 +16,7 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
     frobenius2 = std::max(frobenius2, (m.linear() - Eigen::Matrix3d::Identity()).squaredNorm());
     z_move2 = std::max(z_move2, (m.linear().col(2) - Eigen::Vector3d::UnitZ()).squaredNorm());
     const Eigen::Matrix3d& r = m.linear();
+    translations_only_ = translations_only_ && r == Eigen::Matrix3d::Identity();
     in_plane_ = in_plane_ && r(0, 2) == 0 && r(1, 2) == 0 && r(2, 0) == 0 && r(2, 1) == 0 &&
                 r(2, 2) == 1 && m.translation().z() == 0;
   }

@@ -43,13 +43,17 @@ class ColumnMotion {
   // a move in its xy plane, exactly (as a level sensor driving on a floor gives): every column scans
   // the reference's plane.
   bool inPlane() const { return in_plane_; }
+  // True if no column's pose turns from the reference's (a calibrated lidar's columns, each from
+  // its own origin: Caster::castBeams).
+  bool translationsOnly() const { return translations_only_; }
 
   // Beam d of column col as a ray in the reference sensor frame.
   Ray ray(int col, const Eigen::Vector3d& d, double tmin) const {
     const Eigen::Isometry3d& m = refFromColumn(col);
     Ray r;
     r.origin = m.translation();
-    r.dir = m.linear() * d;
+    // Turning by the identity gives d's bits: skipped where no column turns.
+    r.dir = translations_only_ ? d : Eigen::Vector3d(m.linear() * d);
     r.tmin = tmin;
     return r;
   }
@@ -76,6 +80,7 @@ class ColumnMotion {
   std::vector<Eigen::Isometry3d> ref_from_column_;
   Spread spread_;
   bool in_plane_ = true;
+  bool translations_only_ = true;
   int padded_lo_;
   std::vector<float> origin_[3];
 };

@@ -24,6 +24,8 @@ const BeamListGrid* CasterState::gridOf(const BeamList& beams) {
   const std::vector<Eigen::Vector3d>& origins = beams.origins;
   if (!fitted || fitted->directions != beams.directions || fitted->origins != origins ||
       fitted->lines != beams.lines) {
+    fitted.reset();
+    beams.validate();
     fitted = FittedList{beams.directions, origins, beams.lines, fitBeamGrid(beams)};
   }
   return fitted->grid ? &*fitted->grid : nullptr;

@@ -128,7 +128,7 @@ struct CasterState {
   void castBlocks(const Scene& scene, const std::vector<SweepBlock>& blocks,
                   const ScanPattern& pattern, const CastConfig& config, ScanResult* result);
   // beams' grids (beam_list_grid.h), fitted or remembered from the last call; null if it lies on
-  // none.
+  // none. A list not remembered is checked first (BeamList::validate throws for a bad one).
   const BeamListGrid* gridOf(const BeamList& beams);
   // Casts a beam list that lies on `grid` from one pose into result (reset for it, the sensor
   // pose valid): each part as a bundle of one sub-ray a grid beam, from its column's origin
