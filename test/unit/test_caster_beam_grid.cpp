@@ -196,5 +196,56 @@ TEST(CastBeamGrid, AChangedListIsFittedAnew) {
   expectSameResult(caster.castBeams(s.scene, s.poses, sensor, beams, c), expected, order, 0.0);
 }
 
+// A rotating sweep through the grids: each beam from the sensor and frame poses at its own time
+// (a VLP-16's lasers each at its place in the firing sequence, an Ouster's columns at theirs),
+// against the shuffled list's ray-by-ray sweep; the sensor drives and turns, the cart moves the
+// other way, and the sensor has no pose for the first 10 ms (those beams NaN either way).
+TEST(CastBeamGrid, RotatingSweepsGiveTheRayByRaySweep) {
+  for (unsigned seed = 1; seed <= 2; ++seed) {
+    Rng rng(seed + 20);
+    const RandomScene s = randomScene(rng);
+    core::PoseSamples samples;
+    const Eigen::Isometry3d start =
+        pose(Eigen::Vector3d(uniform(rng, -1, 1), 0, 0.3), randomRotation(rng).toRotationMatrix());
+    for (int k = 0; k <= 5; ++k) {
+      const double t = 0.02 * k;
+      samples.times.push_back(t);
+      Eigen::Isometry3d sensor = start * pose(Eigen::Vector3d(1.5 * t, 0.4 * t, 0), yaw(2 * t));
+      if (k == 0) sensor.translation().x() = std::nan("");
+      samples.world_from_sensor.push_back(sensor);
+      core::FramePoses frames = s.poses;
+      frames.pose[1] = pose(Eigen::Vector3d(-3 * t, 0, 0)) * frames.pose[1];
+      samples.frames.push_back(frames);
+    }
+    core::CastConfig c = config(true, 25.0);
+    c.compute_incidence = true;
+    for (const core::BeamList& beams : {core::nominalVlp16().scan(0.1), ouster().scan(0.1)}) {
+      std::vector<int> order;
+      const core::BeamList one_by_one = shuffled(beams, rng, &order);
+      core::Caster grid, rays;
+      const core::ScanResult expected = rays.castBeamsSweep(s.scene, samples, one_by_one, c);
+      const core::ScanResult& r = grid.castBeamsSweep(s.scene, samples, beams, c);
+      int hits = 0, nan = 0, differing = 0;
+      for (std::size_t k = 0; k < order.size(); ++k) {
+        const int i = order[k];
+        hits += expected.body[k] >= 0;
+        nan += std::isnan(expected.range[k]);
+        const bool same =
+            (std::isnan(r.range[i]) && std::isnan(expected.range[k])) ||
+            (near(r.range[i], expected.range[k], 1e-9) && r.body[i] == expected.body[k] &&
+             (r.body[i] < 0 || (r.normal[i] - expected.normal[k]).norm() < 1e-9));
+        if (!same && differing++ < 5) {
+          ADD_FAILURE() << "beam " << i << ": range " << r.range[i] << " vs "
+                        << expected.range[k] << ", body " << r.body[i] << " vs "
+                        << expected.body[k];
+        }
+      }
+      EXPECT_EQ(differing, 0);
+      EXPECT_GT(hits, beams.size() / 10);
+      EXPECT_GT(nan, beams.size() / 20);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace laser_raycast_test

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 namespace laser_raycast {
 namespace core {
@@ -41,6 +42,21 @@ bool sameColumns(const BeamList& beams, int height, int columns) {
 }
 
 }  // namespace
+
+ScanPattern cullingGrid(const FanSpec& fan, std::vector<double> elevations) {
+  if (elevations.size() == 1 && elevations[0] == 0.0) elevations[0] = 1e-9;
+  return ScanPattern(fan, std::move(elevations));
+}
+
+double farthestTurn(const ScanPattern& culling, const std::vector<Eigen::Vector3d>& directions) {
+  double turn = 0;
+  for (std::size_t k = 0; k < directions.size(); ++k) {
+    const double chord = (directions[k] - culling.directions()[k]).norm();
+    turn = std::max(turn, 2 * std::asin(std::min(1.0, chord / 2)));
+  }
+  // Widened for the rounding of the chord and its arcsine (a few ulps of the turn).
+  return turn * (1 + 1e-9) + 1e-15;
+}
 
 std::optional<BeamListGrid> fitBeamGrid(const BeamList& beams) {
   if (beams.lines.size() != beams.directions.size()) return std::nullopt;
@@ -104,21 +120,15 @@ std::optional<BeamListGrid> fitBeamGrid(const BeamList& beams) {
     fan.samples = columns;
     std::vector<double> elevations;
     for (int p : lines) elevations.push_back((elevation_lo[p] + elevation_hi[p]) / 2);
-    BeamListGrid::Part part{ScanPattern(fan, elevations), {}, {}, {}, 0};
-    if (part.culling.planar()) return std::nullopt;
-    const auto& grid_directions = part.culling.directions();
+    BeamListGrid::Part part{cullingGrid(fan, elevations), {}, {}, {}, 0};
     for (std::size_t q = 0; q < lines.size(); ++q) {
       for (int j = 0; j < columns; ++j) {
         const int i = beam(lines[q], columnOf(j));
-        const Eigen::Vector3d& d = beams.directions[i];
-        const double chord = (d - grid_directions[q * columns + j]).norm();
-        part.turn = std::max(part.turn, 2 * std::asin(std::min(1.0, chord / 2)));
-        part.directions.push_back(d);
+        part.directions.push_back(beams.directions[i]);
         part.beam.push_back(i);
       }
     }
-    // Widened for the rounding of the chord and its arcsine (a few ulps of the turn).
-    part.turn = part.turn * (1 + 1e-9) + 1e-15;
+    part.turn = farthestTurn(part.culling, part.directions);
     if (!(part.turn <= kMaxTurnIncrements * increment)) return std::nullopt;
     for (int j = 0; j < columns; ++j) {
       part.column_origin.push_back(beams.origin(beam(0, columnOf(j))) - grid.center);

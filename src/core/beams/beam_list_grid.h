@@ -48,5 +48,13 @@ std::optional<BeamListGrid> fitBeamGrid(const BeamList& beams);
 inline constexpr double kMaxTurnIncrements = 1.0;
 inline constexpr int kMaxParts = 8;
 
+// A part's grid: fan's azimuths at each of elevations. A single ring at elevation exactly 0 would
+// be a planar fan, which the walks cast in 2D: it is raised by 1e-9 rad (the grid only culls; the
+// beams keep their own directions, and the turn covers the difference).
+ScanPattern cullingGrid(const FanSpec& fan, std::vector<double> elevations);
+// The farthest angle (rad) of directions[k] from culling's k-th direction, widened for the
+// rounding of how it is found.
+double farthestTurn(const ScanPattern& culling, const std::vector<Eigen::Vector3d>& directions);
+
 }  // namespace core
 }  // namespace laser_raycast

@@ -60,6 +60,7 @@ class ColumnMotion {
   // A unit normal in the reference sensor frame as column col's sensor frame has it (the frame
   // ScanResult's normals are in).
   Eigen::Vector3d toColumn(int col, const Eigen::Vector3d& n) const {
+    if (translations_only_) return n;
     return refFromColumn(col).linear().transpose() * n;
   }
   // Each column's origin (refFromColumn(c).translation()) rounded to float, one array per axis,

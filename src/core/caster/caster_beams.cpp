@@ -330,11 +330,10 @@ void castBeamList(CasterState& state, const Scene& scene, const BeamList& beams,
   }
 }
 
-// beams_checked: beams is known to be valid (CasterState::gridOf has seen it).
+// beams has been checked (CasterState::gridOf).
 void startResult(const Scene& scene, const BeamList& beams, const CastConfig& config,
-                 bool beams_checked, ScanResult* result) {
+                 ScanResult* result) {
   config.validate();
-  if (!beams_checked) beams.validate();
   resetResult(beams.size(), static_cast<int>(scene.bodies().size()), true, config.compute_incidence,
               result);
   if (config.compute_incidence) result->cos_incidence.assign(beams.size(), 0.0);
@@ -348,7 +347,7 @@ const ScanResult& Caster::castBeams(const Scene& scene, const FramePoses& poses,
   checkFramePoses(scene, poses);
   state_->previous.reset();
   const BeamListGrid* grid = state_->gridOf(beams);  // checks beams
-  startResult(scene, beams, config, true, &result_);
+  startResult(scene, beams, config, &result_);
   if (grid && isValidPose(world_from_sensor)) {
     state_->castBeamGrids(scene, poses, world_from_sensor, beams, *grid, config, &result_);
     return result_;
@@ -378,7 +377,12 @@ const ScanResult& Caster::castBeamsSweep(const Scene& scene, const PoseSamples& 
                                          const BeamList& beams, const CastConfig& config) {
   samples.validate(scene);
   state_->previous.reset();
-  startResult(scene, beams, config, false, &result_);
+  const BeamListGrid* grid = state_->gridOf(beams);  // checks beams
+  startResult(scene, beams, config, &result_);
+  if (grid) {
+    state_->castBeamGridsSweep(scene, samples, beams, *grid, config, &result_);
+    return result_;
+  }
   const SceneIndex& index = state_->indexOf(scene);
   castBeamList(
       *state_, scene, beams, config, true,

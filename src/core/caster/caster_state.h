@@ -50,6 +50,8 @@ struct ReuseKey {
   }
 };
 
+class ColumnPoses;  // caster/column_poses.h
+
 // A scene frame with bodies this scan, with its pose in the sensor frame.
 struct PlacedGroup {
   const SceneIndex::Group* group;
@@ -124,9 +126,19 @@ struct CasterState {
                    std::vector<PlacedGroup>* out, int* skipped);
   void castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,
                   ScanResult* result);
+  // A rotating sweep of pattern's columns into result (reset for pattern), column c's beams from
+  // the sensor and frame poses of poses' column base + c (caster/column_poses.h), leaving from
+  // (*origins)[c] in its sensor frame (null: its origin), as a bundle's sub-rays if bundle is not
+  // null (turned by at most `turn` from the pattern's directions). column_valid: 1 for each column
+  // with a sensor pose; the others' beams are NaN in result (caster_sweep.cpp).
+  void sweepColumns(const Scene& scene, const ColumnPoses& poses, int base,
+                    const ScanPattern& pattern, const std::vector<Eigen::Vector3d>* origins,
+                    double turn, const CastConfig& config, const BeamSet::Bundle* bundle,
+                    ScanResult* result, std::vector<char>* column_valid);
   // The blocks of a sweep cast against the beams of result (caster_sweep.cpp).
   void castBlocks(const Scene& scene, const std::vector<SweepBlock>& blocks,
-                  const ScanPattern& pattern, const CastConfig& config, ScanResult* result);
+                  const ScanPattern& pattern, const CastConfig& config, ScanResult* result,
+                  const BeamSet::Bundle* bundle = nullptr);
   // beams' grids (beam_list_grid.h), fitted or remembered from the last call; null if it lies on
   // none. A list not remembered is checked first (BeamList::validate throws for a bad one).
   const BeamListGrid* gridOf(const BeamList& beams);
@@ -136,6 +148,13 @@ struct CasterState {
   void castBeamGrids(const Scene& scene, const FramePoses& poses,
                      const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
                      const BeamListGrid& grid, const CastConfig& config, ScanResult* result);
+  // The same for a rotating sweep, each beam from the sensor and frame poses at its own time
+  // (caster_beam_grid.cpp): each part's lines that fire together in every column are swept as a
+  // bundle of one sub-ray a grid beam, their columns from the poses at those times.
+  // at_once: every beam at the samples' first time, whatever its own.
+  void castBeamGridsSweep(const Scene& scene, const PoseSamples& samples, const BeamList& beams,
+                          const BeamListGrid& grid, const CastConfig& config, ScanResult* result,
+                          bool at_once = false);
   // Starts a cast (the beams open as result holds them, no body marked), runs
   // castWithin(rect) over the pattern's beams on config's threads, and counts the bodies culled.
   void castOnThreads(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,

@@ -209,8 +209,7 @@ class MeshWalk {
   // sweep's block the column's own.
   Eigen::Vector3d columnNormal(int col, std::uint32_t triangle) const {
     const Eigen::Vector3d n = sensorNormal(triangle);
-    // A bundle's block does not move: every column's frame is the sensor's.
-    return motion_ && !bundle_ ? motion_->toColumn(col, n) : n;
+    return motion_ ? motion_->toColumn(col, n) : n;
   }
 
   void offer(int row, int col, const Best& best) {

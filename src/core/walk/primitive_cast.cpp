@@ -128,7 +128,8 @@ void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
       const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
       if (!hit) continue;
       beams.keepNearestSubHit(k, row, col, hit->t, a.index, -1, [&] {
-        return Eigen::Vector3d(a.sensor_from_body.linear() * hit->normal);
+        const Eigen::Vector3d n = a.sensor_from_body.linear() * hit->normal;
+        return a.motion ? a.motion->toColumn(col, n) : n;
       });
     }
     return;

@@ -1,0 +1,219 @@
+// The sensor's and the scene frames' poses at each column of a rotating sweep
+// (Caster::castSweep, and a calibrated lidar's columns in Caster::castBeamsSweep).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "laser_raycast/core/pose.h"
+#include "laser_raycast/core/pose_samples.h"
+#include "laser_raycast/core/scene.h"
+#include "scene/scene_index.h"
+
+namespace laser_raycast {
+namespace core {
+
+// The poses of a sweep's columns: the sensor's, and each frame with bodies (static frames, at one
+// pose in every sample, are checked once and not interpolated). The same poses as
+// PoseSamples::sensorAt and frameAt give, to an ulp or two (interpolatePose's slerp from the
+// samples' quaternions, converted once here rather than at every column, with the angle between
+// two samples found once and the sines of its fractions from their series). Column c is at
+// times[c] (s after the first sample's time; in any order: a calibrated lidar's columns count
+// down in azimuth as their times go up).
+class ColumnPoses {
+ public:
+  ColumnPoses(const Scene& scene, const SceneIndex& index, const PoseSamples& samples,
+              std::vector<double> times)
+      : samples_(samples), times_(std::move(times)) {
+    const int columns = static_cast<int>(times_.size());
+    const std::size_t n = samples.times.size();
+    sample_sensor_ok_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      sample_sensor_ok_[k] = isValidPose(samples.world_from_sensor[k]);
+    }
+    findBrackets(columns);
+    sample_rotation_.set(samples.world_from_sensor, arcs_used_);
+    sensor_.resize(columns);
+    sensor_valid_.resize(columns);
+    for (int c = 0; c < columns; ++c) {
+      const Bracket& b = brackets_[c];
+      sensor_valid_[c] = sample_sensor_ok_[b.i] && sample_sensor_ok_[b.j];
+      if (sensor_valid_[c]) {
+        sensor_[c] = interpolate(samples.world_from_sensor, sample_rotation_, b);
+      }
+    }
+    prepareFrames(scene, index);
+  }
+
+  double time(int col) const { return times_[col]; }
+  bool sensorValid(int col) const { return sensor_valid_[col]; }
+  const Eigen::Isometry3d& sensor(int col) const { return sensor_[col]; }
+  const std::vector<int>& framesWithBodies() const { return frames_; }
+  bool isStatic(int frame) const { return frame_[frame].is_static; }
+  // The frame's pose at the column's time; false if it has none then.
+  bool frameAt(int col, int frame, Eigen::Isometry3d* pose) const {
+    const Frame& f = frame_[frame];
+    if (f.is_static) {
+      *pose = samples_.frames.front().pose[frame];
+      return true;
+    }
+    const Bracket& b = brackets_[col];
+    if (!(f.ok[b.i] && f.ok[b.j])) return false;
+    *pose = interpolate(f.pose, f.rotation, b);
+    return true;
+  }
+
+ private:
+  struct Bracket {
+    std::size_t i, j;
+    double s;
+  };
+  // The samples' rotations as quaternions, and the slerp between two of them as Eigen's
+  // QuaternionBase::slerp computes it, with the angle between each sample and the next and its
+  // sine worked out once rather than at every column, and the sines of its fractions by smallSin.
+  // Only the samples some column is interpolated between (arc_used[k]: between k and k + 1) are
+  // converted: with a sample at every column's time (cast_scan's sweeps), none is.
+  class Rotations {
+   public:
+    void set(const std::vector<Eigen::Isometry3d>& poses, const std::vector<char>& arc_used) {
+      q_.resize(poses.size());
+      arc_.resize(poses.size());
+      for (std::size_t k = 0; k + 1 < poses.size(); ++k) {
+        if (!arc_used[k]) continue;
+        q_[k] = Eigen::Quaterniond(poses[k].linear());
+        q_[k + 1] = Eigen::Quaterniond(poses[k + 1].linear());
+        arc_[k] = arcBetween(q_[k], q_[k + 1]);
+      }
+    }
+    // The bracket's samples must be consecutive, with their arc used.
+    Eigen::Quaterniond slerp(const Bracket& b) const {
+      const Arc& arc = arc_[b.i];
+      const double t = b.s;
+      double scale0, scale1;
+      if (arc.linear) {
+        scale0 = 1 - t;
+        scale1 = t;
+      } else {
+        scale0 = smallSin((1 - t) * arc.theta) / arc.sin_theta;
+        scale1 = smallSin(t * arc.theta) / arc.sin_theta;
+      }
+      if (arc.flip) scale1 = -scale1;
+      return Eigen::Quaterniond(scale0 * q_[b.i].coeffs() + scale1 * q_[b.j].coeffs());
+    }
+
+   private:
+    // sin x: for |x| <= 1/4 (two samples of a sweep a few degrees apart at most) its Taylor series
+    // to x^13, whose first term left out is below 2^-61 of |x| there, so that it is within an ulp
+    // or two of std::sin; std::sin beyond.
+    static double smallSin(double x) {
+      if (!(std::abs(x) <= 0.25)) return std::sin(x);
+      const double x2 = x * x;
+      return x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 +
+                  x2 * (-1.0 / 39916800 + x2 * (1.0 / 6227020800.0)))))));
+    }
+    struct Arc {
+      bool linear = true, flip = false;
+      double theta = 0, sin_theta = 0;
+    };
+    static Arc arcBetween(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+      const double d = a.dot(b), abs_d = std::abs(d);
+      Arc arc;
+      arc.flip = d < 0;
+      arc.linear = abs_d >= 1 - std::numeric_limits<double>::epsilon();
+      if (!arc.linear) {
+        arc.theta = std::acos(abs_d);
+        arc.sin_theta = std::sin(arc.theta);
+      }
+      return arc;
+    }
+    std::vector<Eigen::Quaterniond> q_;
+    std::vector<Arc> arc_;
+  };
+  struct Frame {
+    bool is_static = false;
+    std::vector<char> ok;                       // by sample
+    std::vector<Eigen::Isometry3d> pose;        // by sample
+    Rotations rotation;                         // by sample
+  };
+
+  // PoseSamples::bracket for each column's time: the last sample at or before it (the first if
+  // none is) and the next.
+  void findBrackets(int columns) {
+    const std::vector<double>& times = samples_.times;
+    brackets_.resize(columns);
+    arcs_used_.assign(times.size(), 0);
+    for (int c = 0; c < columns; ++c) {
+      const double t = time(c);
+      const std::size_t above = std::upper_bound(times.begin(), times.end(), t) - times.begin();
+      const std::size_t k = above == 0 ? 0 : above - 1;
+      Bracket& b = brackets_[c];
+      if (t < times.front() || k + 1 == times.size()) {
+        b = Bracket{k, k, 0.0};
+      } else {
+        b = Bracket{k, k + 1, (t - times[k]) / (times[k + 1] - times[k])};
+        if (b.s == 0) b.j = k;
+      }
+      if (b.j != b.i) arcs_used_[b.i] = 1;
+    }
+  }
+
+  void prepareFrames(const Scene& scene, const SceneIndex& index) {
+    frame_.resize(scene.frames().size());
+    const std::size_t n = samples_.times.size();
+    const FramePoses& first = samples_.frames.front();
+    for (const auto& group : index.groups()) {
+      const int f = group->frame;
+      frames_.push_back(f);
+      Frame& frame = frame_[f];
+      // A frame that stays put (the whole world of racks and walls, frame after frame) is checked
+      // once: the same validity and the same pose bits in every sample.
+      bool same = first.valid[f] != 0;
+      for (std::size_t k = 1; k < n && same; ++k) {
+        const FramePoses& sample = samples_.frames[k];
+        same = sample.valid[f] && sample.pose[f].matrix() == first.pose[f].matrix();
+      }
+      if (same && isValidPose(first.pose[f])) {
+        frame.is_static = true;
+        continue;
+      }
+      frame.ok.resize(n);
+      frame.pose.resize(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        const FramePoses& sample = samples_.frames[k];
+        frame.ok[k] = sample.valid[f] && isValidPose(sample.pose[f]);
+        frame.pose[k] = sample.pose[f];
+      }
+      frame.rotation.set(frame.pose, arcs_used_);
+    }
+  }
+
+  // interpolatePose(a, b, s) of the bracket's samples, from their rotations as quaternions; a
+  // column exactly at a sample has its pose.
+  static Eigen::Isometry3d interpolate(const std::vector<Eigen::Isometry3d>& pose,
+                                       const Rotations& rotation, const Bracket& b) {
+    if (b.j == b.i) return pose[b.i];
+    Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+    const Eigen::Vector3d& ta = pose[b.i].translation();
+    out.translation() = ta + b.s * (pose[b.j].translation() - ta);
+    out.linear() = rotation.slerp(b).toRotationMatrix();
+    return out;
+  }
+
+  const PoseSamples& samples_;
+  std::vector<double> times_;  // by column
+  std::vector<char> sample_sensor_ok_;
+  Rotations sample_rotation_;
+  std::vector<Bracket> brackets_;
+  std::vector<char> arcs_used_;  // by sample: some column lies strictly between it and the next
+  std::vector<Eigen::Isometry3d> sensor_;
+  std::vector<char> sensor_valid_;
+  std::vector<int> frames_;
+  std::vector<Frame> frame_;  // by scene frame (only those with bodies are filled)
+};
+
+}  // namespace core
+}  // namespace laser_raycast
