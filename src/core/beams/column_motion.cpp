@@ -3,15 +3,37 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 namespace laser_raycast {
 namespace core {
 
 ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column,
                            double steepest, double extra_turn)
-    : col_lo_(col_lo), ref_from_column_(std::move(ref_from_column)) {
+    : ColumnMotion(col_lo, std::move(ref_from_column), steepest, extra_turn, {}, {}) {}
+
+ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column,
+                           double steepest, double extra_turn, std::vector<int> class_of_row,
+                           std::vector<std::vector<Eigen::Isometry3d>> ref_from_class)
+    : col_lo_(col_lo),
+      ref_from_column_(std::move(ref_from_column)),
+      class_of_row_(std::move(class_of_row)),
+      ref_from_class_(std::move(ref_from_class)) {
   double shift2 = 0, frobenius2 = 0, z_move2 = 0;
-  for (const Eigen::Isometry3d& m : ref_from_column_) {
+  std::vector<const Eigen::Isometry3d*> poses;
+  for (const Eigen::Isometry3d& m : ref_from_column_) poses.push_back(&m);
+  for (const auto& poses_of_class : ref_from_class_) {
+    for (std::size_t c = 0; c < poses_of_class.size(); ++c) {
+      poses.push_back(&poses_of_class[c]);
+      deviation_ = std::max(
+          deviation_,
+          (poses_of_class[c].translation() - ref_from_column_[c].translation()).norm());
+    }
+  }
+  // Widened for the rounding of the norm.
+  deviation_ = deviation_ > 0 ? deviation_ * (1 + 1e-9) : 0;
+  for (const Eigen::Isometry3d* pose : poses) {
+    const Eigen::Isometry3d& m = *pose;
     shift2 = std::max(shift2, m.translation().squaredNorm());
     frobenius2 = std::max(frobenius2, (m.linear() - Eigen::Matrix3d::Identity()).squaredNorm());
     z_move2 = std::max(z_move2, (m.linear().col(2) - Eigen::Vector3d::UnitZ()).squaredNorm());

@@ -34,6 +34,14 @@ class ColumnMotion {
   // spread's turn.
   ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column, double steepest,
                double extra_turn = 0);
+  // Rows that leave at times of their own (a Velodyne's lasers, each at its place in the firing
+  // sequence): the beam at (row, col) leaves from the pose of class class_of_row[row] (grid rows)
+  // at col, class 0 being ref_from_column, class k >= 1 ref_from_class[k - 1][col - col_lo]. The
+  // columns' poses above are class 0's; deviation() bounds how far any beam's origin lies from its
+  // column's, and the spread holds every class's poses.
+  ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column, double steepest,
+               double extra_turn, std::vector<int> class_of_row,
+               std::vector<std::vector<Eigen::Isometry3d>> ref_from_class);
 
   int colLo() const { return col_lo_; }
   int colHi() const { return col_lo_ + static_cast<int>(ref_from_column_.size()) - 1; }
@@ -47,21 +55,32 @@ class ColumnMotion {
   // its own origin: Caster::castBeams).
   bool translationsOnly() const { return translations_only_; }
 
+  // The pose the beam at (row, col) leaves from: its column's, or its row's class's.
+  const Eigen::Isometry3d& refFromBeam(int row, int col) const {
+    if (class_of_row_.empty() || class_of_row_[row] == 0) return refFromColumn(col);
+    return ref_from_class_[class_of_row_[row] - 1][col - col_lo_];
+  }
+  // The most any beam's origin lies from its column's (0 without row classes).
+  double deviation() const { return deviation_; }
+
   // Beam d of column col as a ray in the reference sensor frame.
   Ray ray(int col, const Eigen::Vector3d& d, double tmin) const {
-    const Eigen::Isometry3d& m = refFromColumn(col);
-    Ray r;
-    r.origin = m.translation();
-    // Turning by the identity gives d's bits: skipped where no column turns.
-    r.dir = translations_only_ ? d : Eigen::Vector3d(m.linear() * d);
-    r.tmin = tmin;
-    return r;
+    return rayFrom(refFromColumn(col), d, tmin);
+  }
+  // Beam d at (row, col), from its row's class's pose.
+  Ray ray(int row, int col, const Eigen::Vector3d& d, double tmin) const {
+    return rayFrom(refFromBeam(row, col), d, tmin);
   }
   // A unit normal in the reference sensor frame as column col's sensor frame has it (the frame
   // ScanResult's normals are in).
   Eigen::Vector3d toColumn(int col, const Eigen::Vector3d& n) const {
     if (translations_only_) return n;
     return refFromColumn(col).linear().transpose() * n;
+  }
+  // The same in the frame of the beam at (row, col).
+  Eigen::Vector3d toBeam(int row, int col, const Eigen::Vector3d& n) const {
+    if (translations_only_) return n;
+    return refFromBeam(row, col).linear().transpose() * n;
   }
   // Each column's origin (refFromColumn(c).translation()) rounded to float, one array per axis,
   // for the columns from colLo() rounded down to a multiple of 4 to colHi() rounded up to one less
@@ -80,8 +99,20 @@ class ColumnMotion {
   int col_lo_;
   std::vector<Eigen::Isometry3d> ref_from_column_;
   Spread spread_;
+  Ray rayFrom(const Eigen::Isometry3d& m, const Eigen::Vector3d& d, double tmin) const {
+    Ray r;
+    r.origin = m.translation();
+    // Turning by the identity gives d's bits: skipped where no column turns.
+    r.dir = translations_only_ ? d : Eigen::Vector3d(m.linear() * d);
+    r.tmin = tmin;
+    return r;
+  }
+
   bool in_plane_ = true;
   bool translations_only_ = true;
+  std::vector<int> class_of_row_;
+  std::vector<std::vector<Eigen::Isometry3d>> ref_from_class_;
+  double deviation_ = 0;
   int padded_lo_;
   std::vector<float> origin_[3];
 };

@@ -38,7 +38,7 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
   const double plane = std::abs(a.dot(m[0])) / (m[0] + m[1] + m[2]).norm() * (1 - 1e-9);
   if (std::isfinite(plane) && plane > 2 * shift) {
     motion_ = &motion;
-    init(beams, a, b, c, m, std::sin(std::min(M_PI / 2, turn)), shift, turn);
+    init(beams, a, b, c, m, std::sin(std::min(M_PI / 2, turn)), shift, turn, motion.deviation());
     return;
   }
   // The plane passes near the sensor: every edge test widened by the shift, from the triangle's
@@ -52,7 +52,7 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
 
 void ColumnRaster::init(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                         const Eigen::Vector3d& c, const Eigen::Vector3d (&m)[3], double widen,
-                        double shift, double turn) {
+                        double shift, double turn, double deviation) {
   const double det = a.dot(m[0]);
   const double abs_det = std::abs(det);
   // The 1-norms bound the 2-norms from above, so this flags a few more triangles than the ratio
@@ -64,6 +64,9 @@ void ColumnRaster::init(const BeamSet& beams, const Eigen::Vector3d& a, const Ei
   // The edges whose cross product with a column's origin moves m (m - o x e).
   const Eigen::Vector3d e[3] = {c - b, a - c, b - a};
   double moves = 0;  // the most |o x e|_2 <= shift |e|_1 moves a scaled normal
+  // The most a beam's origin off its column's by at most `deviation` moves its column's normal
+  // (|d x e|_2 <= deviation |e|_1): the edge tests' margin grows by it.
+  double deviates = 0;
   for (int k = 0; k < 3; ++k) {
     const double scale = sign / (std::abs(m[k].x()) + std::abs(m[k].y()) + std::abs(m[k].z()));
     const float z = static_cast<float>(m[k].z() * scale);
@@ -79,14 +82,16 @@ void ColumnRaster::init(const BeamSet& beams, const Eigen::Vector3d& a, const Ei
       ez_[k] = _mm_set1_ps(static_cast<float>(scaled.z()));
       const double edge_moves = shift * scaled.lpNorm<1>();
       moves = std::max(moves, edge_moves);
+      deviates = std::max(deviates, deviation * scaled.lpNorm<1>());
       // Every column's m_z = z - (o x e)_z, which moves by at most edge_moves: with room to
       // spare for float, its sign is the reference's in every column.
       column_kind_[k] = std::abs(z) > 2 * edge_moves * (1 + 1e-6) ? kind_[k] : EdgeKind::kAny;
     }
   }
-  // A column's normal's |m'|_1 <= 1 + |o x e|_1 <= 1 + sqrt(3) |o x e|_2.
-  const double factor = 1 + std::sqrt(3.0) * moves;
-  widen *= factor;
+  // A column's normal's |m'|_1 <= 1 + |o x e|_1 <= 1 + sqrt(3) |o x e|_2, a beam's within the
+  // deviation of it.
+  const double factor = 1 + std::sqrt(3.0) * (moves + deviates);
+  widen = (widen + deviates) * factor;
   if (!(widen < 0.5)) {
     all_ = true;
     return;

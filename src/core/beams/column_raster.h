@@ -87,9 +87,10 @@ class ColumnRaster {
   // The three normals, the widening and the plane from the reference pose; factor scales the
   // margin (a column's normals' largest |m|_1).
   // m: the edge normals b x c, c x a, a x b.
+  // deviation: how far a beam's origin may lie from its column's (ColumnMotion::deviation).
   void init(const BeamSet& beams, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
             const Eigen::Vector3d& c, const Eigen::Vector3d (&m)[3], double widen, double shift,
-            double turn);
+            double turn, double deviation = 0);
   // Columns base..base + 3's bounds on tan E (lo > hi: none), from their cos A and sin A: from the
   // reference's normals with `margin`, or each column's own normals (following the origins).
   void referenceBounds(__m128 ca, __m128 sa, __m128 margin, __m128* lo, __m128* hi) const;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "caster/caster_state.h"
+#include "beams/beam_grid.h"
 #include "caster/column_poses.h"
 #include "walk/frame_walk.h"
 
@@ -101,57 +102,41 @@ void CasterState::castBeamGrids(const Scene& scene, const FramePoses& poses,
 
 namespace {
 
-// The lines of a part that fire at one time in every column (an Ouster's column, a Velodyne
-// laser's place in its firing sequence): a rotating sweep casts each such class as a sweep of its
-// own, every column from the poses at its one time.
-struct TimeClass {
-  ScanPattern culling;
-  std::vector<Eigen::Vector3d> directions;
-  std::vector<int> beam;
-  std::vector<double> column_time;
-  double turn = 0;
+// A part's lines grouped by when they fire: lines of one class fire at one time in every column
+// (an Ouster's part is one class, each Velodyne laser its own, at its place in the firing
+// sequence). class_of_row by the rows of the part's grid (ascending elevation); time[k][col].
+struct TimeClasses {
+  int count = 0;
+  std::vector<int> class_of_row;
+  std::vector<std::vector<double>> time;
 };
 
 // at_once: every beam at time 0 (a cast from one pose).
-std::vector<TimeClass> timeClasses(const BeamListGrid::Part& part, const BeamList& list,
-                                   bool at_once) {
-  const int rows = part.culling.ringCount(), cols = part.culling.azimuthCount();
+TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list, bool at_once) {
+  const int rings = part.culling.ringCount(), cols = part.culling.azimuthCount();
   auto time = [&](int ring, int col) {
     return at_once ? 0.0 : list.time(part.beam[ring * cols + col]);
   };
-  std::vector<std::vector<int>> classes;
-  for (int ring = 0; ring < rows; ++ring) {
-    bool placed = false;
-    for (std::vector<int>& rings : classes) {
+  TimeClasses out;
+  std::vector<int> first_ring, class_of_ring(rings);
+  for (int ring = 0; ring < rings; ++ring) {
+    int k = 0;
+    for (; k < out.count; ++k) {
       bool same = true;
-      for (int col = 0; col < cols && same; ++col) same = time(ring, col) == time(rings[0], col);
-      if (same) {
-        rings.push_back(ring);
-        placed = true;
-        break;
-      }
+      for (int col = 0; col < cols && same; ++col) same = time(ring, col) == time(first_ring[k], col);
+      if (same) break;
     }
-    if (!placed) classes.push_back({ring});
-  }
-  FanSpec fan;
-  fan.angle_min = part.culling.angleMin();
-  fan.angle_max = part.culling.angleMax();
-  fan.samples = cols;
-  std::vector<TimeClass> out;
-  for (const std::vector<int>& rings : classes) {
-    std::vector<double> elevations;
-    for (int ring : rings) elevations.push_back(part.culling.elevations()[ring]);
-    TimeClass c{cullingGrid(fan, elevations), {}, {}, {}, 0};
-    for (int ring : rings) {
-      for (int col = 0; col < cols; ++col) {
-        c.directions.push_back(part.directions[ring * cols + col]);
-        c.beam.push_back(part.beam[ring * cols + col]);
-      }
+    if (k == out.count) {
+      ++out.count;
+      first_ring.push_back(ring);
+      out.time.emplace_back();
+      for (int col = 0; col < cols; ++col) out.time.back().push_back(time(ring, col));
     }
-    c.turn = farthestTurn(c.culling, c.directions);
-    for (int col = 0; col < cols; ++col) c.column_time.push_back(time(rings[0], col));
-    out.push_back(std::move(c));
+    class_of_ring[ring] = k;
   }
+  std::vector<int> order;
+  ringsByElevation(part.culling, &order);
+  for (int ring : order) out.class_of_row.push_back(class_of_ring[ring]);
   return out;
 }
 
@@ -162,51 +147,56 @@ void CasterState::castBeamGridsSweep(const Scene& scene, const PoseSamples& samp
                                      const CastConfig& config, ScanResult* result, bool at_once) {
   const int bodies = static_cast<int>(scene.bodies().size());
   std::vector<char> cast_any(bodies, 0), column_valid;
-  // Every class's columns' poses at once (the samples are prepared once for all of them).
-  std::vector<std::vector<TimeClass>> classes;
+  // Every part's columns' poses at once (the samples are prepared once for all of them).
+  std::vector<TimeClasses> classes;
   std::vector<double> times;
   for (const BeamListGrid::Part& part : grid.parts) {
     classes.push_back(timeClasses(part, list, at_once));
-    for (const TimeClass& c : classes.back()) {
-      times.insert(times.end(), c.column_time.begin(), c.column_time.end());
+    for (const std::vector<double>& t : classes.back().time) {
+      times.insert(times.end(), t.begin(), t.end());
     }
   }
   const ColumnPoses poses(scene, indexOf(scene), samples, std::move(times));
   int base = 0;
   for (std::size_t p = 0; p < grid.parts.size(); ++p) {
+    const BeamListGrid::Part& part = grid.parts[p];
     std::vector<Eigen::Vector3d> origins;
     bool offset = false;
-    for (const Eigen::Vector3d& o : grid.parts[p].column_origin) {
+    for (const Eigen::Vector3d& o : part.column_origin) {
       origins.push_back(o + grid.center);
       offset = offset || !origins.back().isZero(0);
     }
-    for (const TimeClass& c : classes[p]) {
-      resetResult(c.culling.size(), bodies, true, false, &grid_culling);
-      resetResult(c.culling.size(), bodies, true, config.compute_incidence, &grid_own);
-      BeamSet::Bundle sub_rays;
-      sub_rays.directions.push_back(&c.directions);
-      sub_rays.results.push_back(&grid_own);
-      sweepColumns(scene, poses, base, c.culling, offset ? &origins : nullptr, c.turn, config,
-                   &sub_rays, &grid_culling, &column_valid);
-      base += c.culling.azimuthCount();
-      result->stats.bodies_skipped =
-          std::max(result->stats.bodies_skipped, grid_culling.stats.bodies_skipped);
-      for (int b = 0; b < bodies; ++b) cast_any[b] |= cast[b].load(std::memory_order_relaxed);
-      const int cols = c.culling.azimuthCount();
-      for (std::size_t k = 0; k < c.beam.size(); ++k) {
-        const int i = c.beam[k];
-        if (!column_valid[k % cols]) {
-          result->range[i] = std::numeric_limits<double>::quiet_NaN();
-          continue;
-        }
-        result->range[i] = grid_own.range[k];
-        result->body[i] = grid_own.body[k];
-        result->triangle[i] = grid_own.triangle[k];
-        if (config.compute_incidence && grid_own.body[k] >= 0) {
-          result->normal[i] = grid_own.normal[k];
-          result->cos_incidence[i] =
-              std::min(1.0, std::abs(list.directions[i].dot(grid_own.normal[k])));
-        }
+    resetResult(part.culling.size(), bodies, true, false, &grid_culling);
+    resetResult(part.culling.size(), bodies, true, config.compute_incidence, &grid_own);
+    BeamSet::Bundle sub_rays;
+    sub_rays.directions.push_back(&part.directions);
+    sub_rays.results.push_back(&grid_own);
+    SweepBeams beams_of_part;
+    beams_of_part.origins = offset ? &origins : nullptr;
+    beams_of_part.bundle = &sub_rays;
+    beams_of_part.turn = part.turn;
+    beams_of_part.classes = classes[p].count;
+    beams_of_part.class_of_row = classes[p].class_of_row;
+    sweepColumns(scene, poses, base, part.culling, beams_of_part, config, &grid_culling,
+                 &column_valid);
+    base += classes[p].count * part.culling.azimuthCount();
+    result->stats.bodies_skipped =
+        std::max(result->stats.bodies_skipped, grid_culling.stats.bodies_skipped);
+    for (int b = 0; b < bodies; ++b) cast_any[b] |= cast[b].load(std::memory_order_relaxed);
+    const int cols = part.culling.azimuthCount();
+    for (std::size_t k = 0; k < part.beam.size(); ++k) {
+      const int i = part.beam[k];
+      if (!column_valid[k % cols]) {
+        result->range[i] = std::numeric_limits<double>::quiet_NaN();
+        continue;
+      }
+      result->range[i] = grid_own.range[k];
+      result->body[i] = grid_own.body[k];
+      result->triangle[i] = grid_own.triangle[k];
+      if (config.compute_incidence && grid_own.body[k] >= 0) {
+        result->normal[i] = grid_own.normal[k];
+        result->cos_incidence[i] =
+            std::min(1.0, std::abs(list.directions[i].dot(grid_own.normal[k])));
       }
     }
   }

@@ -91,6 +91,21 @@ struct SweepBlock {
   std::vector<const KeptSlice*> slices;                     // by placed group; null: none
 };
 
+// How the beams of a sweep's columns leave (CasterState::sweepColumns): from the sensor's origin
+// along the pattern's directions at their column's time, unless said otherwise here.
+struct SweepBeams {
+  // By column, in its sensor frame: where its beams leave from (a calibrated lidar's); null: the
+  // sensor's origin.
+  const std::vector<Eigen::Vector3d>* origins = nullptr;
+  // A bundle's sub-rays are cast instead of the pattern's beams, turned by at most `turn` (rad).
+  const BeamSet::Bundle* bundle = nullptr;
+  double turn = 0;
+  // Rows that fire at times of their own (a Velodyne's lasers): `classes` times a column, grid
+  // row r at class class_of_row[r] (empty: every row at class 0).
+  int classes = 1;
+  std::vector<int> class_of_row;
+};
+
 // What a caster keeps between casts: the scene's body trees (rebuilt when the scene changes), the
 // walk's per-scan state (kept to reuse its memory), the threads, the kept slices and the inputs of
 // the last result.
@@ -127,14 +142,14 @@ struct CasterState {
   void castBodies(const Scene& scene, const ScanPattern& pattern, const CastConfig& config,
                   ScanResult* result);
   // A rotating sweep of pattern's columns into result (reset for pattern), column c's beams from
-  // the sensor and frame poses of poses' column base + c (caster/column_poses.h), leaving from
-  // (*origins)[c] in its sensor frame (null: its origin), as a bundle's sub-rays if bundle is not
-  // null (turned by at most `turn` from the pattern's directions). column_valid: 1 for each column
-  // with a sensor pose; the others' beams are NaN in result (caster_sweep.cpp).
+  // the sensor and frame poses of poses' column base + c (caster/column_poses.h; those of row
+  // class k at base + k * columns + c), as sweep_beams says they leave. column_valid: 1 for each
+  // column with a sensor pose (at every class's time); the others' beams are NaN in result
+  // (caster_sweep.cpp).
   void sweepColumns(const Scene& scene, const ColumnPoses& poses, int base,
-                    const ScanPattern& pattern, const std::vector<Eigen::Vector3d>* origins,
-                    double turn, const CastConfig& config, const BeamSet::Bundle* bundle,
-                    ScanResult* result, std::vector<char>* column_valid);
+                    const ScanPattern& pattern, const SweepBeams& sweep_beams,
+                    const CastConfig& config, ScanResult* result,
+                    std::vector<char>* column_valid);
   // The blocks of a sweep cast against the beams of result (caster_sweep.cpp).
   void castBlocks(const Scene& scene, const std::vector<SweepBlock>& blocks,
                   const ScanPattern& pattern, const CastConfig& config, ScanResult* result,

@@ -63,19 +63,17 @@ class BlockPlanner {
   // origins: where each column's beams leave from in its sensor frame (null: the sensor's origin);
   // turn: how far the beams may turn from the pattern's directions (a calibrated lidar's, cast as
   // a bundle: ColumnMotion's extra turn).
-  // The pattern's column c is poses' column base + c.
+  // The pattern's column c is poses' column base + c (base + k * columns + c for row class k).
   BlockPlanner(const Scene& scene, const ColumnPoses& poses, int base, const ScanPattern& pattern,
-               const CastConfig& config, const std::vector<Eigen::Vector3d>* origins = nullptr,
-               double turn = 0)
+               const CastConfig& config, const SweepBeams& beams)
       : scene_(scene),
         poses_(poses),
         base_(base),
         pattern_(pattern),
         config_(config),
-        origins_(origins),
-        turn_(turn) {
+        beams_(beams) {
     steepest_ = steepestElevation(pattern);
-    limits_ = pattern.planar() ? kLimitsPlanar : origins ? kLimitsOrigins : kLimits3d;
+    limits_ = pattern.planar() ? kLimitsPlanar : beams.origins ? kLimitsOrigins : kLimits3d;
   }
 
   // Blocks over [lo, hi], every column of which has a sensor pose, in column order.
@@ -110,9 +108,9 @@ class BlockPlanner {
     frames.pose.assign(frame_count, Eigen::Isometry3d::Identity());
     frames.valid.assign(frame_count, 0);
     for (int f : poses_.framesWithBodies()) {
-      frames.valid[f] = poses_.frameAt(base_ + ref, f, &frames.pose[f]);
+      frames.valid[f] = poses_.frameAt(column(0, ref), f, &frames.pose[f]);
     }
-    block->key = relativeInputs(scene_, frames, beamsFrom(ref), pattern_, config_);
+    block->key = relativeInputs(scene_, frames, beamsFrom(0, ref), pattern_, config_);
     block->motion.assign(scene_.frames().size(), nullptr);
     std::shared_ptr<const ColumnMotion> static_motion;
     for (int f : poses_.framesWithBodies()) {
@@ -123,24 +121,28 @@ class BlockPlanner {
         block->motion[f] = static_motion;
         continue;
       }
-      std::vector<Eigen::Isometry3d> ref_from_column(hi - lo + 1);
-      for (int c = lo; c <= hi; ++c) {
-        Eigen::Isometry3d world_from_frame;
-        if (!poses_.frameAt(base_ + c, f, &world_from_frame)) return false;  // not throughout
-        const Eigen::Isometry3d column_from_frame =
-            relativePose(beamsFrom(c), world_from_frame);
-        ref_from_column[c - lo] = block->key.sensor_from_frame[f] * column_from_frame.inverse();
+      std::vector<std::vector<Eigen::Isometry3d>> ref_from(beams_.classes,
+                                                        std::vector<Eigen::Isometry3d>(hi - lo + 1));
+      for (int k = 0; k < beams_.classes; ++k) {
+        for (int c = lo; c <= hi; ++c) {
+          Eigen::Isometry3d world_from_frame;
+          if (!poses_.frameAt(column(k, c), f, &world_from_frame)) return false;  // not throughout
+          const Eigen::Isometry3d column_from_frame =
+              relativePose(beamsFrom(k, c), world_from_frame);
+          ref_from[k][c - lo] = block->key.sensor_from_frame[f] * column_from_frame.inverse();
+        }
       }
-      block->motion[f] =
-          std::make_shared<ColumnMotion>(lo, std::move(ref_from_column), steepest_, turn_);
+      block->motion[f] = motion(lo, std::move(ref_from));
       if (!small(*block->motion[f], limits_)) return false;
     }
     // A frame valid at some column but not at the reference: halved until it is one or the other.
     for (int f : poses_.framesWithBodies()) {
       if (block->key.valid[f] || poses_.isStatic(f)) continue;
       Eigen::Isometry3d unused;
-      for (int c = lo; c <= hi; ++c) {
-        if (poses_.frameAt(base_ + c, f, &unused)) return false;
+      for (int k = 0; k < beams_.classes; ++k) {
+        for (int c = lo; c <= hi; ++c) {
+          if (poses_.frameAt(column(k, c), f, &unused)) return false;
+        }
       }
     }
     if (static_motion && !small(*static_motion, limits_)) return false;
@@ -161,26 +163,45 @@ class BlockPlanner {
   }
 
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
-    std::vector<Eigen::Isometry3d> ref_from_column(hi - lo + 1);
-    const Eigen::Isometry3d world_from_ref = beamsFrom(ref);
-    for (int c = lo; c <= hi; ++c) {
-      ref_from_column[c - lo] = relativePose(world_from_ref, beamsFrom(c));
+    std::vector<std::vector<Eigen::Isometry3d>> ref_from(beams_.classes,
+                                                      std::vector<Eigen::Isometry3d>(hi - lo + 1));
+    const Eigen::Isometry3d world_from_ref = beamsFrom(0, ref);
+    for (int k = 0; k < beams_.classes; ++k) {
+      for (int c = lo; c <= hi; ++c) {
+        ref_from[k][c - lo] = relativePose(world_from_ref, beamsFrom(k, c));
+      }
     }
-    return std::make_shared<ColumnMotion>(lo, std::move(ref_from_column), steepest_, turn_);
+    return motion(lo, std::move(ref_from));
   }
 
-  // Where column c's beams leave from, with the sensor's axes: the sensor's pose at the column's
-  // time, moved to the column's origin.
-  Eigen::Isometry3d beamsFrom(int c) const {
-    Eigen::Isometry3d pose = poses_.sensor(base_ + c);
-    if (origins_) pose.translation() += pose.linear() * (*origins_)[c];
+  // The block's motion from each row class's poses (class 0's are the columns').
+  std::shared_ptr<const ColumnMotion> motion(
+      int lo, std::vector<std::vector<Eigen::Isometry3d>> ref_from) const {
+    std::vector<Eigen::Isometry3d> columns = std::move(ref_from.front());
+    if (beams_.classes == 1) {
+      return std::make_shared<ColumnMotion>(lo, std::move(columns), steepest_, beams_.turn);
+    }
+    ref_from.erase(ref_from.begin());
+    return std::make_shared<ColumnMotion>(lo, std::move(columns), steepest_, beams_.turn,
+                                          beams_.class_of_row, std::move(ref_from));
+  }
+
+  // poses' column of row class k's column c.
+  int column(int k, int c) const { return base_ + k * pattern_.azimuthCount() + c; }
+  // Where row class k's beams of column c leave from, with the sensor's axes: the sensor's pose
+  // at their time, moved to the column's origin.
+  Eigen::Isometry3d beamsFrom(int k, int c) const {
+    Eigen::Isometry3d pose = poses_.sensor(column(k, c));
+    if (beams_.origins) pose.translation() += pose.linear() * (*beams_.origins)[c];
     return pose;
   }
 
+  // The limits bound the block's own motion: a bundle's turn (beams_.turn) is the same whatever
+  // the block.
   bool small(const ColumnMotion& m, const BlockLimits& limits) const {
     const double max_turn =
         std::min(limits.turn, limits.turn_per_increment * std::abs(pattern_.angleIncrement()));
-    return m.spread().turn <= max_turn && m.spread().shift <= limits.shift;
+    return m.spread().turn <= max_turn + beams_.turn && m.spread().shift <= limits.shift;
   }
 
   const Scene& scene_;
@@ -188,8 +209,7 @@ class BlockPlanner {
   int base_;
   const ScanPattern& pattern_;
   const CastConfig& config_;
-  const std::vector<Eigen::Vector3d>* origins_;
-  double turn_;
+  const SweepBeams& beams_;
   double steepest_ = 0;
   BlockLimits limits_;
 };
@@ -234,29 +254,34 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
               config.compute_incidence, &result_);
   const ColumnPoses poses(scene, state_->indexOf(scene), samples, std::move(times));
   std::vector<char> column_valid;
-  state_->sweepColumns(scene, poses, 0, pattern, nullptr, 0, config, nullptr, &result_,
-                       &column_valid);
+  state_->sweepColumns(scene, poses, 0, pattern, SweepBeams{}, config, &result_, &column_valid);
   if (config.compute_incidence) computeIncidence(pattern, &result_);
   return result_;
 }
 
 void CasterState::sweepColumns(const Scene& scene, const ColumnPoses& poses, int base,
-                               const ScanPattern& pattern,
-                               const std::vector<Eigen::Vector3d>* origins, double turn,
-                               const CastConfig& config, const BeamSet::Bundle* bundle,
-                               ScanResult* result, std::vector<char>* column_valid) {
+                               const ScanPattern& pattern, const SweepBeams& sweep_beams,
+                               const CastConfig& config, ScanResult* result,
+                               std::vector<char>* column_valid) {
   const int azimuths = pattern.azimuthCount();
+  // A column has a sensor pose if each of its row classes has.
+  auto valid = [&](int c) {
+    for (int k = 0; k < sweep_beams.classes; ++k) {
+      if (!poses.sensorValid(base + k * azimuths + c)) return false;
+    }
+    return true;
+  };
   // Blocks over each run of columns with a sensor pose; the others' beams are NaN.
-  BlockPlanner planner(scene, poses, base, pattern, config, origins, turn);
+  BlockPlanner planner(scene, poses, base, pattern, config, sweep_beams);
   std::vector<SweepBlock> blocks;
   column_valid->assign(azimuths, 0);
   for (int c = 0; c < azimuths;) {
-    if (!poses.sensorValid(base + c)) {
+    if (!valid(c)) {
       ++c;
       continue;
     }
     int end = c;
-    while (end + 1 < azimuths && poses.sensorValid(base + end + 1)) ++end;
+    while (end + 1 < azimuths && valid(end + 1)) ++end;
     planner.plan(c, end, &blocks);
     std::fill(column_valid->begin() + c, column_valid->begin() + end + 1, 1);
     c = end + 1;
@@ -285,7 +310,7 @@ void CasterState::sweepColumns(const Scene& scene, const ColumnPoses& poses, int
     }
     result->stats.kept_slices = std::max(result->stats.kept_slices, kept);
   }
-  castBlocks(scene, blocks, pattern, config, result, bundle);
+  castBlocks(scene, blocks, pattern, config, result, sweep_beams.bundle);
   const int rows = pattern.ringCount();
   for (int c = 0; c < azimuths; ++c) {
     if ((*column_valid)[c]) continue;

@@ -157,17 +157,17 @@ class MeshWalk {
   WideBoxRay boxRay(int row, int col) const {
     Eigen::Vector3d d = beams_.grid().rebuiltDirection(row, col);
     // A sweep's beam turns with its column.
-    if (motion_) d = motion_->refFromColumn(col).linear() * d;
-    return columnBoxRay(col, active_.body_from_sensor_rot * d);
+    if (motion_) d = motion_->refFromBeam(row, col).linear() * d;
+    return beamBoxRay(row, col, active_.body_from_sensor_rot * d);
   }
-  // A ray of column col along body-frame direction d for box tests: from the sensor, or for a
-  // sweep's block from the column's own origin. (origin_ holds every column's origin, the box
-  // grown by the block's shift: a centimetre on every box makes a ray traced through small boxes
-  // enter many more of them.)
-  WideBoxRay columnBoxRay(int col, const Eigen::Vector3d& d) const {
+  // A ray of the beam at (row, col) along body-frame direction d for box tests: from the sensor,
+  // or for a sweep's block from the beam's own origin. (origin_ holds every column's origin, the
+  // box grown by the block's shift: a centimetre on every box makes a ray traced through small
+  // boxes enter many more of them.)
+  WideBoxRay beamBoxRay(int row, int col, const Eigen::Vector3d& d) const {
     if (!motion_ || spread_.shift == 0) return WideBoxRay(origin_, d);
     const Eigen::Vector3d o =
-        active_.body_from_sensor_rot * motion_->refFromColumn(col).translation() +
+        active_.body_from_sensor_rot * motion_->refFromBeam(row, col).translation() +
         active_.sensor_in_body;
     return WideBoxRay(WideBoxRay::Origin(o, mesh_.bvh().bounds(), config_.tmin), d);
   }
@@ -205,23 +205,23 @@ class MeshWalk {
     }
   };
 
-  // A triangle's unit normal in the frame of the beams of column col: the sensor's, or for a
-  // sweep's block the column's own.
-  Eigen::Vector3d columnNormal(int col, std::uint32_t triangle) const {
+  // A triangle's unit normal in the frame of the beam at (row, col): the sensor's, or for a
+  // sweep's block the beam's own pose's.
+  Eigen::Vector3d beamNormal(int row, int col, std::uint32_t triangle) const {
     const Eigen::Vector3d n = sensorNormal(triangle);
-    return motion_ ? motion_->toColumn(col, n) : n;
+    return motion_ ? motion_->toBeam(row, col, n) : n;
   }
 
   void offer(int row, int col, const Best& best) {
     beams_.keepNearestHit(row, col, best.t, active_.index, static_cast<int>(best.triangle), [&] {
-      return slicing_ ? slicer_->sensorNormal(best.slot) : columnNormal(col, best.triangle);
+      return slicing_ ? slicer_->sensorNormal(best.slot) : beamNormal(row, col, best.triangle);
     });
   }
 
   // Sub-ray k of a bundle's beam: as offer() for the beam.
   void offerSub(int k, int row, int col, const Best& best) {
     beams_.keepNearestSubHit(k, row, col, best.t, active_.index, static_cast<int>(best.triangle),
-                             [&] { return columnNormal(col, best.triangle); });
+                             [&] { return beamNormal(row, col, best.triangle); });
   }
 
   // Sub-ray k of a bundle's beam as a ray for the triangle tests: from its column's pose (a
@@ -231,7 +231,7 @@ class MeshWalk {
     const Eigen::Vector3d& d = beams_.subDirection(k, row, col);
     Ray ray;
     if (motion_) {
-      ray = motion_->ray(col, d, config_.tmin);
+      ray = motion_->ray(row, col, d, config_.tmin);
     } else {
       ray.origin.setZero();
       ray.dir = d;
@@ -242,8 +242,8 @@ class MeshWalk {
   // Its ray in the body's frame for box tests.
   WideBoxRay subBoxRay(int k, int row, int col) const {
     Eigen::Vector3d d = beams_.subDirection(k, row, col);
-    if (motion_) d = motion_->refFromColumn(col).linear() * d;
-    return columnBoxRay(col, active_.body_from_sensor_rot * d);
+    if (motion_) d = motion_->refFromBeam(row, col).linear() * d;
+    return beamBoxRay(row, col, active_.body_from_sensor_rot * d);
   }
 
   // A beam as a ray for the triangle tests: from the sensor, or for a sweep's block from its
@@ -251,7 +251,7 @@ class MeshWalk {
   PreparedRay<double, M> beamRay(int row, int col) const {
     if (!motion_) return beams_.grid().template sensorRay<M>(row, col);
     return PreparedRay<double, M>(
-        motion_->ray(col, beams_.grid().rebuiltDirection(row, col), config_.tmin),
+        motion_->ray(row, col, beams_.grid().rebuiltDirection(row, col), config_.tmin),
         config_.cull_backfaces);
   }
 
@@ -393,14 +393,14 @@ class MeshWalk {
             if (!hit) continue;
             beams_.keepNearestSubHit(k, row, col, hit->t, active_.index,
                                      static_cast<int>(triangle),
-                                     [&] { return columnNormal(col, triangle); });
+                                     [&] { return beamNormal(row, col, triangle); });
           }
           return;
         }
         const auto hit = beamRay(row, col).intersect(s.a, s.b, s.c, std::min(config_.tmax, range));
         if (!hit) return;
         beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
-                              [&] { return columnNormal(col, triangle); });
+                              [&] { return beamNormal(row, col, triangle); });
       };
       if (beams_.grid().columnRaster()) {
         (motion_ ? ColumnRaster(beams_, s.a, s.b, s.c, *motion_, e.near)

@@ -119,7 +119,7 @@ void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
       ray.origin = a.sensor_in_body;
       ray.dir = a.body_from_sensor_rot * d;
       if (a.motion) {
-        const Ray column = a.motion->ray(col, d, config.tmin);
+        const Ray column = a.motion->ray(row, col, d, config.tmin);
         ray.origin = a.body_from_sensor_rot * column.origin + a.sensor_in_body;
         ray.dir = a.body_from_sensor_rot * column.dir;
       }
@@ -129,7 +129,7 @@ void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
       if (!hit) continue;
       beams.keepNearestSubHit(k, row, col, hit->t, a.index, -1, [&] {
         const Eigen::Vector3d n = a.sensor_from_body.linear() * hit->normal;
-        return a.motion ? a.motion->toColumn(col, n) : n;
+        return a.motion ? a.motion->toBeam(row, col, n) : n;
       });
     }
     return;
@@ -138,7 +138,7 @@ void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
   ray.origin = a.sensor_in_body;
   ray.dir = a.body_from_sensor_rot * beams.grid().direction(row, col);
   if (a.motion) {  // a sweep's beam, from its column's pose
-    const Ray column = a.motion->ray(col, beams.grid().direction(row, col), config.tmin);
+    const Ray column = a.motion->ray(row, col, beams.grid().direction(row, col), config.tmin);
     ray.origin = a.body_from_sensor_rot * column.origin + a.sensor_in_body;
     ray.dir = a.body_from_sensor_rot * column.dir;
   }
@@ -149,7 +149,7 @@ void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
   if (!hit) return;
   beams.keepNearestHit(row, col, hit->t, a.index, -1, [&] {
     const Eigen::Vector3d n = a.sensor_from_body.linear() * hit->normal;
-    return a.motion ? a.motion->toColumn(col, n) : n;
+    return a.motion ? a.motion->toBeam(row, col, n) : n;
   });
 }
 
