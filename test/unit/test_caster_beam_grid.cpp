@@ -196,12 +196,27 @@ TEST(CastBeamGrid, AChangedListIsFittedAnew) {
   expectSameResult(caster.castBeams(s.scene, s.poses, sensor, beams, c), expected, order, 0.0);
 }
 
+// A VLP-16 whose azimuth corrections cancel its lasers' drift over the firing sequence: every
+// laser of a sequence points at the sequence's azimuth, so its grid holds the beams exactly (no
+// turn to widen the raster), while each laser still fires at its own time.
+core::VelodyneHead driftless() {
+  core::VelodyneHead head = core::nominalVlp16();
+  for (core::VelodyneLaser& l : head.lasers) {
+    l.rot_correction = 2 * M_PI * l.id * head.timing.laser_period / 0.1;
+  }
+  return head;
+}
+
 // A rotating sweep through the grids: each beam from the sensor and frame poses at its own time
 // (a VLP-16's lasers each at its place in the firing sequence, an Ouster's columns at theirs),
-// against the shuffled list's ray-by-ray sweep; the sensor drives and turns, the cart moves the
-// other way, and the sensor has no pose for the first 10 ms (those beams NaN either way).
+// against the shuffled list's ray-by-ray sweep; the sensor drives (at 6 m/s: a laser's origin
+// moves 0.2 mm between the first and last of a sequence) and turns, or only drives, the cart moves
+// the other way, and the sensor has no pose for the first 20 ms (those beams NaN either way).
 TEST(CastBeamGrid, RotatingSweepsGiveTheRayByRaySweep) {
-  for (unsigned seed = 1; seed <= 2; ++seed) {
+  const auto drift_free = core::fitBeamGrid(driftless().scan(0.1));
+  ASSERT_TRUE(drift_free);
+  EXPECT_LT(drift_free->parts[0].turn, 1e-9);
+  for (unsigned seed = 1; seed <= 3; ++seed) {
     Rng rng(seed + 20);
     const RandomScene s = randomScene(rng);
     core::PoseSamples samples;
@@ -210,7 +225,11 @@ TEST(CastBeamGrid, RotatingSweepsGiveTheRayByRaySweep) {
     for (int k = 0; k <= 5; ++k) {
       const double t = 0.02 * k;
       samples.times.push_back(t);
-      Eigen::Isometry3d sensor = start * pose(Eigen::Vector3d(1.5 * t, 0.4 * t, 0), yaw(2 * t));
+      // Seed 1 only drives: no turn widens the raster, so the lasers' origins off their
+      // column's must (ColumnMotion::deviation).
+      const double turn_rate = seed == 1 ? 0.0 : 2.0;
+      Eigen::Isometry3d sensor =
+          start * pose(Eigen::Vector3d(6 * t, 0.4 * t, 0), yaw(turn_rate * t));
       if (k == 0) sensor.translation().x() = std::nan("");
       samples.world_from_sensor.push_back(sensor);
       core::FramePoses frames = s.poses;
@@ -219,7 +238,8 @@ TEST(CastBeamGrid, RotatingSweepsGiveTheRayByRaySweep) {
     }
     core::CastConfig c = config(true, 25.0);
     c.compute_incidence = true;
-    for (const core::BeamList& beams : {core::nominalVlp16().scan(0.1), ouster().scan(0.1)}) {
+    for (const core::BeamList& beams :
+         {core::nominalVlp16().scan(0.1), driftless().scan(0.1), ouster().scan(0.1)}) {
       std::vector<int> order;
       const core::BeamList one_by_one = shuffled(beams, rng, &order);
       core::Caster grid, rays;
