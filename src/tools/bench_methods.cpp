@@ -106,7 +106,9 @@ Pass pipelinePass(const BenchScene& scene, int threads, bool keep_slices) {
         continue;
       }
       const core::ScanResult& result =
-          w.offGrid()
+          w.offGrid() && !w.sweeps.empty()
+              ? caster->castBeamsSweep(scene.scene, w.sweeps[p], w.beams, config)
+          : w.offGrid()
               ? caster->castBeams(scene.scene, scene.frame_poses, w.sensors[p], w.beams, config)
           : w.sweeps.empty()
               ? caster->cast(scene.scene, scene.frame_poses, w.sensors[p], *w.pattern, config)
@@ -221,10 +223,13 @@ void sweepPoses(const BenchScene& scene, const core::Bvh& soup_bvh, const Worklo
   w->time_increment = w->pattern->angleIncrement() * scan_seconds / (2 * M_PI);
   for (int k = 0; k < scans; ++k) {
     w->sweeps.push_back(sweepSamples(path, k * scan_seconds, scan_seconds, scene.frame_poses));
-    for (int c = 0; c < w->pattern->azimuthCount(); ++c) {
-      SensorPose column{0, 0, 0, 0, 0, 0};
-      column.base = fromIsometry(w->sweeps.back().sensorAt(c * w->time_increment));
-      w->poses.push_back(column);
+    // A calibrated head's beams each at their own time (castBeamsSweep), a grid's by column.
+    const int count = w->offGrid() ? w->beams.size() : w->pattern->azimuthCount();
+    for (int i = 0; i < count; ++i) {
+      SensorPose pose{0, 0, 0, 0, 0, 0};
+      const double t = w->offGrid() ? w->beams.time(i) : i * w->time_increment;
+      pose.base = fromIsometry(w->sweeps.back().sensorAt(t));
+      w->poses.push_back(pose);
     }
   }
 }
@@ -260,6 +265,15 @@ const std::vector<Workload>& workloads() {
     ouster.calibrated_vlp16 = false;
     ouster.ouster_metadata = "os1_64_nominal.json";
     all.push_back(ouster);
+    Workload vlp16_sweep = moving("sweep_vlp16_calibrated", fullTurn(1800), vlp16Rings(),
+                                  Motion::kSweep, 10, 20, 1);
+    vlp16_sweep.calibrated_vlp16 = true;
+    all.push_back(vlp16_sweep);
+    Workload ouster_sweep = vlp16_sweep;
+    ouster_sweep.name = "sweep_os1_64_metadata";
+    ouster_sweep.calibrated_vlp16 = false;
+    ouster_sweep.ouster_metadata = "os1_64_nominal.json";
+    all.push_back(ouster_sweep);
     return all;
   }();
   return list;
@@ -293,9 +307,10 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
                                  workload.ouster_metadata)
                   .scan(0.1);
   }
-  // Still workloads: every beam from the pose's one time. The lines stay, as the node's and
-  // cast_scan's lists have them (a calibrated lidar's list is fitted to grids by its lines).
-  w.beams.times.clear();
+  // Still workloads: every beam from the pose's one time; sweeps keep each beam's. The lines stay,
+  // as the node's and cast_scan's lists have them (a calibrated lidar's list is fitted to grids by
+  // its lines).
+  if (workload.motion != Motion::kSweep) w.beams.times.clear();
   if (workload.motion == Motion::kPath) {
     w.poses = pathPoses(scene, soup_bvh, workload, count);
   } else if (workload.motion == Motion::kSweep) {

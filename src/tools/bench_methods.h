@@ -58,7 +58,9 @@ struct Workload {
 // sweep_rings, a rotating VLP-16 at 10 Hz. Still, beams off any grid: pattern_rosette, the
 // 10000 points of config/patterns/rosette_4line.csv (a Livox-like rosette) from the scene's poses;
 // vlp16_calibrated, a VLP-16's 1808 x 16 beams as a calibrated head fires them; os1_64_metadata,
-// the 1024 x 64 beams of config/ouster/os1_64_nominal.json. Moving, divergent: rings_divergent,
+// the 1024 x 64 beams of config/ouster/os1_64_nominal.json; sweeping along the path at 10 Hz,
+// each beam from the pose at its own time: sweep_vlp16_calibrated and sweep_os1_64_metadata (by
+// Caster::castBeamsSweep). Moving, divergent: rings_divergent,
 // rings_path's VLP-16 with each beam 7 sub-rays over a 3 mrad footprint (the VLS-128 manual's
 // horizontal divergence), 7 x 28,800 rays a scan.
 const std::vector<Workload>& workloads();
@@ -80,7 +82,8 @@ struct WorkloadRays {
   std::vector<double> scale, scale_f;
   double tmax = 0;
   // Sweeps: each scan's pose samples and the time from one azimuth column to the next; poses and
-  // sensors then hold one pose per column (scan-major), the one Caster::castSweep casts it from.
+  // sensors then hold one pose per column (scan-major), the one Caster::castSweep casts it from (a
+  // beam list's: one per beam, at its time, as Caster::castBeamsSweep casts it).
   std::vector<core::PoseSamples> sweeps;
   double time_increment = 0;
 
@@ -95,9 +98,11 @@ struct WorkloadRays {
   }
   bool planar() const { return !offGrid() && pattern->planar(); }
   std::size_t scans() const { return sweeps.empty() ? sensors.size() : sweeps.size(); }
-  // The pose beam b (ring-major, as in the pattern) of a scan is cast from.
+  // The pose beam b (ring-major, as in the pattern; a list's in its order) of a scan is cast from.
   std::size_t poseIndex(std::size_t scan, int beam) const {
-    return sweeps.empty() ? scan : scan * pattern->azimuthCount() + beam % pattern->azimuthCount();
+    if (sweeps.empty()) return scan;
+    if (offGrid()) return scan * beams.size() + beam;
+    return scan * pattern->azimuthCount() + beam % pattern->azimuthCount();
   }
 };
 

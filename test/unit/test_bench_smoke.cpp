@@ -90,7 +90,9 @@ const std::map<std::string, long> kWorkloadBeams = {{"fan2d", 1081},
                                                     {"sweep_rings", 16 * 1800},
                                                     {"pattern_rosette", 10000},
                                                     {"vlp16_calibrated", 16 * 1808},
-                                                    {"os1_64_metadata", 64 * 1024}};
+                                                    {"os1_64_metadata", 64 * 1024},
+                                                    {"sweep_vlp16_calibrated", 16 * 1808},
+                                                    {"sweep_os1_64_metadata", 64 * 1024}};
 
 // A workload cast from the scene's poses, every method on it.
 bool isStill(const std::string& workload) {
@@ -281,8 +283,8 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  // header, 5 still workloads x 2 rows, 6 moving ones x the pipeline's row
-  ASSERT_EQ(lines.size(), 17u) << readFile(dir + "/results.csv");
+  // header, 5 still workloads x 2 rows, 8 moving ones x the pipeline's row
+  ASSERT_EQ(lines.size(), 19u) << readFile(dir + "/results.csv");
   std::multiset<std::string> rows;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const auto f = splitFields(lines[i]);
@@ -297,7 +299,8 @@ TEST(BenchSmoke, MethodKeepsOnlyTheRowsAskedFor) {
                       "sweep_rings pipeline",
                       "pattern_rosette watertight_bvh", "pattern_rosette pipeline",
                       "vlp16_calibrated watertight_bvh", "vlp16_calibrated pipeline",
-                      "os1_64_metadata watertight_bvh", "os1_64_metadata pipeline"}));
+                      "os1_64_metadata watertight_bvh", "os1_64_metadata pipeline",
+                      "sweep_vlp16_calibrated pipeline", "sweep_os1_64_metadata pipeline"}));
   std::filesystem::remove_all(dir);
   std::filesystem::remove(log);
 }
@@ -338,9 +341,9 @@ TEST(BenchSmoke, NewPlaneRowHasThePipelinesRanges) {
       " --quick --scene forest --method pipeline pipeline_new_plane --out " + dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  // header, fan2d x 2 rows, rings3d x 1 row, the pipeline's 6 moving rows, then one row each of
-  // pattern_rosette, vlp16_calibrated and os1_64_metadata
-  ASSERT_EQ(lines.size(), 13u) << readFile(dir + "/results.csv");
+  // header, fan2d x 2 rows, rings3d x 1 row, the pipeline's 6 moving rows, one row each of
+  // pattern_rosette, vlp16_calibrated and os1_64_metadata, then the calibrated heads' two sweeps
+  ASSERT_EQ(lines.size(), 15u) << readFile(dir + "/results.csv");
   const auto kept = splitFields(lines[1]), fresh = splitFields(lines[2]);
   ASSERT_EQ(kept.size(), kFields);
   ASSERT_EQ(fresh.size(), kFields);
@@ -364,7 +367,7 @@ TEST(BenchSmoke, ThreadsAddsAPipelineRowWithTheSameRanges) {
                               dir + " 2>" + log);
   ASSERT_EQ(run.status, 0) << readFile(log);
   const auto lines = splitLines(readFile(dir + "/results.csv"));
-  ASSERT_EQ(lines.size(), 23u) << readFile(dir + "/results.csv");  // header, 11 workloads x 2
+  ASSERT_EQ(lines.size(), 27u) << readFile(dir + "/results.csv");  // header, 13 workloads x 2
   for (std::size_t i = 1; i + 1 < lines.size(); i += 2) {
     const auto one = splitFields(lines[i]), two = splitFields(lines[i + 1]);
     ASSERT_EQ(one.size(), kFields) << lines[i];
@@ -411,7 +414,7 @@ TEST(BenchSmoke, MovingRowsAreTheSameInEveryRun) {
       EXPECT_EQ(a[k], b[k]) << "field " << k << ": " << runs[0][i] << " / " << runs[1][i];
     }
   }
-  EXPECT_EQ(moving, 6);
+  EXPECT_EQ(moving, 8);
 }
 
 }  // namespace
