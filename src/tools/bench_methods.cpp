@@ -255,25 +255,19 @@ const std::vector<Workload>& workloads() {
     rosette.name = "pattern_rosette";
     rosette.pattern_file = "rosette_4line.csv";
     all.push_back(rosette);
-    Workload vlp16 = rosette;
-    vlp16.name = "vlp16_calibrated";
-    vlp16.pattern_file.clear();
-    vlp16.calibrated_vlp16 = true;
-    all.push_back(vlp16);
-    Workload ouster = vlp16;
-    ouster.name = "os1_64_metadata";
-    ouster.calibrated_vlp16 = false;
-    ouster.ouster_metadata = "os1_64_nominal.json";
-    all.push_back(ouster);
-    Workload vlp16_sweep = moving("sweep_vlp16_calibrated", fullTurn(1800), vlp16Rings(),
-                                  Motion::kSweep, 10, 20, 1);
-    vlp16_sweep.calibrated_vlp16 = true;
-    all.push_back(vlp16_sweep);
-    Workload ouster_sweep = vlp16_sweep;
-    ouster_sweep.name = "sweep_os1_64_metadata";
-    ouster_sweep.calibrated_vlp16 = false;
-    ouster_sweep.ouster_metadata = "os1_64_nominal.json";
-    all.push_back(ouster_sweep);
+    // The calibrated heads, from the still poses and swept along the path.
+    auto addHeads = [&all](Workload base, const std::string& prefix) {
+      base.pattern_file.clear();
+      base.name = prefix + "vlp16_calibrated";
+      base.calibrated_vlp16 = true;
+      all.push_back(base);
+      base.name = prefix + "os1_64_metadata";
+      base.calibrated_vlp16 = false;
+      base.ouster_metadata = "os1_64_nominal.json";
+      all.push_back(base);
+    };
+    addHeads(rosette, "");
+    addHeads(moving("", fullTurn(1800), vlp16Rings(), Motion::kSweep, 10, 20, 1), "sweep_");
     return all;
   }();
   return list;

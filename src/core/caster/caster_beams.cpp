@@ -36,11 +36,14 @@ constexpr int kBeamsPerPiece = 512;
 // A cast is split between threads only if each gets at least this many beams.
 constexpr int kMinBeamsPerThread = 2048;
 
-// Every frame with bodies relative to the sensor at one time: the group's pose, or invalid.
+// Every frame with bodies relative to the sensor at one time: the group's pose, or invalid, and
+// the sphere about its tree's box in the sensor frame (a beam that misses it skips the group).
 struct GroupPoses {
   bool sensor_ok = false;
   std::vector<char> valid;                           // by group of the scene index
   std::vector<Eigen::Isometry3d> sensor_from_frame;  // by group, meaningful where valid
+  std::vector<Eigen::Vector3d> center;               // by group, sensor frame
+  std::vector<double> radius;                        // by group, widened for rounding
 };
 
 void placeGroupsAt(const SceneIndex& index, const Eigen::Isometry3d& world_from_sensor,
@@ -50,12 +53,24 @@ void placeGroupsAt(const SceneIndex& index, const Eigen::Isometry3d& world_from_
   out->sensor_ok = isValidPose(world_from_sensor);
   out->valid.assign(groups.size(), 0);
   out->sensor_from_frame.resize(groups.size());
+  out->center.resize(groups.size());
+  out->radius.resize(groups.size());
   if (!out->sensor_ok) return;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     Eigen::Isometry3d pose;
     if (!frame_pose(groups[g]->frame, &pose) || !isValidPose(pose)) continue;
     out->valid[g] = 1;
     out->sensor_from_frame[g] = relativePose(world_from_sensor, pose);
+    if (groups[g]->wide.empty()) continue;
+    const Aabb& box = groups[g]->tree.bounds();
+    out->center[g] = out->sensor_from_frame[g] * box.center();
+    const double half = (box.extent() * 0.5).norm();
+    // The box's corners lie within half of its centre; moving the centre rounds by a few ulps of
+    // the magnitudes involved, far below this relative slack.
+    out->radius[g] = half * (1 + 1e-9) +
+                     1e-9 * (out->center[g].cwiseAbs().maxCoeff() + box.center().cwiseAbs().maxCoeff() +
+                             out->sensor_from_frame[g].translation().cwiseAbs().maxCoeff()) +
+                     1e-12;
   }
 }
 
@@ -82,6 +97,21 @@ bool mayEnterBox(const Ray& ray, const Eigen::Vector3d& center, const Eigen::Vec
     if (lo > hi) return false;
   }
   return true;
+}
+
+// Whether the ray from o along unit d can meet the sphere (center, radius) within [tmin, tmax]:
+// radius holds every rounding of how the sphere was found, and the tests here add a relative
+// slack above their own, so that a group is skipped only if every point of its box is clear of
+// the ray.
+bool mayMeetSphere(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                   const Eigen::Vector3d& center, double radius, double tmax) {
+  const Eigen::Vector3d oc = center - o;
+  const double along = oc.dot(d);
+  const double slack = 1e-9 * (oc.cwiseAbs().maxCoeff() + radius) + 1e-12;
+  if (along - radius > tmax + slack) return false;  // beyond the nearest hit so far
+  if (along + radius < -slack) return false;        // behind the origin
+  const double r = radius + slack;
+  return (oc - along * d).squaredNorm() <= r * r;
 }
 
 // The nearest hit of one beam so far, over every body.
@@ -121,6 +151,9 @@ class BeamTracer {
     const auto& groups = index_.groups();
     for (std::size_t g = 0; g < groups.size(); ++g) {
       if (!poses.valid[g] || groups[g]->wide.empty()) continue;
+      if (!mayMeetSphere(o, d, poses.center[g], poses.radius[g], std::min(config_.tmax, hit.t))) {
+        continue;
+      }
       const SceneIndex::Group& group = *groups[g];
       const Eigen::Isometry3d& sensor_from_frame = poses.sensor_from_frame[g];
       const Eigen::Matrix3d frame_rot = sensor_from_frame.linear().transpose();
