@@ -53,7 +53,8 @@ class Caster {
                               const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
                               const CastConfig& config);
   // The same with each beam from the sensor and frame poses at its own time (beams.times, s from
-  // the first sample's time), interpolated in samples as castSweep does. Throws
+  // the first sample's time), interpolated in samples as castSweep does (a list on grids is swept
+  // in castSweep's blocks of columns, each beam still from the poses at its own time). Throws
   // std::invalid_argument for bad samples or beams.
   const ScanResult& castBeamsSweep(const Scene& scene, const PoseSamples& samples,
                                    const BeamList& beams, const CastConfig& config);

@@ -3,11 +3,12 @@
 // each may hit.
 //
 // Each part of the grid is cast as a bundle (BeamSet::Bundle) whose one sub-ray at a grid beam is
-// the list's beam there, from a reference pose at the middle of the beams' origins: each column of
-// the part leaves from its own origin (a ColumnMotion of translations, as a rotating sweep's block
-// leaves from its columns' poses), and the windows are widened by that shift and by the part's
-// turn. The walks test the sub-ray wherever they would test its grid beam, so a beam's range is
-// what its own ray gives; only the work of finding its triangles is shared.
+// the list's beam there, with the windows widened by the part's turn. Columns that all leave from
+// one origin (a Velodyne's) are cast from a reference pose there; columns from origins of their
+// own (an Ouster's) and rotating sweeps go through the blocks of a rotating sweep
+// (CasterState::sweepColumns), each column from its own origin and its beams' poses. The walks
+// test the sub-ray wherever they would test its grid beam, so a beam's range is what its own ray
+// gives; only the work of finding its triangles is shared.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
@@ -16,8 +17,8 @@
 #include <utility>
 #include <vector>
 
-#include "caster/caster_state.h"
 #include "beams/beam_grid.h"
+#include "caster/caster_state.h"
 #include "caster/column_poses.h"
 #include "walk/frame_walk.h"
 
