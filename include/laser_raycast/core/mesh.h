@@ -39,8 +39,9 @@ class Mesh {
   // The caster's BVH: 4-wide, over the same triangle slots (src/core/accel/wide_bvh.h, private to
   // the core); a leaf holds the triangles of one connected component where the binary BVH allows.
   const WideBvh& wideBvh() const { return *wide_; }
-  // Depth-first walk over the wide BVH's subtrees whose box (mesh frame, containing the exact box of
-  // what is below) satisfies descend(box); calls leaf(slot) for each BVH slot of every such leaf.
+  // Depth-first walk over the wide BVH's subtrees whose box (mesh frame, containing the exact box
+  // of what is below) satisfies descend(box); calls leaf(slot) for each BVH slot of every such
+  // leaf.
   void visit(const std::function<bool(const Aabb&)>& descend,
              const std::function<void(std::uint32_t)>& leaf) const;
   // The connected component of each triangle, numbered from 0, and how many there are.

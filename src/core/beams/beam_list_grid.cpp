@@ -41,6 +41,37 @@ bool sameColumns(const BeamList& beams, int height, int columns) {
   return true;
 }
 
+// Each line's first azimuth and elevations, and the mean step of the lines' azimuths (unwrapped
+// along their columns) from one column to the next.
+struct Lines {
+  std::vector<double> start, elevation_lo, elevation_hi;
+  double step = 0;
+};
+Lines measureLines(const BeamList& beams, int height, int columns) {
+  auto azimuth = [&](int i) {
+    return std::atan2(beams.directions[i].y(), beams.directions[i].x());
+  };
+  Lines out;
+  out.start.resize(height);
+  out.elevation_lo.assign(height, M_PI);
+  out.elevation_hi.assign(height, -M_PI);
+  for (int p = 0; p < height; ++p) {
+    double u = out.start[p] = azimuth(p), previous = u;
+    for (int c = 0; c < columns; ++c) {
+      const int i = c * height + p;
+      const double e = std::asin(std::max(-1.0, std::min(1.0, beams.directions[i].z())));
+      out.elevation_lo[p] = std::min(out.elevation_lo[p], e);
+      out.elevation_hi[p] = std::max(out.elevation_hi[p], e);
+      if (c == 0) continue;
+      const double a = azimuth(i);
+      u += wrapHalfTurn(a - previous);
+      previous = a;
+    }
+    out.step += (u - out.start[p]) / (columns - 1) / height;
+  }
+  return out;
+}
+
 }  // namespace
 
 ScanPattern cullingGrid(const FanSpec& fan, std::vector<double> elevations) {
@@ -65,25 +96,10 @@ std::optional<BeamListGrid> fitBeamGrid(const BeamList& beams) {
   const int columns = beams.size() / height;
   if (columns < 2 || !sameColumns(beams, height, columns)) return std::nullopt;
 
-  // Each line's azimuths unwrapped along its columns, and its step from column to column.
   auto beam = [&](int p, int c) { return c * height + p; };
-  auto azimuth = [&](int i) { return std::atan2(beams.directions[i].y(), beams.directions[i].x()); };
-  std::vector<double> start(height), elevation_lo(height, M_PI), elevation_hi(height, -M_PI);
-  double step = 0;
-  for (int p = 0; p < height; ++p) {
-    double u = start[p] = azimuth(beam(p, 0)), previous = u;
-    for (int c = 0; c < columns; ++c) {
-      const Eigen::Vector3d& d = beams.directions[beam(p, c)];
-      const double e = std::asin(std::max(-1.0, std::min(1.0, d.z())));
-      elevation_lo[p] = std::min(elevation_lo[p], e);
-      elevation_hi[p] = std::max(elevation_hi[p], e);
-      if (c == 0) continue;
-      const double a = azimuth(beam(p, c));
-      u += wrapHalfTurn(a - previous);
-      previous = a;
-    }
-    step += (u - start[p]) / (columns - 1) / height;
-  }
+  const Lines lines_of = measureLines(beams, height, columns);
+  const std::vector<double>& start = lines_of.start;
+  const double step = lines_of.step;
   const double increment = std::abs(step);
   if (!(increment > 0) || !std::isfinite(increment)) return std::nullopt;
 
@@ -119,7 +135,9 @@ std::optional<BeamListGrid> fitBeamGrid(const BeamList& beams) {
     fan.angle_max = fan.angle_min + (columns - 1) * increment;
     fan.samples = columns;
     std::vector<double> elevations;
-    for (int p : lines) elevations.push_back((elevation_lo[p] + elevation_hi[p]) / 2);
+    for (int p : lines) {
+      elevations.push_back((lines_of.elevation_lo[p] + lines_of.elevation_hi[p]) / 2);
+    }
     BeamListGrid::Part part{cullingGrid(fan, elevations), {}, {}, {}, 0};
     for (std::size_t q = 0; q < lines.size(); ++q) {
       for (int j = 0; j < columns; ++j) {

@@ -25,6 +25,87 @@
 namespace laser_raycast {
 namespace core {
 
+namespace {
+
+// The bodies cast against in any of a list's walks, for its CastStats::bodies_culled.
+class CastBodies {
+ public:
+  explicit CastBodies(int bodies) : any_(bodies, 0) {}
+  void add(const std::vector<std::atomic<char>>& cast) {
+    for (std::size_t b = 0; b < any_.size(); ++b) {
+      any_[b] |= cast[b].load(std::memory_order_relaxed);
+    }
+  }
+  int count() const { return static_cast<int>(std::count(any_.begin(), any_.end(), 1)); }
+
+ private:
+  std::vector<char> any_;
+};
+
+// A part's result (own, by its grid's beams) into the list's: each beam's range, body, triangle
+// and, with compute_incidence, normal and incidence; NaN where column_valid (if given) is 0.
+void scatter(const BeamListGrid::Part& part, const ScanResult& own, const BeamList& list,
+             const CastConfig& config, const std::vector<char>* column_valid,
+             ScanResult* result) {
+  const int cols = part.culling.azimuthCount();
+  for (std::size_t k = 0; k < part.beam.size(); ++k) {
+    const int i = part.beam[k];
+    if (column_valid && !(*column_valid)[k % cols]) {
+      result->range[i] = std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
+    result->range[i] = own.range[k];
+    result->body[i] = own.body[k];
+    result->triangle[i] = own.triangle[k];
+    if (config.compute_incidence && own.body[k] >= 0) {
+      result->normal[i] = own.normal[k];
+      result->cos_incidence[i] = std::min(1.0, std::abs(list.directions[i].dot(own.normal[k])));
+    }
+  }
+}
+
+// A part's lines grouped by when they fire: lines of one class fire at one time in every column
+// (an Ouster's part is one class, each Velodyne laser its own, at its place in the firing
+// sequence). class_of_row by the rows of the part's grid (ascending elevation); time[k][col].
+struct TimeClasses {
+  int count = 0;
+  std::vector<int> class_of_row;
+  std::vector<std::vector<double>> time;
+};
+
+// at_once: every beam at time 0 (a cast from one pose).
+TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list, bool at_once) {
+  const int rings = part.culling.ringCount(), cols = part.culling.azimuthCount();
+  auto time = [&](int ring, int col) {
+    return at_once ? 0.0 : list.time(part.beam[ring * cols + col]);
+  };
+  TimeClasses out;
+  std::vector<int> first_ring, class_of_ring(rings);
+  for (int ring = 0; ring < rings; ++ring) {
+    int k = 0;
+    for (; k < out.count; ++k) {
+      bool same = true;
+      for (int col = 0; col < cols && same; ++col) {
+        same = time(ring, col) == time(first_ring[k], col);
+      }
+      if (same) break;
+    }
+    if (k == out.count) {
+      ++out.count;
+      first_ring.push_back(ring);
+      out.time.emplace_back();
+      for (int col = 0; col < cols; ++col) out.time.back().push_back(time(ring, col));
+    }
+    class_of_ring[ring] = k;
+  }
+  std::vector<int> order;
+  ringsByElevation(part.culling, &order);
+  for (int ring : order) out.class_of_row.push_back(class_of_ring[ring]);
+  return out;
+}
+
+}  // namespace
+
 const BeamListGrid* CasterState::gridOf(const BeamList& beams) {
   const std::vector<Eigen::Vector3d>& origins = beams.origins;
   if (!fitted || fitted->directions != beams.directions || fitted->origins != origins ||
@@ -56,7 +137,7 @@ void CasterState::castBeamGrids(const Scene& scene, const FramePoses& poses,
   }
   const int bodies = static_cast<int>(scene.bodies().size());
   const Eigen::Isometry3d world_from_ref = world_from_sensor * Eigen::Translation3d(grid.center);
-  std::vector<char> cast_any(bodies, 0);
+  CastBodies cast_any(bodies);
   ScanResult& culling = grid_culling;
   ScanResult& own = grid_own;
   for (const BeamListGrid::Part& part : grid.parts) {
@@ -84,70 +165,18 @@ void CasterState::castBeamGrids(const Scene& scene, const FramePoses& poses,
           }
         },
         &sub_rays);
-    for (int b = 0; b < bodies; ++b) cast_any[b] |= cast[b].load(std::memory_order_relaxed);
-    for (std::size_t k = 0; k < part.beam.size(); ++k) {
-      const int i = part.beam[k];
-      result->range[i] = own.range[k];
-      result->body[i] = own.body[k];
-      result->triangle[i] = own.triangle[k];
-      if (config.compute_incidence && own.body[k] >= 0) {
-        result->normal[i] = own.normal[k];
-        result->cos_incidence[i] = std::min(1.0, std::abs(list.directions[i].dot(own.normal[k])));
-      }
-    }
+    cast_any.add(cast);
+    scatter(part, own, list, config, nullptr, result);
   }
-  int cast_count = 0;
-  for (char c : cast_any) cast_count += c;
-  result->stats.bodies_culled = bodies - result->stats.bodies_skipped - cast_count;
+  result->stats.bodies_culled = bodies - result->stats.bodies_skipped - cast_any.count();
 }
-
-namespace {
-
-// A part's lines grouped by when they fire: lines of one class fire at one time in every column
-// (an Ouster's part is one class, each Velodyne laser its own, at its place in the firing
-// sequence). class_of_row by the rows of the part's grid (ascending elevation); time[k][col].
-struct TimeClasses {
-  int count = 0;
-  std::vector<int> class_of_row;
-  std::vector<std::vector<double>> time;
-};
-
-// at_once: every beam at time 0 (a cast from one pose).
-TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list, bool at_once) {
-  const int rings = part.culling.ringCount(), cols = part.culling.azimuthCount();
-  auto time = [&](int ring, int col) {
-    return at_once ? 0.0 : list.time(part.beam[ring * cols + col]);
-  };
-  TimeClasses out;
-  std::vector<int> first_ring, class_of_ring(rings);
-  for (int ring = 0; ring < rings; ++ring) {
-    int k = 0;
-    for (; k < out.count; ++k) {
-      bool same = true;
-      for (int col = 0; col < cols && same; ++col) same = time(ring, col) == time(first_ring[k], col);
-      if (same) break;
-    }
-    if (k == out.count) {
-      ++out.count;
-      first_ring.push_back(ring);
-      out.time.emplace_back();
-      for (int col = 0; col < cols; ++col) out.time.back().push_back(time(ring, col));
-    }
-    class_of_ring[ring] = k;
-  }
-  std::vector<int> order;
-  ringsByElevation(part.culling, &order);
-  for (int ring : order) out.class_of_row.push_back(class_of_ring[ring]);
-  return out;
-}
-
-}  // namespace
 
 void CasterState::castBeamGridsSweep(const Scene& scene, const PoseSamples& samples,
                                      const BeamList& list, const BeamListGrid& grid,
                                      const CastConfig& config, ScanResult* result, bool at_once) {
   const int bodies = static_cast<int>(scene.bodies().size());
-  std::vector<char> cast_any(bodies, 0), column_valid;
+  CastBodies cast_any(bodies);
+  std::vector<char> column_valid;
   // Every part's columns' poses at once (the samples are prepared once for all of them).
   std::vector<TimeClasses> classes;
   std::vector<double> times;
@@ -183,27 +212,10 @@ void CasterState::castBeamGridsSweep(const Scene& scene, const PoseSamples& samp
     base += classes[p].count * part.culling.azimuthCount();
     result->stats.bodies_skipped =
         std::max(result->stats.bodies_skipped, grid_culling.stats.bodies_skipped);
-    for (int b = 0; b < bodies; ++b) cast_any[b] |= cast[b].load(std::memory_order_relaxed);
-    const int cols = part.culling.azimuthCount();
-    for (std::size_t k = 0; k < part.beam.size(); ++k) {
-      const int i = part.beam[k];
-      if (!column_valid[k % cols]) {
-        result->range[i] = std::numeric_limits<double>::quiet_NaN();
-        continue;
-      }
-      result->range[i] = grid_own.range[k];
-      result->body[i] = grid_own.body[k];
-      result->triangle[i] = grid_own.triangle[k];
-      if (config.compute_incidence && grid_own.body[k] >= 0) {
-        result->normal[i] = grid_own.normal[k];
-        result->cos_incidence[i] =
-            std::min(1.0, std::abs(list.directions[i].dot(grid_own.normal[k])));
-      }
-    }
+    cast_any.add(cast);
+    scatter(part, grid_own, list, config, &column_valid, result);
   }
-  int cast_count = 0;
-  for (char c : cast_any) cast_count += c;
-  result->stats.bodies_culled = bodies - result->stats.bodies_skipped - cast_count;
+  result->stats.bodies_culled = bodies - result->stats.bodies_skipped - cast_any.count();
 }
 
 }  // namespace core

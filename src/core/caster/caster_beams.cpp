@@ -1,5 +1,5 @@
 // Caster::castBeams and castBeamsSweep: beams off any grid (beam_list.h), one ray at a time. (A
-// list that lies on grids, a calibrated spinning lidar's, is cast from one pose through the grid's
+// list that lies on grids, a calibrated spinning lidar's, is cast and swept through the grid's
 // walks instead: caster_beam_grid.cpp.)
 //
 // A grid's walks find the beams each box reaches from the box's view; beams on no grid have no
@@ -64,13 +64,12 @@ void placeGroupsAt(const SceneIndex& index, const Eigen::Isometry3d& world_from_
     if (groups[g]->wide.empty()) continue;
     const Aabb& box = groups[g]->tree.bounds();
     out->center[g] = out->sensor_from_frame[g] * box.center();
-    const double half = (box.extent() * 0.5).norm();
-    // The box's corners lie within half of its centre; moving the centre rounds by a few ulps of
-    // the magnitudes involved, far below this relative slack.
-    out->radius[g] = half * (1 + 1e-9) +
-                     1e-9 * (out->center[g].cwiseAbs().maxCoeff() + box.center().cwiseAbs().maxCoeff() +
-                             out->sensor_from_frame[g].translation().cwiseAbs().maxCoeff()) +
-                     1e-12;
+    // The box's corners lie within half its diagonal of its centre; moving the centre rounds by a
+    // few ulps of the magnitudes involved, far below this relative slack.
+    const double magnitudes = out->center[g].cwiseAbs().maxCoeff() +
+                              box.center().cwiseAbs().maxCoeff() +
+                              out->sensor_from_frame[g].translation().cwiseAbs().maxCoeff();
+    out->radius[g] = (box.extent() * 0.5).norm() * (1 + 1e-9) + 1e-9 * magnitudes;
   }
 }
 
@@ -107,7 +106,7 @@ bool mayMeetSphere(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
                    const Eigen::Vector3d& center, double radius, double tmax) {
   const Eigen::Vector3d oc = center - o;
   const double along = oc.dot(d);
-  const double slack = 1e-9 * (oc.cwiseAbs().maxCoeff() + radius) + 1e-12;
+  const double slack = 1e-9 * (oc.cwiseAbs().maxCoeff() + radius);
   if (along - radius > tmax + slack) return false;  // beyond the nearest hit so far
   if (along + radius < -slack) return false;        // behind the origin
   const double r = radius + slack;

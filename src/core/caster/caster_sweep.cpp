@@ -121,8 +121,7 @@ class BlockPlanner {
         block->motion[f] = static_motion;
         continue;
       }
-      std::vector<std::vector<Eigen::Isometry3d>> ref_from(beams_.classes,
-                                                        std::vector<Eigen::Isometry3d>(hi - lo + 1));
+      ClassPoses ref_from = classPoses(lo, hi);
       for (int k = 0; k < beams_.classes; ++k) {
         for (int c = lo; c <= hi; ++c) {
           Eigen::Isometry3d world_from_frame;
@@ -163,8 +162,7 @@ class BlockPlanner {
   }
 
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
-    std::vector<std::vector<Eigen::Isometry3d>> ref_from(beams_.classes,
-                                                      std::vector<Eigen::Isometry3d>(hi - lo + 1));
+    ClassPoses ref_from = classPoses(lo, hi);
     const Eigen::Isometry3d world_from_ref = beamsFrom(0, ref);
     for (int k = 0; k < beams_.classes; ++k) {
       for (int c = lo; c <= hi; ++c) {
@@ -174,9 +172,14 @@ class BlockPlanner {
     return motion(lo, std::move(ref_from));
   }
 
-  // The block's motion from each row class's poses (class 0's are the columns').
-  std::shared_ptr<const ColumnMotion> motion(
-      int lo, std::vector<std::vector<Eigen::Isometry3d>> ref_from) const {
+  // Each row class's poses at columns lo..hi relative to the reference (class 0's are the
+  // columns'), to be filled.
+  using ClassPoses = std::vector<std::vector<Eigen::Isometry3d>>;
+  ClassPoses classPoses(int lo, int hi) const {
+    return ClassPoses(beams_.classes, std::vector<Eigen::Isometry3d>(hi - lo + 1));
+  }
+  // The block's motion from them.
+  std::shared_ptr<const ColumnMotion> motion(int lo, ClassPoses ref_from) const {
     std::vector<Eigen::Isometry3d> columns = std::move(ref_from.front());
     if (beams_.classes == 1) {
       return std::make_shared<ColumnMotion>(lo, std::move(columns), steepest_, beams_.turn);

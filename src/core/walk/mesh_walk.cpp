@@ -155,23 +155,21 @@ class MeshWalk {
   // The beam as a ray in the body's frame, for box tests: the same one for every box test of this
   // walk.
   WideBoxRay boxRay(int row, int col) const {
-    Eigen::Vector3d d = beams_.grid().rebuiltDirection(row, col);
-    // A sweep's beam turns with its column.
-    if (motion_) d = motion_->refFromBeam(row, col).linear() * d;
-    return beamBoxRay(row, col, active_.body_from_sensor_rot * d);
+    return boxRayAlong(row, col, beams_.grid().rebuiltDirection(row, col));
   }
-  // A ray of the beam at (row, col) along body-frame direction d for box tests: from the sensor,
-  // or for a sweep's block from the beam's own origin. (origin_ holds every column's origin, the
-  // box grown by the block's shift: a centimetre on every box makes a ray traced through small
-  // boxes enter many more of them.)
-  WideBoxRay beamBoxRay(int row, int col, const Eigen::Vector3d& d) const {
-    if (!motion_ || spread_.shift == 0) return WideBoxRay(origin_, d);
+  // The beam at (row, col) along sensor-frame direction d as a ray in the body's frame for box
+  // tests: from the sensor, or for a sweep's block turned with the beam's pose and from its own
+  // origin. (origin_ holds every column's origin, the box grown by the block's shift: a centimetre
+  // on every box makes a ray traced through small boxes enter many more of them.)
+  WideBoxRay boxRayAlong(int row, int col, const Eigen::Vector3d& d) const {
+    if (!motion_) return WideBoxRay(origin_, active_.body_from_sensor_rot * d);
+    const Eigen::Isometry3d& pose = motion_->refFromBeam(row, col);
+    const Eigen::Vector3d dir = active_.body_from_sensor_rot * (pose.linear() * d);
+    if (spread_.shift == 0) return WideBoxRay(origin_, dir);
     const Eigen::Vector3d o =
-        active_.body_from_sensor_rot * motion_->refFromBeam(row, col).translation() +
-        active_.sensor_in_body;
-    return WideBoxRay(WideBoxRay::Origin(o, mesh_.bvh().bounds(), config_.tmin), d);
+        active_.body_from_sensor_rot * pose.translation() + active_.sensor_in_body;
+    return WideBoxRay(WideBoxRay::Origin(o, mesh_.bvh().bounds(), config_.tmin), dir);
   }
-
 
   // A triangle slot moved into the sensor frame. Every 3D test of this body's triangles is the
   // beam's sensor-frame ray against these vertices, however the pair was found (traced,
@@ -224,35 +222,26 @@ class MeshWalk {
                              [&] { return beamNormal(row, col, best.triangle); });
   }
 
-  // Sub-ray k of a bundle's beam as a ray for the triangle tests: from its column's pose (a
-  // divergent beam's block has the sensor's at every column, a calibrated lidar's the column's
-  // origin), as a cast of its pattern tests it.
+  // Sub-ray k of a bundle's beam for the triangle tests and the box tests, as a cast of its
+  // pattern tests it (a divergent beam's block has the sensor's pose at every column).
   PreparedRay<double, M> subRay(int k, int row, int col) const {
-    const Eigen::Vector3d& d = beams_.subDirection(k, row, col);
-    Ray ray;
-    if (motion_) {
-      ray = motion_->ray(row, col, d, config_.tmin);
-    } else {
-      ray.origin.setZero();
-      ray.dir = d;
-      ray.tmin = config_.tmin;
-    }
+    return rayAlong(row, col, beams_.subDirection(k, row, col));
+  }
+  WideBoxRay subBoxRay(int k, int row, int col) const {
+    return boxRayAlong(row, col, beams_.subDirection(k, row, col));
+  }
+  // The beam at (row, col) along sensor-frame direction d for the triangle tests: from the
+  // sensor, or for a sweep's block from the beam's pose, in the reference sensor frame.
+  PreparedRay<double, M> rayAlong(int row, int col, const Eigen::Vector3d& d) const {
+    Ray ray{Eigen::Vector3d::Zero(), d, config_.tmin};
+    if (motion_) ray = motion_->ray(row, col, d, config_.tmin);
     return PreparedRay<double, M>(ray, config_.cull_backfaces);
   }
-  // Its ray in the body's frame for box tests.
-  WideBoxRay subBoxRay(int k, int row, int col) const {
-    Eigen::Vector3d d = beams_.subDirection(k, row, col);
-    if (motion_) d = motion_->refFromBeam(row, col).linear() * d;
-    return beamBoxRay(row, col, active_.body_from_sensor_rot * d);
-  }
-
-  // A beam as a ray for the triangle tests: from the sensor, or for a sweep's block from its
-  // column's pose, in the reference sensor frame.
+  // The grid's beam for the triangle tests (rayAlong its direction; from the sensor, the grid's
+  // prepared ray).
   PreparedRay<double, M> beamRay(int row, int col) const {
     if (!motion_) return beams_.grid().template sensorRay<M>(row, col);
-    return PreparedRay<double, M>(
-        motion_->ray(row, col, beams_.grid().rebuiltDirection(row, col), config_.tmin),
-        config_.cull_backfaces);
+    return rayAlong(row, col, beams_.grid().rebuiltDirection(row, col));
   }
 
   // Each open beam of the rect through the node's subtree, one ray at a time.

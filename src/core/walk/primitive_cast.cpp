@@ -105,52 +105,53 @@ class BoxPrefilter {
   __m128 ox_, oy_, tube_r_, tube_pad_;
 };
 
+// The beam at (row, col) along sensor-frame direction d as a ray in the body's frame, out to tmax:
+// from the sensor, or for a sweep's block (and a bundle's) from the beam's own pose.
+Ray bodyRay(const PlacedBody& a, const CastConfig& config, int row, int col,
+            const Eigen::Vector3d& d, double tmax) {
+  Ray ray;
+  if (a.motion) {
+    const Ray beam = a.motion->ray(row, col, d, config.tmin);
+    ray.origin = a.body_from_sensor_rot * beam.origin + a.sensor_in_body;
+    ray.dir = a.body_from_sensor_rot * beam.dir;
+  } else {
+    ray.origin = a.sensor_in_body;
+    ray.dir = a.body_from_sensor_rot * d;
+  }
+  ray.tmin = config.tmin;
+  ray.tmax = tmax;
+  return ray;
+}
+
+// A hit's normal n (body frame) in the frame of the beam at (row, col), as ScanResult has it.
+Eigen::Vector3d beamNormal(const PlacedBody& a, int row, int col, const Eigen::Vector3d& n) {
+  const Eigen::Vector3d sensor_n = a.sensor_from_body.linear() * n;
+  return a.motion ? a.motion->toBeam(row, col, sensor_n) : sensor_n;
+}
+
 // One beam (its range so far: current) against the primitive, analytically: every hit of a beam on
-// a primitive is found here.
+// a primitive is found here. The beams are valid rays (a unit direction, a finite pose): no check
+// needed.
 template <class Primitive>
 void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
               const CastConfig& config, int row, int col, double current) {
   if (beams.bundle()) {
-    // Each of a bundle's sub-rays, from its column's pose (the block's motion), as testBeam below
-    // casts a sweep's beam.
     for (int k = 0; k < beams.subRays(); ++k) {
-      const Eigen::Vector3d& d = beams.subDirection(k, row, col);
-      Ray ray;
-      ray.origin = a.sensor_in_body;
-      ray.dir = a.body_from_sensor_rot * d;
-      if (a.motion) {
-        const Ray column = a.motion->ray(row, col, d, config.tmin);
-        ray.origin = a.body_from_sensor_rot * column.origin + a.sensor_in_body;
-        ray.dir = a.body_from_sensor_rot * column.dir;
-      }
-      ray.tmin = config.tmin;
-      ray.tmax = std::min(config.tmax, beams.subRange(k, row, col));
+      const Ray ray = bodyRay(a, config, row, col, beams.subDirection(k, row, col),
+                              std::min(config.tmax, beams.subRange(k, row, col)));
       const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
       if (!hit) continue;
-      beams.keepNearestSubHit(k, row, col, hit->t, a.index, -1, [&] {
-        const Eigen::Vector3d n = a.sensor_from_body.linear() * hit->normal;
-        return a.motion ? a.motion->toBeam(row, col, n) : n;
-      });
+      beams.keepNearestSubHit(k, row, col, hit->t, a.index, -1,
+                              [&] { return beamNormal(a, row, col, hit->normal); });
     }
     return;
   }
-  Ray ray;
-  ray.origin = a.sensor_in_body;
-  ray.dir = a.body_from_sensor_rot * beams.grid().direction(row, col);
-  if (a.motion) {  // a sweep's beam, from its column's pose
-    const Ray column = a.motion->ray(row, col, beams.grid().direction(row, col), config.tmin);
-    ray.origin = a.body_from_sensor_rot * column.origin + a.sensor_in_body;
-    ray.dir = a.body_from_sensor_rot * column.dir;
-  }
-  ray.tmin = config.tmin;
-  ray.tmax = std::min(config.tmax, current);
-  // The beams are valid rays (a unit direction, a finite pose): no check needed.
+  const Ray ray = bodyRay(a, config, row, col, beams.grid().direction(row, col),
+                          std::min(config.tmax, current));
   const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
   if (!hit) return;
-  beams.keepNearestHit(row, col, hit->t, a.index, -1, [&] {
-    const Eigen::Vector3d n = a.sensor_from_body.linear() * hit->normal;
-    return a.motion ? a.motion->toBeam(row, col, n) : n;
-  });
+  beams.keepNearestHit(row, col, hit->t, a.index, -1,
+                       [&] { return beamNormal(a, row, col, hit->normal); });
 }
 
 // The open beams of rect that the pre-test lets through against one primitive, analytically.
