@@ -29,13 +29,18 @@ class BeamSet {
   // ColumnMotion from their column's origin as the grid's beams do. The grid's own ranges then
   // hold the farthest of a beam's sub-ray ranges, which is what culling reads, and the walks test
   // each sub-ray where they would test the beam.
+  // With `first`, each grid beam stands for a list of its own instead (a cell of an angular grid
+  // over beams off any grid, beams/beam_list_grid.h): sub-rays first[i] to first[i + 1] - 1 of
+  // the one `directions` and `results` (indexed by sub-ray); a grid beam with none is never open.
   struct Bundle {
     std::vector<const std::vector<Eigen::Vector3d>*> directions;  // each indexed as the pattern's
     std::vector<ScanResult*> results;
+    const std::vector<int>* first = nullptr;  // by grid beam, one more at the end
   };
 
   // Starts a scan: every beam open (result's ranges as resetResult left them, and a bundle's
-  // results'), the grid prepared for pattern and config.
+  // results'), the grid prepared for pattern and config. A bundle's results are complete only
+  // after finish().
   void reset(const ScanPattern& pattern, const CastConfig& config, ScanResult* result,
              const Bundle* bundle = nullptr);
 
@@ -65,23 +70,37 @@ class BeamSet {
 
   // The bundle being cast, or null.
   const Bundle* bundle() const { return bundle_; }
-  int subRays() const { return static_cast<int>(bundle_->directions.size()); }
-  // Sub-ray k of the beam at (row, col): its direction (sensor frame) and its range so far.
-  const Eigen::Vector3d& subDirection(int k, int row, int col) const {
-    return (*bundle_->directions[k])[grid_.beam(row, col)];
-  }
-  double subRange(int k, int row, int col) const {
-    return bundle_->results[k]->range[grid_.beam(row, col)];
-  }
-  // keepNearestHit for sub-ray k, by the same order; the beam's culling range follows the
-  // farthest of its sub-rays'.
+  // The sub-rays of the beam at (row, col) are s = subBegin(...) to subEnd(...) - 1.
+  int subBegin(int row, int col) const { return firstSub(grid_.beam(row, col)); }
+  int subEnd(int row, int col) const { return firstSub(grid_.beam(row, col) + 1); }
+  // Sub-ray s: its direction (sensor frame) and its range so far.
+  const Eigen::Vector3d& subDirection(int s) const { return sub_direction_[s]; }
+  double subRange(int s) const { return sub_range_[s]; }
+  // keepNearestHit for sub-ray s of the beam at (row, col), by the same order; the beam's culling
+  // range follows the farthest of its sub-rays'.
   template <class Normal>
-  bool keepNearestSubHit(int k, int row, int col, double t, int body, int triangle,
+  bool keepNearestSubHit(int s, int row, int col, double t, int body, int triangle,
                          Normal&& normal);
+  // Ends a scan: a bundle's sub-ray hits written into its results.
+  void finish();
 
  private:
+  int firstSub(int beam) const { return first_ ? (*first_)[beam] : beam * sub_rays_; }
+
   BeamGrid grid_;
   const Bundle* bundle_ = nullptr;
+  // The sub-rays while a bundle is cast, sub-ray by sub-ray: a fixed number a beam (sub_rays_)
+  // kept beam by beam (sub-ray k of beam i at i * sub_rays_ + k), so that a beam's sub-rays share
+  // cache lines, or a bundle's own lists (first_).
+  const std::vector<int>* first_ = nullptr;
+  int sub_rays_ = 0;
+  const Eigen::Vector3d* sub_direction_ = nullptr;
+  double* sub_range_ = nullptr;
+  int *sub_body_ = nullptr, *sub_triangle_ = nullptr;
+  Eigen::Vector3d* sub_normal_ = nullptr;
+  // What the pointers above point into when the bundle's own arrays are not sub-ray by sub-ray.
+  std::vector<Eigen::Vector3d> interleaved_directions_;
+  ScanResult interleaved_;
   ScanResult* result_ = nullptr;
   bool with_normals_ = false;
   bool occlusion_culling_ = true;
@@ -104,17 +123,18 @@ bool BeamSet::keepNearestHit(int row, int col, double t, int body, int triangle,
 }
 
 template <class Normal>
-bool BeamSet::keepNearestSubHit(int k, int row, int col, double t, int body, int triangle,
+bool BeamSet::keepNearestSubHit(int s, int row, int col, double t, int body, int triangle,
                                 Normal&& normal) {
+  if (!hitBefore(t, body, triangle, sub_range_[s], sub_body_[s], sub_triangle_[s])) return false;
+  sub_range_[s] = t;
+  sub_body_[s] = body;
+  sub_triangle_[s] = triangle;
+  if (with_normals_) sub_normal_[s] = normal();
   const int i = grid_.beam(row, col);
-  ScanResult& sub = *bundle_->results[k];
-  if (!hitBefore(t, body, triangle, sub.range[i], sub.body[i], sub.triangle[i])) return false;
-  sub.range[i] = t;
-  sub.body[i] = body;
-  sub.triangle[i] = triangle;
-  if (with_normals_) sub.normal[i] = normal();
   double farthest = 0;
-  for (const ScanResult* r : bundle_->results) farthest = std::max(farthest, r->range[i]);
+  for (int j = firstSub(i), end = firstSub(i + 1); j < end; ++j) {
+    farthest = std::max(farthest, sub_range_[j]);
+  }
   if (farthest < result_->range[i]) {
     result_->range[i] = farthest;
     tiles_.lower(row, col, floatAbove(farthest));

@@ -177,6 +177,34 @@ class MeshWalk {
   struct SensorTriangle {
     Eigen::Vector3d a, b, c;
   };
+  // A bundle's sub-rays that all leave from the reference sensor's origin, unturned (a divergent
+  // beam's, a cell's): a sub-ray d whose triple products with the triangle's edges, d.(b x c),
+  // d.(c x a) and d.(a x b), have clearly opposite signs passes beside it, which the exact test
+  // would find too (its edge functions are these seen along d, to a few ulps of |b| |c|); the rest
+  // go on to the exact test. Cheaper than preparing the ray for a cell's many sub-rays near a small
+  // triangle.
+  class SubRayFilter {
+   public:
+    explicit SubRayFilter(const SensorTriangle& s)
+        : m_{s.b.cross(s.c), s.c.cross(s.a), s.a.cross(s.b)},
+          tol_{kTolerance * s.b.cwiseAbs().sum() * s.c.cwiseAbs().sum(),
+               kTolerance * s.c.cwiseAbs().sum() * s.a.cwiseAbs().sum(),
+               kTolerance * s.a.cwiseAbs().sum() * s.b.cwiseAbs().sum()} {}
+    bool misses(const Eigen::Vector3d& d) const {
+      bool below = false, above = false;
+      for (int i = 0; i < 3; ++i) {
+        const double e = m_[i].dot(d);
+        below = below || e < -tol_[i];
+        above = above || e > tol_[i];
+      }
+      return below && above;
+    }
+
+   private:
+    static constexpr double kTolerance = 1e-12;
+    Eigen::Vector3d m_[3];
+    double tol_[3];
+  };
   SensorTriangle sensorTriangle(std::uint32_t slot) const {
     const auto& v = slots_[slot];
     return SensorTriangle{rot_ * v[0] + trans_, rot_ * v[1] + trans_, rot_ * v[2] + trans_};
@@ -216,19 +244,19 @@ class MeshWalk {
     });
   }
 
-  // Sub-ray k of a bundle's beam: as offer() for the beam.
-  void offerSub(int k, int row, int col, const Best& best) {
-    beams_.keepNearestSubHit(k, row, col, best.t, active_.index, static_cast<int>(best.triangle),
+  // Sub-ray s of a bundle's beam: as offer() for the beam.
+  void offerSub(int s, int row, int col, const Best& best) {
+    beams_.keepNearestSubHit(s, row, col, best.t, active_.index, static_cast<int>(best.triangle),
                              [&] { return beamNormal(row, col, best.triangle); });
   }
 
-  // Sub-ray k of a bundle's beam for the triangle tests and the box tests, as a cast of its
-  // pattern tests it (a divergent beam's block has the sensor's pose at every column).
-  PreparedRay<double, M> subRay(int k, int row, int col) const {
-    return rayAlong(row, col, beams_.subDirection(k, row, col));
+  // Sub-ray s of the bundle's beam at (row, col) for the triangle tests and the box tests, as a
+  // cast of its pattern tests it (a divergent beam's block has the sensor's pose at every column).
+  PreparedRay<double, M> subRay(int s, int row, int col) const {
+    return rayAlong(row, col, beams_.subDirection(s));
   }
-  WideBoxRay subBoxRay(int k, int row, int col) const {
-    return boxRayAlong(row, col, beams_.subDirection(k, row, col));
+  WideBoxRay subBoxRay(int s, int row, int col) const {
+    return boxRayAlong(row, col, beams_.subDirection(s));
   }
   // The beam at (row, col) along sensor-frame direction d for the triangle tests: from the
   // sensor, or for a sweep's block from the beam's pose, in the reference sensor frame.
@@ -260,12 +288,12 @@ class MeshWalk {
         if (!(range >= e.near)) continue;  // a hit nearer than this node can be
         if (bundle_) {
           // Each sub-ray traced on its own: the boxes it enters are its own.
-          for (int k = 0; k < beams_.subRays(); ++k) {
-            const double sub_tmax = std::min(config_.tmax, beams_.subRange(k, row, col));
+          for (int s = beams_.subBegin(row, col), end = beams_.subEnd(row, col); s < end; ++s) {
+            const double sub_tmax = std::min(config_.tmax, beams_.subRange(s));
             if (!(sub_tmax >= e.near)) continue;
             Best sub_best;
-            trace(subRay(k, row, col), subBoxRay(k, row, col), sub_tmax, &sub_best);
-            if (sub_best.found()) offerSub(k, row, col, sub_best);
+            trace(subRay(s, row, col), subBoxRay(s, row, col), sub_tmax, &sub_best);
+            if (sub_best.found()) offerSub(s, row, col, sub_best);
           }
           continue;
         }
@@ -346,11 +374,10 @@ class MeshWalk {
           }
         };
         if (bundle_) {
-          for (int k = 0; k < beams_.subRays(); ++k) {
+          for (int s = beams_.subBegin(row, col), end = beams_.subEnd(row, col); s < end; ++s) {
             Best sub_best;
-            testRay(subRay(k, row, col), std::min(config_.tmax, beams_.subRange(k, row, col)),
-                    &sub_best);
-            if (sub_best.found()) offerSub(k, row, col, sub_best);
+            testRay(subRay(s, row, col), std::min(config_.tmax, beams_.subRange(s)), &sub_best);
+            if (sub_best.found()) offerSub(s, row, col, sub_best);
           }
           continue;
         }
@@ -370,17 +397,20 @@ class MeshWalk {
       if (hidden(slot)) continue;
       const SensorTriangle s = sensorTriangle(slot);
       const std::uint32_t triangle = ids_[slot];
+      std::optional<SubRayFilter> filter;
+      if (bundle_ && sub_rays_from_origin_) filter.emplace(s);
       auto test = [&](int row, int col) {
         // The range rounded up to float (compact, so cheaper to read here than the result's): a
         // hit it lets through beyond the exact range is turned down by keepNearestHit().
         const double range = beams_.rangeAbove(row)[col];
         if (!(range >= e.near)) return;
         if (bundle_) {
-          for (int k = 0; k < beams_.subRays(); ++k) {
-            const auto hit = subRay(k, row, col).intersect(
-                s.a, s.b, s.c, std::min(config_.tmax, beams_.subRange(k, row, col)));
+          for (int j = beams_.subBegin(row, col), end = beams_.subEnd(row, col); j < end; ++j) {
+            if (filter && filter->misses(beams_.subDirection(j))) continue;
+            const auto hit = subRay(j, row, col).intersect(
+                s.a, s.b, s.c, std::min(config_.tmax, beams_.subRange(j)));
             if (!hit) continue;
-            beams_.keepNearestSubHit(k, row, col, hit->t, active_.index,
+            beams_.keepNearestSubHit(j, row, col, hit->t, active_.index,
                                      static_cast<int>(triangle),
                                      [&] { return beamNormal(row, col, triangle); });
           }
@@ -472,6 +502,9 @@ class MeshWalk {
   const BeamSet::Bundle* bundle_ = beams_.bundle();  // a bundle's sub-rays, or null
   const Spread spread_;
   const bool planar_, slicing_, tracing_only_;
+  // Every sub-ray leaves from the reference origin along its own direction (SubRayFilter).
+  const bool sub_rays_from_origin_ =
+      !motion_ || (motion_->spread().shift == 0 && motion_->translationsOnly());
   SlotCache<SensorTriangle, 64> triangles_;
   SlotCache<bool, 256> hidden_;
   bool closed_;  // the mesh has closed components

@@ -136,12 +136,12 @@ template <class Primitive>
 void testBeam(BeamSet& beams, const Primitive& shape, const PlacedBody& a,
               const CastConfig& config, int row, int col, double current) {
   if (beams.bundle()) {
-    for (int k = 0; k < beams.subRays(); ++k) {
-      const Ray ray = bodyRay(a, config, row, col, beams.subDirection(k, row, col),
-                              std::min(config.tmax, beams.subRange(k, row, col)));
+    for (int s = beams.subBegin(row, col), end = beams.subEnd(row, col); s < end; ++s) {
+      const Ray ray = bodyRay(a, config, row, col, beams.subDirection(s),
+                              std::min(config.tmax, beams.subRange(s)));
       const std::optional<PrimitiveHit> hit = detail::intersectValid(ray, shape);
       if (!hit) continue;
-      beams.keepNearestSubHit(k, row, col, hit->t, a.index, -1,
+      beams.keepNearestSubHit(s, row, col, hit->t, a.index, -1,
                               [&] { return beamNormal(a, row, col, hit->normal); });
     }
     return;
