@@ -80,11 +80,16 @@ ScanPattern cullingGrid(const FanSpec& fan, std::vector<double> elevations) {
 }
 
 double farthestTurn(const ScanPattern& culling, const std::vector<Eigen::Vector3d>& directions) {
-  double turn = 0;
+  return farthestTurn(culling.directions(), directions);
+}
+
+double farthestTurn(const std::vector<Eigen::Vector3d>& from,
+                    const std::vector<Eigen::Vector3d>& directions) {
+  double chord = 0;  // the longest: the arcsine grows with it
   for (std::size_t k = 0; k < directions.size(); ++k) {
-    const double chord = (directions[k] - culling.directions()[k]).norm();
-    turn = std::max(turn, 2 * std::asin(std::min(1.0, chord / 2)));
+    chord = std::max(chord, (directions[k] - from[k]).norm());
   }
+  const double turn = 2 * std::asin(std::min(1.0, chord / 2));
   // Widened for the rounding of the chord and its arcsine (a few ulps of the turn).
   return turn * (1 + 1e-9) + 1e-15;
 }

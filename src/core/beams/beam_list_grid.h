@@ -55,6 +55,9 @@ ScanPattern cullingGrid(const FanSpec& fan, std::vector<double> elevations);
 // The farthest angle (rad) of directions[k] from culling's k-th direction, widened for the
 // rounding of how it is found.
 double farthestTurn(const ScanPattern& culling, const std::vector<Eigen::Vector3d>& directions);
+// The same from from[k] to directions[k].
+double farthestTurn(const std::vector<Eigen::Vector3d>& from,
+                    const std::vector<Eigen::Vector3d>& directions);
 
 }  // namespace core
 }  // namespace laser_raycast

@@ -1,6 +1,7 @@
 // Caster::castBeams for a beam list that lies on grids (beams/beam_list_grid.h): a calibrated
 // spinning lidar's beams, each cast exactly as its own ray, with the grid's walks finding what
-// each may hit.
+// each may hit; and for a list off any grid from one origin, in the cells of an angular grid
+// (beams/beam_cells.h).
 //
 // Each part of the grid is cast as a bundle (BeamSet::Bundle) whose one sub-ray at a grid beam is
 // the list's beam there, with the windows widened by the part's turn. Columns that all leave from
@@ -42,25 +43,31 @@ class CastBodies {
   std::vector<char> any_;
 };
 
-// A part's result (own, by its grid's beams) into the list's: each beam's range, body, triangle
-// and, with compute_incidence, normal and incidence; NaN where column_valid (if given) is 0.
+// Sub-ray k's result (own's k-th) as the list's beam i: its range, body, triangle and, with
+// compute_incidence, normal and incidence.
+void scatterBeam(const ScanResult& own, std::size_t k, int i, const BeamList& list,
+                 const CastConfig& config, ScanResult* result) {
+  result->range[i] = own.range[k];
+  result->body[i] = own.body[k];
+  result->triangle[i] = own.triangle[k];
+  if (config.compute_incidence && own.body[k] >= 0) {
+    result->normal[i] = own.normal[k];
+    result->cos_incidence[i] = std::min(1.0, std::abs(list.directions[i].dot(own.normal[k])));
+  }
+}
+
+// A part's result (own, by its grid's beams) into the list's; NaN where column_valid (if given)
+// is 0.
 void scatter(const BeamListGrid::Part& part, const ScanResult& own, const BeamList& list,
              const CastConfig& config, const std::vector<char>* column_valid,
              ScanResult* result) {
   const int cols = part.culling.azimuthCount();
   for (std::size_t k = 0; k < part.beam.size(); ++k) {
-    const int i = part.beam[k];
     if (column_valid && !(*column_valid)[k % cols]) {
-      result->range[i] = std::numeric_limits<double>::quiet_NaN();
+      result->range[part.beam[k]] = std::numeric_limits<double>::quiet_NaN();
       continue;
     }
-    result->range[i] = own.range[k];
-    result->body[i] = own.body[k];
-    result->triangle[i] = own.triangle[k];
-    if (config.compute_incidence && own.body[k] >= 0) {
-      result->normal[i] = own.normal[k];
-      result->cos_incidence[i] = std::min(1.0, std::abs(list.directions[i].dot(own.normal[k])));
-    }
+    scatterBeam(own, k, part.beam[k], list, config, result);
   }
 }
 
@@ -112,7 +119,8 @@ const BeamListGrid* CasterState::gridOf(const BeamList& beams) {
       fitted->lines != beams.lines) {
     fitted.reset();
     beams.validate();
-    fitted = FittedList{beams.directions, origins, beams.lines, fitBeamGrid(beams)};
+    fitted = FittedList{beams.directions, origins, beams.lines, fitBeamGrid(beams), {}};
+    if (!fitted->grid) fitted->cells = fitBeamCells(beams);
   }
   return fitted->grid ? &*fitted->grid : nullptr;
 }
@@ -168,6 +176,42 @@ void CasterState::castBeamGrids(const Scene& scene, const FramePoses& poses,
     cast_any.add(cast);
     scatter(part, own, list, config, nullptr, result);
   }
+  result->stats.bodies_culled = bodies - result->stats.bodies_skipped - cast_any.count();
+}
+
+void CasterState::castBeamCells(const Scene& scene, const FramePoses& poses,
+                                const Eigen::Isometry3d& world_from_sensor, const BeamList& list,
+                                const BeamCells& cells, const CastConfig& config,
+                                ScanResult* result) {
+  const int bodies = static_cast<int>(scene.bodies().size());
+  const Eigen::Isometry3d world_from_ref = world_from_sensor * Eigen::Translation3d(cells.origin);
+  const ReuseKey key = relativeInputs(scene, poses, world_from_ref, cells.culling, config);
+  result->stats.bodies_skipped = 0;
+  placeGroups(scene, key, cells.culling, &placed, &result->stats.bodies_skipped);
+  const ColumnMotion motion(
+      0, std::vector<Eigen::Isometry3d>(cells.culling.azimuthCount(), Eigen::Isometry3d::Identity()),
+      steepestElevation(cells.culling), cells.turn);
+  ScanResult& culling = grid_culling;
+  ScanResult& own = grid_own;
+  resetResult(cells.culling.size(), bodies, true, false, &culling);
+  resetResult(list.size(), bodies, true, config.compute_incidence, &own);
+  BeamSet::Bundle sub_rays;
+  sub_rays.directions.push_back(&cells.directions);
+  sub_rays.results.push_back(&own);
+  sub_rays.first = &cells.first;
+  castOnThreads(
+      scene, cells.culling, config, &culling,
+      [&](const BeamRect& within) {
+        for (const PlacedGroup& p : placed) {
+          walkFrame(beams, scene, *p.group, *p.sensor_from_frame, config, within, &cast, &motion);
+        }
+      },
+      &sub_rays);
+  for (std::size_t s = 0; s < cells.beam.size(); ++s) {
+    scatterBeam(own, s, cells.beam[s], list, config, result);
+  }
+  CastBodies cast_any(bodies);
+  cast_any.add(cast);
   result->stats.bodies_culled = bodies - result->stats.bodies_skipped - cast_any.count();
 }
 

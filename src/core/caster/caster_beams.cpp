@@ -384,6 +384,11 @@ const ScanResult& Caster::castBeams(const Scene& scene, const FramePoses& poses,
     state_->castBeamGrids(scene, poses, world_from_sensor, beams, *grid, config, &result_);
     return result_;
   }
+  if (state_->cellsOf() && isValidPose(world_from_sensor)) {
+    state_->castBeamCells(scene, poses, world_from_sensor, beams, *state_->cellsOf(), config,
+                          &result_);
+    return result_;
+  }
   GroupPoses placed;
   placeGroupsAt(
       state_->indexOf(scene), world_from_sensor,

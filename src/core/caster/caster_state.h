@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "beams/beam_cells.h"
 #include "beams/beam_list_grid.h"
 #include "beams/beam_set.h"
 #include "beams/column_motion.h"
@@ -119,11 +120,13 @@ struct CasterState {
   std::optional<ReuseKey> previous;     // the inputs of the result, if it is complete
   std::vector<ScanResult> bundle;       // Caster::castBundle's results, one per sub-ray pattern
   // The beam list Caster::castBeams last fitted to grids (its directions, origins and lines), and
-  // what fitBeamGrid found: a node casts the same list scan after scan.
+  // what fitBeamGrid found, or fitBeamCells where it found none: a node casts the same list scan
+  // after scan.
   struct FittedList {
     std::vector<Eigen::Vector3d> directions, origins;
     std::vector<int> lines;
     std::optional<BeamListGrid> grid;
+    std::optional<BeamCells> cells;
   };
   std::optional<FittedList> fitted;
   ScanResult grid_culling, grid_own;  // castBeamGrids' results for one part, by its grid beams
@@ -157,6 +160,13 @@ struct CasterState {
   // beams' grids (beam_list_grid.h), fitted or remembered from the last call; null if it lies on
   // none. A list not remembered is checked first (BeamList::validate throws for a bad one).
   const BeamListGrid* gridOf(const BeamList& beams);
+  // After gridOf(beams): beams' cells (beam_cells.h) if it lies on no grid and has some, else null.
+  const BeamCells* cellsOf() const { return fitted && fitted->cells ? &*fitted->cells : nullptr; }
+  // Casts a beam list in its cells from one pose into result (reset for it, the sensor pose
+  // valid): one bundle whose grid beam stands for its cell's beams (caster_beam_grid.cpp).
+  void castBeamCells(const Scene& scene, const FramePoses& poses,
+                     const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
+                     const BeamCells& cells, const CastConfig& config, ScanResult* result);
   // Casts a beam list that lies on `grid` from one pose into result (reset for it, the sensor
   // pose valid): each part as a bundle of one sub-ray a grid beam, from its column's origin
   // (caster_beam_grid.cpp).
