@@ -72,6 +72,36 @@ Lines measureLines(const BeamList& beams, int height, int columns) {
   return out;
 }
 
+// A necessary condition, cheaper than measuring every line (a pattern file's lines, which wander in
+// elevation, fail it at once): along a grid's line the elevation stays within a turn (at most
+// kMaxTurnIncrements steps) of its row's, so its z, which changes no faster, spreads over at most
+// twice that. The step here is line 0's mean advance; a grid's other lines advance as much to
+// within two turns over the columns, a few percent from 16 columns on, far inside the margin of
+// 1.5 (shorter lists are left to the full measure).
+bool linesMayKeepTheirElevations(const BeamList& beams, int height, int columns) {
+  if (columns < 16) return true;
+  auto azimuth = [&](int i) {
+    return std::atan2(beams.directions[i].y(), beams.directions[i].x());
+  };
+  double advance = 0, previous = azimuth(0);
+  for (int c = 1; c < columns; ++c) {
+    const double a = azimuth(c * height);
+    advance += wrapHalfTurn(a - previous);
+    previous = a;
+  }
+  const double limit = 2 * kMaxTurnIncrements * 1.5 * std::abs(advance) / (columns - 1) + 1e-9;
+  for (int p = 0; p < height; ++p) {
+    double lo = beams.directions[p].z(), hi = lo;
+    for (int c = 1; c < columns; ++c) {
+      const double z = beams.directions[c * height + p].z();
+      lo = std::min(lo, z);
+      hi = std::max(hi, z);
+    }
+    if (hi - lo > limit) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 ScanPattern cullingGrid(const FanSpec& fan, std::vector<double> elevations) {
@@ -99,7 +129,10 @@ std::optional<BeamListGrid> fitBeamGrid(const BeamList& beams) {
   const int height = columnHeight(beams.lines);
   if (height == 0 || beams.size() % height != 0) return std::nullopt;
   const int columns = beams.size() / height;
-  if (columns < 2 || !sameColumns(beams, height, columns)) return std::nullopt;
+  if (columns < 2 || !sameColumns(beams, height, columns) ||
+      !linesMayKeepTheirElevations(beams, height, columns)) {
+    return std::nullopt;
+  }
 
   auto beam = [&](int p, int c) { return c * height + p; };
   const Lines lines_of = measureLines(beams, height, columns);
