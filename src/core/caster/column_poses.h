@@ -43,7 +43,7 @@ class ColumnPoses {
       const Bracket& b = brackets_[c];
       sensor_valid_[c] = sample_sensor_ok_[b.i] && sample_sensor_ok_[b.j];
       if (sensor_valid_[c]) {
-        sensor_[c] = interpolate(samples.world_from_sensor, sample_rotation_, b);
+        interpolate(samples.world_from_sensor, sample_rotation_, b, &sensor_[c]);
       }
     }
     prepareFrames(scene, index);
@@ -63,7 +63,7 @@ class ColumnPoses {
     }
     const Bracket& b = brackets_[col];
     if (!(f.ok[b.i] && f.ok[b.j])) return false;
-    *pose = interpolate(f.pose, f.rotation, b);
+    interpolate(f.pose, f.rotation, b, pose);
     return true;
   }
 
@@ -146,9 +146,20 @@ class ColumnPoses {
     const std::vector<double>& times = samples_.times;
     brackets_.resize(columns);
     arcs_used_.assign(times.size(), 0);
+    std::size_t above = 0;
     for (int c = 0; c < columns; ++c) {
       const double t = time(c);
-      const std::size_t above = std::upper_bound(times.begin(), times.end(), t) - times.begin();
+      // The first sample after t: the previous column's, or its next, where the columns' times go
+      // up a little at a time (a sweep's); else searched for.
+      if (!(above <= times.size() && (above == 0 || times[above - 1] <= t) &&
+            (above == times.size() || t < times[above]))) {
+        if (above < times.size() && times[above] <= t &&
+            (above + 1 == times.size() || t < times[above + 1])) {
+          ++above;
+        } else {
+          above = std::upper_bound(times.begin(), times.end(), t) - times.begin();
+        }
+      }
       const std::size_t k = above == 0 ? 0 : above - 1;
       Bracket& b = brackets_[c];
       if (t < times.front() || k + 1 == times.size()) {
@@ -191,16 +202,39 @@ class ColumnPoses {
     }
   }
 
-  // interpolatePose(a, b, s) of the bracket's samples, from their rotations as quaternions; a
-  // column exactly at a sample has its pose.
-  static Eigen::Isometry3d interpolate(const std::vector<Eigen::Isometry3d>& pose,
-                                       const Rotations& rotation, const Bracket& b) {
-    if (b.j == b.i) return pose[b.i];
-    Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  // interpolatePose(a, b, s) of the bracket's samples, from their rotations as quaternions, into
+  // *out; a column exactly at a sample has its pose. The rotation matrix is Eigen's
+  // QuaternionBase::toRotationMatrix's expression, written entry by entry straight into *out:
+  // through a temporary matrix, its entries stored one at a time and read back two at a time could
+  // not be forwarded from the pending stores, and every column waited for them.
+  static void interpolate(const std::vector<Eigen::Isometry3d>& pose, const Rotations& rotation,
+                          const Bracket& b, Eigen::Isometry3d* out) {
+    if (b.j == b.i) {
+      *out = pose[b.i];
+      return;
+    }
     const Eigen::Vector3d& ta = pose[b.i].translation();
-    out.translation() = ta + b.s * (pose[b.j].translation() - ta);
-    out.linear() = rotation.slerp(b).toRotationMatrix();
-    return out;
+    const Eigen::Vector3d t = ta + b.s * (pose[b.j].translation() - ta);
+    const Eigen::Quaterniond q = rotation.slerp(b);
+    const double tx = 2 * q.x(), ty = 2 * q.y(), tz = 2 * q.z();
+    const double twx = tx * q.w(), twy = ty * q.w(), twz = tz * q.w();
+    const double txx = tx * q.x(), txy = ty * q.x(), txz = tz * q.x();
+    const double tyy = ty * q.y(), tyz = tz * q.y(), tzz = tz * q.z();
+    Eigen::Matrix4d& m = out->matrix();
+    m(0, 0) = 1 - (tyy + tzz);
+    m(0, 1) = txy - twz;
+    m(0, 2) = txz + twy;
+    m(1, 0) = txy + twz;
+    m(1, 1) = 1 - (txx + tzz);
+    m(1, 2) = tyz - twx;
+    m(2, 0) = txz - twy;
+    m(2, 1) = tyz + twx;
+    m(2, 2) = 1 - (txx + tyy);
+    m(0, 3) = t.x();
+    m(1, 3) = t.y();
+    m(2, 3) = t.z();
+    m(3, 0) = m(3, 1) = m(3, 2) = 0;
+    m(3, 3) = 1;
   }
 
   const PoseSamples& samples_;
