@@ -11,6 +11,7 @@
 #include "slice/slicer.h"
 #include "util/walk_stack.h"
 #include "walk/slot_cache.h"
+#include "walk/sub_ray_filter.h"
 #include "accel/wide_bvh.h"
 
 namespace laser_raycast {
@@ -176,34 +177,6 @@ class MeshWalk {
   // rasterised or tested directly), so shared edges are decided the same way everywhere.
   struct SensorTriangle {
     Eigen::Vector3d a, b, c;
-  };
-  // A bundle's sub-rays that all leave from the reference sensor's origin, unturned (a divergent
-  // beam's, a cell's): a sub-ray d whose triple products with the triangle's edges, d.(b x c),
-  // d.(c x a) and d.(a x b), have clearly opposite signs passes beside it, which the exact test
-  // would find too (its edge functions are these seen along d, to a few ulps of |b| |c|); the rest
-  // go on to the exact test. Cheaper than preparing the ray for a cell's many sub-rays near a small
-  // triangle.
-  class SubRayFilter {
-   public:
-    explicit SubRayFilter(const SensorTriangle& s)
-        : m_{s.b.cross(s.c), s.c.cross(s.a), s.a.cross(s.b)},
-          tol_{kTolerance * s.b.cwiseAbs().sum() * s.c.cwiseAbs().sum(),
-               kTolerance * s.c.cwiseAbs().sum() * s.a.cwiseAbs().sum(),
-               kTolerance * s.a.cwiseAbs().sum() * s.b.cwiseAbs().sum()} {}
-    bool misses(const Eigen::Vector3d& d) const {
-      bool below = false, above = false;
-      for (int i = 0; i < 3; ++i) {
-        const double e = m_[i].dot(d);
-        below = below || e < -tol_[i];
-        above = above || e > tol_[i];
-      }
-      return below && above;
-    }
-
-   private:
-    static constexpr double kTolerance = 1e-12;
-    Eigen::Vector3d m_[3];
-    double tol_[3];
   };
   SensorTriangle sensorTriangle(std::uint32_t slot) const {
     const auto& v = slots_[slot];
@@ -398,7 +371,7 @@ class MeshWalk {
       const SensorTriangle s = sensorTriangle(slot);
       const std::uint32_t triangle = ids_[slot];
       std::optional<SubRayFilter> filter;
-      if (bundle_ && sub_rays_from_origin_) filter.emplace(s);
+      if (bundle_ && sub_rays_from_origin_) filter.emplace(s.a, s.b, s.c);
       auto test = [&](int row, int col) {
         // The range rounded up to float (compact, so cheaper to read here than the result's): a
         // hit it lets through beyond the exact range is turned down by keepNearestHit().
