@@ -30,7 +30,7 @@ class BeamSet {
   // hold the farthest of a beam's sub-ray ranges, which is what culling reads, and the walks test
   // each sub-ray where they would test the beam.
   // With `first`, each grid beam stands for a list of its own instead (a cell of an angular grid
-  // over beams off any grid, beams/beam_list_grid.h): sub-rays first[i] to first[i + 1] - 1 of
+  // over beams off any grid, beams/beam_cells.h): sub-rays first[i] to first[i + 1] - 1 of
   // the one `directions` and `results` (indexed by sub-ray); a grid beam with none is never open.
   struct Bundle {
     std::vector<const std::vector<Eigen::Vector3d>*> directions;  // each indexed as the pattern's
