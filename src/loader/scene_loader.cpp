@@ -419,8 +419,8 @@ std::shared_ptr<const core::Mesh> SceneLoader::loadMesh(const std::string& uri,
     const Clock::time_point start = Clock::now();
     std::shared_ptr<const core::Mesh> mesh;
     try {
-      auto built = std::make_shared<core::Mesh>(std::move(data.vertices),
-                                                std::move(data.triangles), bvh);
+      auto built = std::make_shared<core::Mesh>(std::move(data.vertices), std::move(data.triangles),
+                                                bvh, scale);
       built->setSurface(std::move(data.surface));
       mesh = std::move(built);
     } catch (const std::invalid_argument& e) {

@@ -65,7 +65,8 @@ Pass brutePass(const core::BvhT<T>& bvh) {
       const core::PreparedRay<T, M> prepared(rays[i], false);
       T tmax = rays[i].tmax;
       bool hit = false;
-      for (const auto& tri : tris) {
+      for (std::uint32_t slot = 0; slot < tris.size(); ++slot) {
+        const auto tri = tris[slot];
         if (const auto h = prepared.intersect(tri[0], tri[1], tri[2], tmax)) {
           tmax = h->t;
           hit = true;

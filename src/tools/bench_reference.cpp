@@ -117,8 +117,7 @@ std::optional<Real> ReferenceRay::intersect(const Eigen::Vector3d& a, const Eige
 // The nearest hit among the triangle slots that visit(descend, leaf) reaches through a tree of
 // boxes (a Bvh's, or a Mesh's wide BVH).
 template <class Visit>
-Real referenceClosestHit(const std::vector<std::array<Eigen::Vector3d, 3>>& slots, Visit&& visit,
-                         const RayL& ray) {
+Real referenceClosestHit(const core::SlotVertices<double>& slots, Visit&& visit, const RayL& ray) {
   Real best = kInfL;
   const ReferenceRay prepared(ray);
   visit([&](const core::Aabb& box) { return mayHit(ray, box, std::min(ray.tmax, best)); },

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -98,6 +99,62 @@ TEST(Mesh, KeepsOnlyTheWideTreeAndVisitsThroughIt) {
     EXPECT_EQ(missed, 0u) << "slab " << lo << " .. " << hi;
     EXPECT_LT(extra, slots / 2) << "slab " << lo << " .. " << hi << ", " << meets << " meet it";
   }
+}
+
+// Whether every slot holds, bit for bit, the vertices of its triangle.
+::testing::AssertionResult slotsHoldTheVertices(const Mesh& mesh) {
+  const auto& slots = mesh.bvh().triangleVertices();
+  const auto& ids = mesh.bvh().triangleIds();
+  for (std::uint32_t slot = 0; slot < slots.size(); ++slot) {
+    const auto tri = slots[slot];
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& v = mesh.vertices()[mesh.triangles()[ids[slot]][k]];
+      if (std::memcmp(tri[k].data(), v.data(), sizeof(double) * 3) != 0) {
+        return ::testing::AssertionFailure() << "slot " << slot << " vertex " << k << " holds "
+                                             << tri[k].transpose() << ", not " << v.transpose();
+      }
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// A mesh read from a file has float coordinates, scaled: its slots keep them in float, half the
+// bytes, and give back the same doubles; any other mesh keeps them in double.
+TEST(Mesh, KeepsSlotsInFloatOnlyWhenThatLosesNothing) {
+  Rng rng(73);
+  const Soup s = clusteredSoup(rng, 3000);
+  const Mesh doubles(s.vertices, s.triangles);
+  EXPECT_FALSE(doubles.bvh().triangleVertices().packed());
+  EXPECT_TRUE(slotsHoldTheVertices(doubles));
+
+  // As an STL file gives them (floats), and scaled per axis as a URDF's <mesh scale> does.
+  const Eigen::Vector3d scale(0.001, 0.0254, 2.5);
+  std::vector<Eigen::Vector3d> read, scaled;
+  for (const Eigen::Vector3d& v : s.vertices) {
+    read.emplace_back(keptFloat(v.x()), keptFloat(v.y()), keptFloat(v.z()));
+    scaled.push_back(read.back().cwiseProduct(scale));
+  }
+  const Mesh floats(read, s.triangles);
+  EXPECT_TRUE(floats.bvh().triangleVertices().packed());
+  EXPECT_TRUE(slotsHoldTheVertices(floats));
+  const Mesh scaled_floats(scaled, s.triangles, BvhConfig{}, scale);
+  EXPECT_TRUE(scaled_floats.bvh().triangleVertices().packed());
+  EXPECT_TRUE(slotsHoldTheVertices(scaled_floats));
+
+  // The same vertices with a scale they were not read with, or none that can be: in double, and
+  // the only difference in bytes is the slots' (36 a slot: nine floats instead of nine doubles).
+  for (const Eigen::Vector3d& wrong :
+       {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(0.001, 0.0254, 2.6),
+        Eigen::Vector3d(0.001, 0, 2.5), Eigen::Vector3d(0.001, -0.0254, 2.5),
+        Eigen::Vector3d(0.001, 0.0254, std::nan(""))}) {
+    const Mesh unpacked(scaled, s.triangles, BvhConfig{}, wrong);
+    EXPECT_FALSE(unpacked.bvh().triangleVertices().packed()) << wrong.transpose();
+    EXPECT_TRUE(slotsHoldTheVertices(unpacked));
+    EXPECT_EQ(unpacked.bytes() - scaled_floats.bytes(), 36 * unpacked.bvh().triangleIds().size());
+  }
+  // What a mesh holds, counted: 3000 triangles cannot fit in fewer bytes than their slots.
+  EXPECT_GT(scaled_floats.bytes(), 36 * 3000u + 12 * 3000u);
+  EXPECT_LT(scaled_floats.bytes(), doubles.bytes());
 }
 
 TEST(Mesh, BoundingSphereContainsEveryVertex) {

@@ -131,6 +131,27 @@ TEST_F(SharedDataTest, TurtleBot3Waffle) {
             (std::set<std::string>{"base_footprint", "wheel_left_link", "wheel_right_link"}));
   EXPECT_EQ(model.link_frames.at("camera_rgb_optical_frame").first, "base_footprint");
 
+  // The STL meshes (float coordinates, URDF scale 0.001) keep their BVH slots in float, giving
+  // back the very vertices the loader read.
+  int stl_bodies = 0;
+  for (int b = 0; b < static_cast<int>(scene_.bodies().size()); ++b) {
+    const std::string label = labelOf(scene_, b);
+    if (label != "wheel_left_link" && label != "wheel_right_link" && label != "base_scan") continue;
+    ++stl_bodies;
+    const MeshPtr mesh = meshOf(scene_, b);
+    ASSERT_TRUE(mesh);
+    EXPECT_TRUE(mesh->bvh().triangleVertices().packed()) << label;
+    const auto& ids = mesh->bvh().triangleIds();
+    for (std::uint32_t slot = 0; slot < ids.size(); ++slot) {
+      const auto tri = mesh->bvh().triangleVertices()[slot];
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_EQ(tri[k], mesh->vertices()[mesh->triangles()[ids[slot]][k]])
+            << label << " " << slot;
+      }
+    }
+  }
+  EXPECT_EQ(stl_bodies, 3);
+
   int base_bodies = 0;
   for (int b = 0; b < static_cast<int>(scene_.bodies().size()); ++b) {
     if (labelOf(scene_, b) != "base_link") continue;

@@ -5,7 +5,9 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -26,6 +28,78 @@ struct BvhConfig {
 
   // Throws std::invalid_argument naming the field and its value.
   void validate() const;
+};
+
+// x rounded to float, kept a float: GCC 12's SLP vectorizer folds a double taken to float and back
+// into the double itself (at -O2, a vectorised (double)(float)x gave x unrounded); the empty asm
+// hides the float's value from it.
+inline float keptFloat(double x) {
+  float f = static_cast<float>(x);
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  asm("" : "+x"(f));
+#endif
+  return f;
+}
+
+// The vertices of a BVH's triangle slots, copied in slot order so that a leaf's triangles are the
+// next bytes. For T = double they can be kept in float (36 bytes a slot instead of 72): pack(scale)
+// does so when every coordinate is exactly a float times that axis' scale (a mesh file's float
+// coordinates, scaled as the URDF says), and operator[] then gives back those same doubles, bit for
+// bit: what reads the slots cannot tell the difference.
+template <typename T>
+class SlotVertices {
+ public:
+  using Triangle = std::array<Vec3<T>, 3>;
+
+  std::size_t size() const { return packed_.empty() ? full_.size() : packed_.size(); }
+  bool empty() const { return size() == 0; }
+  // Whether the slots are kept in float.
+  bool packed() const { return !packed_.empty(); }
+  // Bytes the slots take (what the vectors hold).
+  std::size_t bytes() const {
+    return full_.capacity() * sizeof(Triangle) + packed_.capacity() * sizeof(packed_[0]);
+  }
+
+  LASER_RAYCAST_HOT_INLINE Triangle operator[](std::uint32_t slot) const {
+    if (packed_.empty()) return full_[slot];
+    const float* f = packed_[slot].data();
+    Triangle tri;
+    for (int k = 0; k < 3; ++k) {
+      for (int a = 0; a < 3; ++a) tri[k][a] = static_cast<T>(f[3 * k + a]) * scale_[a];
+    }
+    return tri;
+  }
+
+  void reserve(std::size_t n) { full_.reserve(n); }
+  void push_back(const Triangle& tri) { full_.push_back(tri); }
+
+  // Keeps the slots in float if every coordinate c on axis a is, bit for bit, T(float(c / s_a)) *
+  // s_a (scale: s, positive and finite); returns whether they are. A no-op for T = float.
+  bool pack(const Vec3<T>& scale) {
+    if (sizeof(T) == sizeof(float) || full_.empty() || packed()) return packed();
+    if (!(scale.array() > 0).all() || !scale.allFinite()) return false;
+    std::vector<std::array<float, 9>> packed(full_.size());
+    for (std::size_t slot = 0; slot < full_.size(); ++slot) {
+      for (int k = 0; k < 3; ++k) {
+        for (int a = 0; a < 3; ++a) {
+          const T c = full_[slot][k][a];
+          const float f = keptFloat(c / scale[a]);
+          const T back = static_cast<T>(f) * scale[a];
+          if (std::memcmp(&back, &c, sizeof(T)) != 0) return false;
+          packed[slot][3 * k + a] = f;
+        }
+      }
+    }
+    packed_ = std::move(packed);
+    scale_ = scale;
+    std::vector<Triangle>().swap(full_);
+    return true;
+  }
+
+ private:
+  std::vector<Triangle> full_;
+  std::vector<std::array<float, 9>> packed_;
+  Vec3<T> scale_ = Vec3<T>::Ones();
 };
 
 template <typename T>
@@ -85,9 +159,11 @@ class BvhT {
   const std::vector<Node>& nodes() const { return nodes_; }
   Child root() const { return root_; }
   // Triangle slots in leaf order: the original triangle index, and its vertices copied for
-  // locality.
+  // locality (in float where packSlots could).
   const std::vector<std::uint32_t>& triangleIds() const { return triangle_ids_; }
-  const std::vector<std::array<Vec3<T>, 3>>& triangleVertices() const { return vertices_; }
+  const SlotVertices<T>& triangleVertices() const { return vertices_; }
+  // Keeps the slots' vertices in float if that loses nothing (SlotVertices::pack); returns whether.
+  bool packSlots(const Vec3<T>& scale) { return vertices_.pack(scale); }
   // The exact bounds of every stored vertex.
   const AabbT<T>& bounds() const { return bounds_; }
   bool empty() const { return triangle_ids_.empty(); }
@@ -111,6 +187,11 @@ class BvhT {
   // tree). After it, hasTree() is false, and closestHit, anyHit and visit throw std::logic_error.
   void releaseTree();
   bool hasTree() const { return !tree_released_; }
+  // Bytes the nodes and slots take (what the vectors hold).
+  std::size_t bytes() const {
+    return nodes_.capacity() * sizeof(Node) + triangle_ids_.capacity() * sizeof(std::uint32_t) +
+           vertices_.bytes();
+  }
 
  private:
   template <TriangleMethod M, bool kAnyHit>
@@ -131,7 +212,7 @@ class BvhT {
   Child root_{0, 0};
   AabbT<T> bounds_;
   std::vector<std::uint32_t> triangle_ids_;
-  std::vector<std::array<Vec3<T>, 3>> vertices_;
+  SlotVertices<T> vertices_;
   int depth_ = 0;
   bool tree_released_ = false;
 

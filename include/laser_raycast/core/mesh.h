@@ -23,8 +23,13 @@ class Mesh {
   // Throws std::invalid_argument naming the problem: no triangles, a non-finite vertex (with its
   // index and value), or a triangle index out of range. Degenerate triangles are kept in
   // triangles() but left out of the BVH; a mesh whose triangles are all degenerate is rejected.
+  // float_scale: the per-axis scale the vertices were read with if they came from a file's float
+  // coordinates (an STL's, scaled as the URDF says). When every vertex is exactly such a float
+  // times it, the BVH's slots keep their vertices in float, half the bytes, giving back the same
+  // doubles (SlotVertices::pack); otherwise, or for any other scale, in double.
   Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> triangles,
-       const BvhConfig& bvh_config = {});
+       const BvhConfig& bvh_config = {},
+       const Eigen::Vector3d& float_scale = Eigen::Vector3d::Ones());
   // The wide BVH refers to the binary one: a Mesh stays where it was built (share it by pointer).
   Mesh(const Mesh&) = delete;
   Mesh& operator=(const Mesh&) = delete;
@@ -71,6 +76,9 @@ class Mesh {
   // Throws std::invalid_argument if surface does not fit this mesh (SurfaceAttributes::validate).
   // Set it before the mesh is shared.
   void setSurface(std::shared_ptr<const SurfaceAttributes> surface);
+  // Bytes the mesh holds: vertices, triangles, components, its BVH's slots and nodes (not the
+  // surface attributes, which may be shared).
+  std::size_t bytes() const;
   // Geometric unit normal of a triangle, (b - a) x (c - a) normalised (the front face's side).
   Eigen::Vector3d normal(std::uint32_t triangle) const;
 

@@ -88,6 +88,10 @@ class WideBvh {
     return child_triangles_[node * kWidth + k];
   }
   std::uint32_t rootTriangles() const { return root_triangles_; }
+  // Bytes the nodes take (not the binary BVH's slots).
+  std::size_t bytes() const {
+    return nodes_.capacity() * sizeof(Node) + child_triangles_.capacity() * sizeof(std::uint32_t);
+  }
 
   // Depth-first walk over the subtrees whose box satisfies descend(box) (the root's: the binary
   // BVH's bounds; below it, the nodes' float boxes, which contain the exact ones); calls leaf(slot)

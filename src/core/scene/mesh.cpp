@@ -11,7 +11,7 @@ namespace laser_raycast {
 namespace core {
 
 Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> triangles,
-           const BvhConfig& bvh_config)
+           const BvhConfig& bvh_config, const Eigen::Vector3d& float_scale)
     : vertices_(std::move(vertices)), triangles_(std::move(triangles)) {
   if (triangles_.empty()) throw std::invalid_argument("mesh has no triangles");
   for (std::size_t i = 0; i < vertices_.size(); ++i) {
@@ -38,6 +38,7 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
     msg << "mesh has " << triangles_.size() << " triangles but all of them have zero area";
     throw std::invalid_argument(msg.str());
   }
+  bvh_.packSlots(float_scale);
   // Bounds and sphere over the vertices that triangles use.
   for (const TriangleIndices& tri : triangles_) {
     for (const std::uint32_t v : tri) bounds_.grow(vertices_[v]);
@@ -66,6 +67,14 @@ void Mesh::visit(const std::function<bool(const Aabb&)>& descend,
 }
 
 Mesh::~Mesh() = default;
+
+std::size_t Mesh::bytes() const {
+  return vertices_.capacity() * sizeof(Eigen::Vector3d) +
+         triangles_.capacity() * sizeof(TriangleIndices) +
+         component_.capacity() * sizeof(std::uint32_t) +
+         component_bounds_.capacity() * sizeof(Aabb) +
+         slot_facing_.capacity() * sizeof(std::int8_t) + bvh_.bytes() + wide_->bytes();
+}
 
 void Mesh::findClosedComponents() {
   component_bounds_.assign(component_count_, Aabb{});

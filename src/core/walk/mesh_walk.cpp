@@ -465,7 +465,7 @@ class MeshWalk {
   BeamSet& beams_;
   const Mesh& mesh_;
   const WideBvh& wide_;
-  const std::vector<std::array<Eigen::Vector3d, 3>>& slots_;
+  const SlotVertices<double>& slots_;
   const std::vector<std::uint32_t>& ids_;
   const PlacedBody& active_;
   const CastConfig& config_;
