@@ -211,7 +211,23 @@ bench::SceneMethods sceneMethods(const Options& options, bench::SceneGeometry* g
   return methods;
 }
 
-std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settings& settings) {
+// The log line of a scene's memory per triangle.
+void logMemory(const bench::MemoryRow& memory) {
+  const double triangles = static_cast<double>(memory.triangles);
+  const double ours = static_cast<double>(memory.ours_bytes) / triangles;
+  std::cerr << "  memory: " << memory.triangles << " triangles in its distinct meshes, ours "
+            << ours << " bytes per triangle";
+  if (memory.embree_bytes) {
+    const double embree = static_cast<double>(*memory.embree_bytes) / triangles;
+    std::cerr << ", Embree's " << embree << " bytes per triangle (ours/embree " << ours / embree
+              << ")";
+  }
+  std::cerr << "\n";
+}
+
+// The rows, and each scene's memory per triangle in *memory (the scenes with meshes).
+std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settings& settings,
+                                     std::vector<bench::MemoryRow>* memory) {
   std::vector<bench::Row> rows;
   const std::string shared_dir =
       contains(options.scenes, "tb3") ? bench::findSharedData() : std::string();
@@ -224,6 +240,9 @@ std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settin
                    "holding it, or put it on ROS_PACKAGE_PATH)\n";
       continue;
     }
+    // Whatever methods and workloads run, and before the rows' structures are built, so that its
+    // Embree scenes are released before any row is built or timed.
+    const std::optional<bench::MemoryRow> scene_memory = bench::measureMemory(*scene);
     bench::SceneGeometry geometry;
     geometry.scene = &*scene;
     const bench::SceneMethods methods = sceneMethods(options, &geometry);
@@ -231,6 +250,10 @@ std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settin
               << "): " << scene->soup.triangles.size() << " triangles in the soup, "
               << scene->scene.bodies().size() << " bodies, range max " << scene->range_max
               << " m, built in " << bench::secondsSince(build_start) << " s\n";
+    if (scene_memory) {
+      logMemory(*scene_memory);
+      memory->push_back(*scene_memory);
+    }
     for (const bench::Workload& workload : bench::workloads()) {
       if (!options.workloads.empty() && !contains(options.workloads, workload.name)) continue;
       const int poses = options.quick ? workload.quick_poses : workload.full_poses;
@@ -309,14 +332,16 @@ int run(const Options& options) {
   const bench::Settings settings = settingsFor(options.quick);
   const std::filesystem::path out(options.out_dir);
   std::filesystem::create_directories(out);
-  const std::vector<bench::Row> rows = runBenchmark(options, settings);
+  std::vector<bench::MemoryRow> memory;
+  const std::vector<bench::Row> rows = runBenchmark(options, settings, &memory);
   if (rows.empty()) throw std::runtime_error("no scene ran");
   const std::string csv = (out / "results.csv").string();
   const std::string md = (out / "results.md").string();
   const std::string png = (out / "pareto.png").string();
   const std::string matrix_png = (out / "pareto_matrix.png").string();
   bench::writeCsv(csv, rows);
-  bench::writeMarkdown(md, rows, runInfo(options, settings, rows, bench::secondsSince(start)));
+  bench::writeMarkdown(md, rows, memory,
+                       runInfo(options, settings, rows, bench::secondsSince(start)));
   const std::string plot_error = bench::runPlot(
       plotScript(), {csv, png, "--matrix", matrix_png, "--source", "Run: " + runLabel(options)});
   if (!plot_error.empty()) throw std::runtime_error("plotting failed: " + plot_error);

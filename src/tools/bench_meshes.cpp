@@ -35,6 +35,15 @@ PoseL fromIsometry(const Eigen::Isometry3d& pose) {
   return PoseL{pose.linear().cast<Real>(), pose.translation().cast<Real>()};
 }
 
+std::shared_ptr<const core::Mesh> meshAsRead(const MeshData& mesh) {
+  std::vector<Eigen::Vector3d> vertices;
+  vertices.reserve(mesh.vertices.size());
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    vertices.emplace_back(core::keptFloat(v.x()), core::keptFloat(v.y()), core::keptFloat(v.z()));
+  }
+  return std::make_shared<const core::Mesh>(std::move(vertices), mesh.triangles);
+}
+
 void MeshData::append(const MeshData& other) {
   const auto offset = static_cast<std::uint32_t>(vertices.size());
   vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());

@@ -5,9 +5,11 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
+#include "laser_raycast/core/mesh.h"
 
 namespace laser_raycast {
 namespace bench {
@@ -43,6 +45,10 @@ struct MeshData {
   // Adds quad (a, b, c, d), counter-clockwise seen from its front, as two triangles.
   void quad(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d);
 };
+
+// The mesh as a mesh file would give it to the loader: every coordinate rounded to float (an STL's
+// or a Collada file's), so that it is built as the node builds such a file.
+std::shared_ptr<const core::Mesh> meshAsRead(const MeshData& mesh);
 
 // The side of a cylinder (axis z, centred on it): a ring of `segments` vertices at each height in
 // ring_z (ascending), joined by quads facing outwards; with caps, a centre vertex closes each end.

@@ -1,6 +1,8 @@
 #include "bench_peers.h"
 
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -41,26 +43,27 @@ void checkEmbree(const char* what) {
   }
 }
 
-// An Embree scene holding the soup as one triangle geometry (float vertices, shared indices).
+// An Embree scene holding the triangles as one geometry (float vertices, shared indices).
 class EmbreeScene {
  public:
-  EmbreeScene(const MeshData& soup, bool robust) {
+  EmbreeScene(const std::vector<Eigen::Vector3d>& vertices,
+              const std::vector<core::TriangleIndices>& triangles, bool robust) {
     RTCDevice device = embreeDevice();
     scene_ = rtcNewScene(device);
     rtcSetSceneFlags(scene_, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
                                                           RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                          soup.vertices.size()));
+                                                          vertices.size()));
     auto* idx = static_cast<unsigned*>(
         rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                3 * sizeof(unsigned), soup.triangles.size()));
+                                3 * sizeof(unsigned), triangles.size()));
     checkEmbree("rtcSetNewGeometryBuffer");
-    for (std::size_t i = 0; i < soup.vertices.size(); ++i) {
-      for (int k = 0; k < 3; ++k) v[3 * i + k] = static_cast<float>(soup.vertices[i][k]);
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+      for (int k = 0; k < 3; ++k) v[3 * i + k] = static_cast<float>(vertices[i][k]);
     }
-    for (std::size_t i = 0; i < soup.triangles.size(); ++i) {
-      for (int k = 0; k < 3; ++k) idx[3 * i + k] = soup.triangles[i][k];
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+      for (int k = 0; k < 3; ++k) idx[3 * i + k] = triangles[i][k];
     }
     rtcCommitGeometry(geometry);
     rtcAttachGeometry(scene_, geometry);
@@ -101,6 +104,30 @@ class EmbreeScene {
 
  private:
   RTCScene scene_;
+};
+
+// Keeps the device's running total of the bytes Embree allocated minus those it freed, as its
+// memory monitor reports them, while it lives: installed only while a mesh is measured, so that
+// the rows' builds run without it.
+class MemoryMonitor {
+ public:
+  MemoryMonitor() {
+    rtcSetDeviceMemoryMonitorFunction(
+        embreeDevice(),
+        [](void* held, ssize_t bytes, bool) {
+          static_cast<std::atomic<std::int64_t>*>(held)->fetch_add(bytes);
+          return true;  // never refuse an allocation
+        },
+        &held_);
+  }
+  ~MemoryMonitor() { rtcSetDeviceMemoryMonitorFunction(embreeDevice(), nullptr, nullptr); }
+  MemoryMonitor(const MemoryMonitor&) = delete;
+  MemoryMonitor& operator=(const MemoryMonitor&) = delete;
+
+  std::int64_t held() const { return held_.load(); }
+
+ private:
+  std::atomic<std::int64_t> held_{0};
 };
 
 #endif  // LASER_RAYCAST_HAVE_EMBREE
@@ -187,6 +214,19 @@ std::string peerVersions() {
   return versions.empty() ? "none" : versions;
 }
 
+std::optional<std::size_t> embreeMeshBytes([[maybe_unused]] const core::Mesh& mesh) {
+#ifdef LASER_RAYCAST_HAVE_EMBREE
+  const MemoryMonitor monitor;
+  // What the scene holds once built: the build's temporary arrays are freed by then, and the
+  // buffers made by rtcSetNewGeometryBuffer are counted too (the vertex buffer with the 4 bytes
+  // of padding that lets Embree read its last vertex with a 16-byte load).
+  const EmbreeScene scene(mesh.vertices(), mesh.triangles(), false);
+  return static_cast<std::size_t>(monitor.held());
+#else
+  return std::nullopt;
+#endif
+}
+
 std::vector<Method> peerMethods([[maybe_unused]] const MeshData& soup,
                                 [[maybe_unused]] const MethodFilter& wanted) {
   std::vector<Method> methods;
@@ -195,7 +235,7 @@ std::vector<Method> peerMethods([[maybe_unused]] const MeshData& soup,
   for (const bool robust : {false, true}) {
     const std::string name = robust ? "embree_robust" : "embree_default";
     if (!wanted(name)) continue;
-    auto scene = std::make_shared<const EmbreeScene>(soup, robust);
+    auto scene = std::make_shared<const EmbreeScene>(soup.vertices, soup.triangles, robust);
     methods.push_back(Method{name, false, false, triangles,
                              [scene](const WorkloadRays& w, const std::vector<int>& rays,
                                      std::vector<double>* out) { scene->pass(w, rays, out); },

@@ -5,10 +5,13 @@
 // are simply no rows for it.
 #pragma once
 
+#include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "bench_methods.h"
+#include "laser_raycast/core/mesh.h"
 
 namespace laser_raycast {
 namespace bench {
@@ -21,6 +24,11 @@ std::vector<Method> peerMethods(const MeshData& soup, const MethodFilter& wanted
 std::vector<std::string> peerMethodNames();
 // The peers compiled in, with their versions (e.g. "Embree 3.13.5, Bullet 3.24"), or "none".
 std::string peerVersions();
+// The bytes Embree holds for the mesh (in its own frame) built alone as the embree_default row
+// builds the soup (default flags, float vertices, one geometry), as its device's memory monitor
+// counts them: its BVH with triangle leaves and its vertex and index buffers. Nullopt without
+// Embree. Throws std::runtime_error if Embree reports an error.
+std::optional<std::size_t> embreeMeshBytes(const core::Mesh& mesh);
 
 }  // namespace bench
 }  // namespace laser_raycast

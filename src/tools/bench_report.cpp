@@ -9,6 +9,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <ostream>
 #include <stdexcept>
 #include <utility>
 
@@ -41,6 +42,45 @@ std::ofstream openForWriting(const std::string& path) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
   return out;
+}
+
+// The memory per triangle of each scene's meshes, ours and (with Embree) Embree's, with a line
+// saying what each side counts: a scene's figure is per mesh triangle, not per soup triangle.
+void writeMemoryTable(std::ostream& out, const std::vector<MemoryRow>& memory) {
+  const bool embree = std::any_of(memory.begin(), memory.end(),
+                                  [](const MemoryRow& m) { return m.embree_bytes.has_value(); });
+  out << "\n## Memory per triangle\n\n";
+  out << "Each scene's distinct meshes, each once however many bodies instance it, in its own "
+         "frame (primitives hold no triangles and are left out); ours: core::Mesh::bytes(), its "
+         "vertices in double, triangles, components, BVH slots and wide nodes";
+  if (embree) {
+    out << "; Embree: the bytes its device's memory monitor counts for the mesh built alone as "
+           "embree_default builds the soup, its BVH with triangle leaves plus its float vertex "
+           "and index buffers (the monitor counts the buffers made by rtcSetNewGeometryBuffer, "
+           "the vertex buffer with its 4 bytes of padding)";
+  }
+  out << ".\n\n";
+  if (memory.empty()) {
+    out << "No scene run has meshes.\n";
+    return;
+  }
+  out << "| scene | triangles | ours_bytes_per_triangle |"
+      << (embree ? " embree_bytes_per_triangle | ours/embree |" : "") << "\n";
+  out << "| --- | ---: | ---: |" << (embree ? " ---: | ---: |" : "") << "\n";
+  for (const MemoryRow& m : memory) {
+    const double triangles = static_cast<double>(m.triangles);
+    const double ours = static_cast<double>(m.ours_bytes) / triangles;
+    out << "| " << m.scene << " | " << m.triangles << " | " << format("%.1f", ours) << " |";
+    if (embree) {
+      if (m.embree_bytes) {
+        const double theirs = static_cast<double>(*m.embree_bytes) / triangles;
+        out << " " << format("%.1f", theirs) << " | " << format("%.3g", ours / theirs) << " |";
+      } else {
+        out << " n/a | n/a |";
+      }
+    }
+    out << "\n";
+  }
 }
 
 }  // namespace
@@ -119,7 +159,7 @@ void writeCsv(const std::string& path, const std::vector<Row>& rows) {
 }
 
 void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
-                   const std::string& run_info) {
+                   const std::vector<MemoryRow>& memory, const std::string& run_info) {
   std::map<std::pair<std::string, std::string>, double> embree;
   for (const Row& r : rows) {
     if (r.method == "embree_default") embree[{r.workload, r.scene}] = r.ns_per_ray;
@@ -148,6 +188,7 @@ void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
       out << "n/a | n/a |\n";
     }
   }
+  writeMemoryTable(out, memory);
   if (!out) throw std::runtime_error("writing " + path + " failed");
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,15 +55,27 @@ struct Row {
   double range_max = 0;    // m, the scene's (for the run's description)
 };
 
+// The memory of one scene's meshes, each distinct mesh once however many bodies instance it (the
+// primitives hold no triangles).
+struct MemoryRow {
+  std::string scene;
+  std::size_t triangles = 0;   // of the distinct meshes
+  std::size_t ours_bytes = 0;  // core::Mesh::bytes(), summed over them
+  // What Embree holds for the same meshes, each built alone in its own frame (embreeMeshBytes);
+  // nullopt without Embree.
+  std::optional<std::size_t> embree_bytes;
+};
+
 // The stable header of results.csv.
 extern const char* const kCsvHeader;
 
 void writeCsv(const std::string& path, const std::vector<Row>& rows);
 // The table of results.csv plus vs_embree (embree_default's ns_per_ray over the row's, same
-// workload and scene), after a few lines that say how the run was made (run_info, markdown).
+// workload and scene), after a few lines that say how the run was made (run_info, markdown), then
+// the memory per triangle of each scene that has meshes (Embree's columns only with Embree).
 // Unavailable agreement columns are empty in the CSV and n/a in the table.
 void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
-                   const std::string& run_info);
+                   const std::vector<MemoryRow>& memory, const std::string& run_info);
 
 // Runs /usr/bin/python3 script args... Returns "" on success, else what went wrong.
 std::string runPlot(const std::string& script, const std::vector<std::string>& args);

@@ -5,10 +5,14 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <numeric>
+#include <set>
 #include <sstream>
 #include <string>
+#include <variant>
 
+#include "bench_peers.h"
 #include "bench_reference.h"
 
 namespace laser_raycast {
@@ -242,6 +246,29 @@ void runWorkload(const Settings& settings, int poses, const BenchScene& scene,
     }
     std::cerr << measured[k].log << "\n";
   }
+}
+
+std::optional<MemoryRow> measureMemory(const BenchScene& scene) {
+  // Instances share their Mesh, which is held once however many bodies place it.
+  std::set<const core::Mesh*> seen;
+  MemoryRow memory;
+  memory.scene = scene.name;
+  // Embree's total, until a mesh has no figure from it (a build without Embree).
+  memory.embree_bytes.emplace(0);
+  for (const core::Body& body : scene.scene.bodies()) {
+    const auto* mesh = std::get_if<std::shared_ptr<const core::Mesh>>(&body.shape);
+    if (!mesh || !seen.insert(mesh->get()).second) continue;
+    memory.triangles += (*mesh)->triangles().size();
+    memory.ours_bytes += (*mesh)->bytes();
+    const std::optional<std::size_t> embree = embreeMeshBytes(**mesh);
+    if (embree && memory.embree_bytes) {
+      *memory.embree_bytes += *embree;
+    } else {
+      memory.embree_bytes.reset();
+    }
+  }
+  if (seen.empty()) return std::nullopt;
+  return memory;
 }
 
 double secondsSince(std::chrono::steady_clock::time_point start) {

@@ -37,6 +37,10 @@ void runWorkload(const Settings& settings, int poses, const BenchScene& scene,
                  const SceneGeometry& geometry, const SceneMethods& methods,
                  const Workload& workload, std::vector<Row>* rows);
 
+// The memory per triangle of the scene's distinct meshes, ours and Embree's (one Embree build per
+// mesh: call it outside any timing); nullopt if the scene has no meshes.
+std::optional<MemoryRow> measureMemory(const BenchScene& scene);
+
 double secondsSince(std::chrono::steady_clock::time_point start);
 
 }  // namespace bench

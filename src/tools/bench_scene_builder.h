@@ -30,7 +30,7 @@ class SceneBuilder {
     out_->body_poses.push_back(pose);
   }
   void add(const MeshData& mesh, const PoseL& pose, const std::string& label) {
-    add(std::make_shared<const core::Mesh>(mesh.vertices, mesh.triangles), pose, label);
+    add(meshAsRead(mesh), pose, label);
   }
 
  private:

@@ -125,8 +125,8 @@ void buildMillion(BenchScene* s) {
   for (int k = 0; k < 3; ++k) {
     const MeshData trunk = cylinderMesh(trunk_radii[k], steps(-0.5, 6.0, 0.25), 64, true);
     const MeshData crown = uvSphereMesh(crown_radii[k], 64, 32);
-    trunks.push_back(std::make_shared<const core::Mesh>(trunk.vertices, trunk.triangles));
-    crowns.push_back(std::make_shared<const core::Mesh>(crown.vertices, crown.triangles));
+    trunks.push_back(meshAsRead(trunk));
+    crowns.push_back(meshAsRead(crown));
   }
 
   auto vehicle = [&](double x, double y, double roll, double pitch, double yaw) {

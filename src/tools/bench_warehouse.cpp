@@ -152,7 +152,7 @@ std::vector<Eigen::Vector2d> palletSlots(double free_from_x) {
 
 void addRacks(SceneBuilder* b, std::vector<double>* aisle_centres, double* free_from_x) {
   const MeshData rack = rackMesh();
-  const auto mesh = std::make_shared<const core::Mesh>(rack.vertices, rack.triangles);
+  const auto mesh = meshAsRead(rack);
   const auto rows = rackRows(aisle_centres);
   for (std::size_t r = 0; r < rows.size(); ++r) {
     for (const double side : {-1.0, 1.0}) {
