@@ -73,6 +73,7 @@ class Reader {
     if (!has(size)) {
       throw SceneLoadError(std::string("the importer's reply is truncated (in ") + what + ")");
     }
+    if (size == 0) return;  // out may be an empty vector's data(), null (memcpy must not see it)
     std::memcpy(out, bytes_.data() + pos_, size);
     pos_ += size;
   }
