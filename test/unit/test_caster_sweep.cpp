@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "cast_reference.h"
 #include "expect_invalid.h"
@@ -212,6 +213,40 @@ TEST(CastSweep, BlocksAgreeWithEachColumnCastOnItsOwn) {
   std::printf("sweep blocks vs columns: %lld beams, %lld hits, %lld ranges off, %lld bodies off, "
               "%lld triangles off, worst %.3g m\n",
               all.beams, all.hits, all.range_off, all.body_off, all.triangle_off, all.worst);
+}
+
+// A caster keeps state between casts (its beams' arrays and occlusion tiles, kept slices, the
+// last cast's inputs): a caster that cast other sweeps before (other scenes, motions and patterns,
+// one thread and two) gives each sweep the bits a new caster gives it.
+TEST(CastSweep, ACasterThatCastOtherSweepsGivesTheBitsOfANewOne) {
+  Rng rng(3301);
+  long long hits = 0;
+  core::Caster reused;
+  for (int trial = 0; trial < 10; ++trial) {
+    const RandomScene rs = randomScene(rng);
+    const double tilt = trial % 2 ? 0.3 : 0.0;
+    const core::PoseSamples samples =
+        randomMotion(rng, rs, 0.1, uniform(rng, 0.5, 3), uniform(rng, 0, 4), tilt);
+    const int columns = trial % 3 ? 720 : 360;
+    const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI - 2 * M_PI / columns, columns),
+                                    {-0.2, -0.1, -0.03, 0.0, 0.05, 0.1, 0.2});
+    core::CastConfig cfg = config(true);
+    cfg.threads = trial % 4 < 2 ? 1 : 2;
+    const double dt = 0.1 / columns;
+    const core::ScanResult again = reused.castSweep(rs.scene, samples, pattern, cfg, dt);
+    core::Caster fresh;
+    const core::ScanResult& first = fresh.castSweep(rs.scene, samples, pattern, cfg, dt);
+    ASSERT_EQ(again.range.size(), first.range.size());
+    for (std::size_t i = 0; i < first.range.size(); ++i) {
+      hits += std::isfinite(first.range[i]);
+      ASSERT_EQ(std::memcmp(&again.range[i], &first.range[i], sizeof(double)), 0)
+          << "trial " << trial << " beam " << i << ": " << again.range[i] << " vs "
+          << first.range[i];
+      ASSERT_EQ(again.body[i], first.body[i]) << "trial " << trial << " beam " << i;
+      ASSERT_EQ(again.triangle[i], first.triangle[i]) << "trial " << trial << " beam " << i;
+    }
+  }
+  EXPECT_GT(hits, 10000);
 }
 
 // Many small primitives close around a fast sensor: a beam of a block that meets one near its
