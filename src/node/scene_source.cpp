@@ -39,6 +39,7 @@ LoaderOptions optionsFor(const NodeParams& params, const ModelSource& model) {
   options.geometry = params.geometry;
   options.skip_bad_geometry = params.skip_bad_geometry;
   options.mesh_import = params.mesh_import;
+  options.bvh.threads = params.threads;  // ~threads builds the meshes' BVHs too
   options.tf_prefix = model.tf_prefix;
   for (const std::string& link : params.ignore_links) {
     options.ignore_links.push_back(link);

@@ -99,6 +99,7 @@ LoadedScene loadScene(const Args& args) {
     laser_raycast::LoaderOptions options;
     options.geometry = args.geometry;
     options.mesh_import = args.mesh_import;
+    options.bvh.threads = args.threads;  // --threads builds the meshes' BVHs too
     if (out.prefixed) options.tf_prefix = "m" + std::to_string(m) + "/";
     loaded.push_back(loader.addUrdfFile(args.models[m].path, options, &out.scene));
     out.load_seconds += loaded.back().load_seconds;

@@ -77,6 +77,57 @@ TEST(Bvh, StructureInvariants) {
   checkStructure(Bvh::build(gridSoup().vertices, gridSoup().triangles), gridSoup());
 }
 
+// Two trees node for node: the same boxes, children, depth, triangle order and slots.
+template <typename T>
+void expectSameTree(const BvhT<T>& a, const BvhT<T>& b, const std::string& what) {
+  ASSERT_EQ(a.nodes().size(), b.nodes().size()) << what;
+  EXPECT_EQ(a.depth(), b.depth()) << what;
+  EXPECT_EQ(a.root().index, b.root().index) << what;
+  EXPECT_EQ(a.root().count, b.root().count) << what;
+  EXPECT_EQ(a.bounds().lo, b.bounds().lo) << what;
+  EXPECT_EQ(a.bounds().hi, b.bounds().hi) << what;
+  for (std::size_t i = 0; i < a.nodes().size(); ++i) {
+    for (int k = 0; k < 2; ++k) {
+      ASSERT_EQ(a.nodes()[i].child[k].index, b.nodes()[i].child[k].index) << what << " node " << i;
+      ASSERT_EQ(a.nodes()[i].child[k].count, b.nodes()[i].child[k].count) << what << " node " << i;
+      ASSERT_EQ(a.nodes()[i].box(k).lo, b.nodes()[i].box(k).lo) << what << " node " << i;
+      ASSERT_EQ(a.nodes()[i].box(k).hi, b.nodes()[i].box(k).hi) << what << " node " << i;
+    }
+  }
+  EXPECT_EQ(a.triangleIds(), b.triangleIds()) << what;
+  ASSERT_EQ(a.triangleVertices().size(), b.triangleVertices().size()) << what;
+  for (std::size_t slot = 0; slot < a.triangleVertices().size(); ++slot) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(a.triangleVertices()[slot][k], b.triangleVertices()[slot][k]) << what;
+    }
+  }
+}
+
+// BvhConfig::threads builds subtrees on several threads: the tree is the one a single thread
+// builds, for any number of threads, with and without groups (a mesh's components), for soups
+// spread out and clustered, large enough that several subtrees go to the threads.
+TEST(Bvh, TheTreeIsTheSameForAnyNumberOfThreads) {
+  Rng rng(71);
+  for (const int n : {3000, 40000, 150000}) {
+    const Soup s = n % 2 ? spreadSoup(rng, n) : clusteredSoup(rng, n);
+    std::vector<std::uint32_t> groups(s.triangles.size());
+    for (std::size_t i = 0; i < groups.size(); ++i) groups[i] = static_cast<std::uint32_t>(i / 997);
+    for (const bool grouped : {false, true}) {
+      const std::vector<std::uint32_t> g = grouped ? groups : std::vector<std::uint32_t>{};
+      const Bvh one = Bvh::build(s.vertices, s.triangles, BvhConfig{}, g);
+      for (const int threads : {0, 2, 3, 8}) {
+        BvhConfig config;
+        config.threads = threads;
+        const std::string what = std::to_string(n) + " triangles, " +
+                                 std::to_string(threads) + " threads" +
+                                 (grouped ? ", grouped" : "");
+        expectSameTree(one, Bvh::build(s.vertices, s.triangles, config, g), what);
+        if (n == 40000) checkStructure(Bvh::build(s.vertices, s.triangles, config, g), s);
+      }
+    }
+  }
+}
+
 // Degenerate triangles (repeated vertex, collinear, a sliver that is collinear only once rounded to
 // float) are left out of the BVH, counted by Mesh, and never hit.
 TEST(Bvh, DegenerateTrianglesAreExcluded) {
@@ -232,8 +283,18 @@ TEST(BvhConfig, ValidateNamesFieldAndValue) {
     EXPECT_NO_THROW(c.validate());
   }
   c = BvhConfig{};
+  c.threads = -1;
+  expectInvalid(c, "threads", "-1");
+  c.threads = -2;
+  expectInvalid(c, "threads", "-2");
+  c.threads = 1025;
+  expectInvalid(c, "threads", "1025");
+  c = BvhConfig{};
   c.max_leaf_size = 1;
   c.traversal_cost = 0;
+  c.threads = 1024;
+  EXPECT_NO_THROW(c.validate());
+  c.threads = 0;  // every core
   EXPECT_NO_THROW(c.validate());
 }
 

@@ -6,8 +6,10 @@
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include "util/float_rounding.h"
+#include "util/thread_pool.h"
 
 namespace laser_raycast {
 namespace core {
@@ -56,34 +58,38 @@ class Builder {
     for (std::uint32_t g = 0; g < count; ++g) group_centroid_[g] = group_bounds[g].center();
   }
 
+  // The tree over every triangle. With config_.threads > 1 the top of the tree is built first,
+  // down to subtrees of a few thousand triangles at most, which are then built on the threads,
+  // each into a vector of its own, and joined. A node's split depends only on the triangles in its
+  // range, so the tree (its structure, boxes and triangle order; writeTree numbers the nodes
+  // afresh) is the same for any number of threads.
   void run() {
+    const auto n = static_cast<std::uint32_t>(tris_.size());
     nodes_.reserve(2 * tris_.size());
     nodes_.emplace_back();
-    std::vector<Task> tasks{{0, 0, static_cast<std::uint32_t>(tris_.size()), 0}};
-    while (!tasks.empty()) {
-      const Task task = tasks.back();
-      tasks.pop_back();
-      depth_ = std::max(depth_, task.depth);
-      BuildNode& node = nodes_[task.node];
-      Aabb centroids;
-      for (std::uint32_t i = task.begin; i < task.end; ++i) {
-        node.bounds.grow(tris_[order_[i]].bounds);
-        centroids.grow(tris_[order_[i]].centroid);
-      }
-      const std::uint32_t count = task.end - task.begin;
-      const std::uint32_t mid = split(task, node.bounds, centroids);
-      if (mid == task.begin || mid == task.end) {
-        node.first = task.begin;
-        node.count = count;
-        continue;
-      }
-      const auto left = static_cast<std::uint32_t>(nodes_.size());
-      node.first = left;
-      node.count = 0;
-      nodes_.emplace_back();  // invalidates `node`
-      nodes_.emplace_back();
-      tasks.push_back({left + 1, mid, task.end, task.depth + 1});
-      tasks.push_back({left, task.begin, mid, task.depth + 1});
+    const int threads = config_.threads > 0
+                            ? config_.threads
+                            : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    // Subtrees of at most this many triangles are left to the threads: about eight a thread, so
+    // that one large subtree does not leave the others idle, and none so small that handing it
+    // out costs more than building it.
+    const std::uint32_t defer_below =
+        threads > 1 ? std::max<std::uint32_t>(kMinParallelSubtree, n / (8 * threads)) : 0;
+    std::vector<Task> deferred;
+    depth_ = grow({0, 0, n, 0}, defer_below, &nodes_, &deferred);
+    if (deferred.empty()) return;
+    std::vector<std::vector<BuildNode>> parts(deferred.size());
+    std::vector<int> depths(deferred.size(), 0);
+    ThreadPool pool(std::min<int>(threads, static_cast<int>(deferred.size())));
+    pool.run(static_cast<int>(deferred.size()), [&](int i) {
+      Task root = deferred[i];
+      root.node = 0;
+      parts[i].emplace_back();
+      depths[i] = grow(root, 0, &parts[i], nullptr);
+    });
+    for (std::size_t i = 0; i < deferred.size(); ++i) {
+      join(parts[i], deferred[i].node);
+      depth_ = std::max(depth_, depths[i]);
     }
   }
 
@@ -92,6 +98,61 @@ class Builder {
   int depth() const { return depth_; }
 
  private:
+  // Subtrees with fewer triangles are never handed to a thread of their own.
+  static constexpr std::uint32_t kMinParallelSubtree = 4096;
+
+  // Builds the subtree of `root` (its node already in *nodes) into *nodes, children after their
+  // parents; with `deferred`, a task below the root with at most defer_below triangles is left
+  // there instead (its node stays empty). Returns the deepest depth built.
+  int grow(const Task& root, std::uint32_t defer_below, std::vector<BuildNode>* nodes,
+           std::vector<Task>* deferred) {
+    int depth = 0;
+    std::vector<Task> tasks{root};
+    while (!tasks.empty()) {
+      const Task task = tasks.back();
+      tasks.pop_back();
+      const std::uint32_t count = task.end - task.begin;
+      if (deferred && task.depth > 0 && count <= defer_below) {
+        deferred->push_back(task);
+        continue;
+      }
+      depth = std::max(depth, task.depth);
+      BuildNode& node = (*nodes)[task.node];
+      Aabb centroids;
+      for (std::uint32_t i = task.begin; i < task.end; ++i) {
+        node.bounds.grow(tris_[order_[i]].bounds);
+        centroids.grow(tris_[order_[i]].centroid);
+      }
+      const std::uint32_t mid = split(task, node.bounds, centroids);
+      if (mid == task.begin || mid == task.end) {
+        node.first = task.begin;
+        node.count = count;
+        continue;
+      }
+      const auto left = static_cast<std::uint32_t>(nodes->size());
+      node.first = left;
+      node.count = 0;
+      nodes->emplace_back();  // invalidates `node`
+      nodes->emplace_back();
+      tasks.push_back({left + 1, mid, task.end, task.depth + 1});
+      tasks.push_back({left, task.begin, mid, task.depth + 1});
+    }
+    return depth;
+  }
+
+  // A subtree built on its own (its root part[0], the inner nodes' children indices into part)
+  // put in place of the empty node `at`.
+  void join(const std::vector<BuildNode>& part, std::uint32_t at) {
+    // part[j] for j >= 1 goes to base + j - 1.
+    const auto base = static_cast<std::uint32_t>(nodes_.size());
+    auto placed = [&](BuildNode node) {
+      if (node.count == 0) node.first = base + node.first - 1;
+      return node;
+    };
+    nodes_[at] = placed(part[0]);
+    for (std::size_t j = 1; j < part.size(); ++j) nodes_.push_back(placed(part[j]));
+  }
+
   // The centroid a triangle is binned by: its own, or its group's while groups are split apart.
   const Eigen::Vector3d& binCentroid(std::uint32_t tri, bool by_group) const {
     return by_group ? group_centroid_[groups_[tri]] : tris_[tri].centroid;
@@ -293,6 +354,8 @@ void BvhConfig::validate() const {
   } else if (max_depth < 1 || max_depth > 62) {
     msg << "BvhConfig.max_depth must be in [1, 62] (the traversal stack holds 64), got "
         << max_depth;
+  } else if (threads < 0 || threads > 1024) {
+    msg << "BvhConfig.threads must be in [0, 1024] (0: every core), got " << threads;
   } else {
     return;
   }
