@@ -255,8 +255,8 @@ po::options_description flags(Args* args) {
              [args](const std::string& v) {
                args->threads = laser_raycast::tools::parseThreads("--threads", v);
              }),
-      ("threads a cast uses (default " + std::to_string(Args().threads) +
-       "; 0: every core); the ranges are the same for any number")
+      ("threads a cast uses, and that build the meshes' BVHs (default " +
+       std::to_string(Args().threads) + "; 0: every core); the ranges are the same for any number")
           .c_str());
   add("help,h", "print this help");
   return options;

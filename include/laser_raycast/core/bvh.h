@@ -25,7 +25,7 @@ struct BvhConfig {
   int bins = 16;                // SAH candidate planes per axis, minus one
   double traversal_cost = 1.0;  // cost of visiting a node, in units of one triangle test
   int max_depth = 60;           // deeper nodes become leaves; bounds the traversal stack (64)
-  int threads = 1;  // threads building the tree (0: every core); the tree is the same for any number
+  int threads = 1;              // building the tree (0: every core); the same tree for any number
 
   // Throws std::invalid_argument naming the field and its value.
   void validate() const;

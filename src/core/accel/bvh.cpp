@@ -6,7 +6,6 @@
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
 #include "util/float_rounding.h"
 #include "util/thread_pool.h"
@@ -67,9 +66,7 @@ class Builder {
     const auto n = static_cast<std::uint32_t>(tris_.size());
     nodes_.reserve(2 * tris_.size());
     nodes_.emplace_back();
-    const int threads = config_.threads > 0
-                            ? config_.threads
-                            : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = threadsFor(config_.threads);
     // Subtrees of at most this many triangles are left to the threads: about eight a thread, so
     // that one large subtree does not leave the others idle, and none so small that handing it
     // out costs more than building it.

@@ -15,7 +15,6 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 #include <vector>
 
 #include "accel/wide_bvh.h"
@@ -303,9 +302,7 @@ void checkFramePoses(const Scene& scene, const FramePoses& poses) {
 }
 
 int castThreads(const CastConfig& config, int beams, int min_per_thread) {
-  int threads = config.threads;
-  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  return std::max(1, std::min(threads, beams / min_per_thread));
+  return std::max(1, std::min(threadsFor(config.threads), beams / min_per_thread));
 }
 
 namespace {

@@ -1,7 +1,13 @@
 #include "util/thread_pool.h"
 
+#include <algorithm>
+
 namespace laser_raycast {
 namespace core {
+
+int threadsFor(int setting) {
+  return setting > 0 ? setting : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
 
 ThreadPool::ThreadPool(int threads) {
   for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { work(); });

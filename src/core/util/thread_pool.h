@@ -15,6 +15,10 @@
 namespace laser_raycast {
 namespace core {
 
+// A thread count as the settings give it (CastConfig::threads, BvhConfig::threads): 0 means every
+// core the machine reports (at least 1).
+int threadsFor(int setting);
+
 class ThreadPool {
  public:
   // threads: how many threads run a job, the caller included (>= 1).
