@@ -5,6 +5,9 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <set>
+#include <utility>
 #include <optional>
 #include <vector>
 
@@ -62,6 +65,74 @@ TEST(MeshClosed, ClosedComponentsAndTheirWinding) {
   EXPECT_GT(open_slots, 0);
   const TriMesh sheet{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}}};
   EXPECT_FALSE(core::Mesh(sheet.vertices, sheet.triangles).hasClosedComponents());
+}
+
+// Which components count as closed, against counting every directed edge of each component in a
+// map: a component is closed when it has no triangle with a repeated vertex and each of its
+// directed edges is used exactly once, as is its reverse. The solids are damaged at random: a
+// triangle taken away, repeated, turned around, collapsed onto an edge, or a fin added on an edge
+// (three triangles on it).
+TEST(MeshClosed, ClosedAsCountingEveryEdgeSays) {
+  Rng rng(83);
+  int closed_seen = 0, open_seen = 0;
+  for (int scene = 0; scene < 40; ++scene) {
+    TriMesh m = solids(rng, 8, scene % 2 == 1);
+    const int damage = static_cast<int>(rng() % 6);
+    for (int d = 0; d < damage; ++d) {
+      const std::size_t t = rng() % m.triangles.size();
+      auto tri = m.triangles[t];
+      switch (rng() % 5) {
+        case 0:
+          m.triangles.erase(m.triangles.begin() + static_cast<long>(t));
+          break;
+        case 1:
+          m.triangles.push_back(tri);
+          break;
+        case 2:
+          std::swap(m.triangles[t][1], m.triangles[t][2]);
+          break;
+        case 3:
+          m.triangles[t][2] = tri[0];
+          break;
+        default: {
+          // A new vertex off the edge tri[0]-tri[1], joined to it: a third triangle on that edge.
+          m.vertices.push_back(m.vertices[tri[2]] + Eigen::Vector3d(0.01, 0.02, 0.03));
+          m.triangles.push_back({tri[0], tri[1], static_cast<std::uint32_t>(m.vertices.size() - 1)});
+          break;
+        }
+      }
+    }
+    const core::Mesh mesh(m.vertices, m.triangles);
+    std::map<std::uint32_t, std::map<std::pair<std::uint32_t, std::uint32_t>, int>> uses;
+    std::set<std::uint32_t> collapsed;
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+      const std::uint32_t c = mesh.components()[t];
+      auto& edges = uses[c];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t from = m.triangles[t][k], to = m.triangles[t][(k + 1) % 3];
+        if (from == to) collapsed.insert(c);
+        ++edges[{from, to}];
+      }
+    }
+    std::map<std::uint32_t, bool> closed;
+    for (const auto& [c, edges] : uses) {
+      bool ok = collapsed.count(c) == 0;
+      for (const auto& [edge, n] : edges) {
+        const auto reverse = edges.find({edge.second, edge.first});
+        ok = ok && n == 1 && reverse != edges.end() && reverse->second == 1;
+      }
+      closed[c] = ok;
+    }
+    const auto& ids = mesh.bvh().triangleIds();
+    for (std::size_t slot = 0; slot < ids.size(); ++slot) {
+      const std::uint32_t c = mesh.components()[ids[slot]];
+      ASSERT_EQ(mesh.slotFacing()[slot] != 0, closed[c])
+          << "scene " << scene << " slot " << slot << " component " << c;
+    }
+    for (const auto& [c, ok] : closed) (ok ? closed_seen : open_seen)++;
+  }
+  EXPECT_GT(closed_seen, 100);
+  EXPECT_GT(open_seen, 20);
 }
 
 // From outside every solid's bounds: the nearest hit over all triangles is the nearest over those

@@ -4,8 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "util/float_rounding.h"
 #include "util/thread_pool.h"
@@ -25,10 +27,21 @@ struct BuildNode {
   std::uint32_t count = 0;  // leaf: triangle count
 };
 
+// The bounds of some triangles and of their centroids.
+struct Extent {
+  Aabb bounds, centroids;
+  void grow(const BuildTriangle& t) {
+    bounds.grow(t.bounds);
+    centroids.grow(t.centroid);
+  }
+};
+
 struct Task {
   std::uint32_t node;
   std::uint32_t begin, end;  // range in the order array
   int depth;
+  // The range's extent, if known (the partition that made the range measures it on the way).
+  std::optional<Extent> extent;
 };
 
 struct Bin {
@@ -42,11 +55,19 @@ struct Bin {
 // the node holds more than one group: the groups are partitioned first (SAH over their centroids),
 // then each group's triangles. So every subtree below some node holds exactly one group, and every
 // leaf does.
+//
+// The builder keeps its triangles (and their groups) in the order of the tree being built, moved
+// with their indices when a range is partitioned, so that every pass over a node's range reads
+// memory in order: read through the indices instead, a mesh of millions of triangles spent most of
+// its build waiting for memory.
 class Builder {
  public:
-  Builder(const std::vector<BuildTriangle>& tris, const BvhConfig& config,
-          const std::vector<std::uint32_t>& groups)
-      : tris_(tris), config_(config), groups_(groups), order_(tris.size()) {
+  Builder(std::vector<BuildTriangle> tris, const BvhConfig& config,
+          std::vector<std::uint32_t> groups)
+      : tris_(std::move(tris)),
+        config_(config),
+        groups_(std::move(groups)),
+        order_(tris_.size()) {
     std::iota(order_.begin(), order_.end(), 0u);
     if (groups_.empty()) return;
     std::uint32_t count = 0;
@@ -73,7 +94,7 @@ class Builder {
     const std::uint32_t defer_below =
         threads > 1 ? std::max<std::uint32_t>(kMinParallelSubtree, n / (8 * threads)) : 0;
     std::vector<Task> deferred;
-    depth_ = grow({0, 0, n, 0}, defer_below, &nodes_, &deferred);
+    depth_ = grow({0, 0, n, 0, std::nullopt}, defer_below, &nodes_, &deferred);
     if (deferred.empty()) return;
     std::vector<std::vector<BuildNode>> parts(deferred.size());
     std::vector<int> depths(deferred.size(), 0);
@@ -98,12 +119,21 @@ class Builder {
   // Subtrees with fewer triangles are never handed to a thread of their own.
   static constexpr std::uint32_t kMinParallelSubtree = 4096;
 
+  // What one thread's splits reuse: the bins of the three axes and the sweep's sums.
+  struct Scratch {
+    explicit Scratch(int nbins) : bins(3 * nbins), right_area(nbins), right_count(nbins) {}
+    std::vector<Bin> bins;  // axis a's bin b at a * nbins + b
+    std::vector<double> right_area;
+    std::vector<std::uint32_t> right_count;
+  };
+
   // Builds the subtree of `root` (its node already in *nodes) into *nodes, children after their
   // parents; with `deferred`, a task below the root with at most defer_below triangles is left
   // there instead (its node stays empty). Returns the deepest depth built.
   int grow(const Task& root, std::uint32_t defer_below, std::vector<BuildNode>* nodes,
            std::vector<Task>* deferred) {
     int depth = 0;
+    Scratch scratch(config_.bins);
     std::vector<Task> tasks{root};
     while (!tasks.empty()) {
       const Task task = tasks.back();
@@ -115,12 +145,15 @@ class Builder {
       }
       depth = std::max(depth, task.depth);
       BuildNode& node = (*nodes)[task.node];
-      Aabb centroids;
-      for (std::uint32_t i = task.begin; i < task.end; ++i) {
-        node.bounds.grow(tris_[order_[i]].bounds);
-        centroids.grow(tris_[order_[i]].centroid);
+      Extent extent;
+      if (task.extent) {
+        extent = *task.extent;
+      } else {
+        for (std::uint32_t i = task.begin; i < task.end; ++i) extent.grow(tris_[i]);
       }
-      const std::uint32_t mid = split(task, node.bounds, centroids);
+      node.bounds = extent.bounds;
+      Sides sides;
+      const std::uint32_t mid = split(task, extent, &scratch, &sides);
       if (mid == task.begin || mid == task.end) {
         node.first = task.begin;
         node.count = count;
@@ -131,8 +164,8 @@ class Builder {
       node.count = 0;
       nodes->emplace_back();  // invalidates `node`
       nodes->emplace_back();
-      tasks.push_back({left + 1, mid, task.end, task.depth + 1});
-      tasks.push_back({left, task.begin, mid, task.depth + 1});
+      tasks.push_back({left + 1, mid, task.end, task.depth + 1, sides.right});
+      tasks.push_back({left, task.begin, mid, task.depth + 1, sides.left});
     }
     return depth;
   }
@@ -150,65 +183,108 @@ class Builder {
     for (std::size_t j = 1; j < part.size(); ++j) nodes_.push_back(placed(part[j]));
   }
 
-  // The centroid a triangle is binned by: its own, or its group's while groups are split apart.
-  const Eigen::Vector3d& binCentroid(std::uint32_t tri, bool by_group) const {
-    return by_group ? group_centroid_[groups_[tri]] : tris_[tri].centroid;
+  // The centroid the triangle at position i of the order is binned by: its own, or its group's
+  // while groups are split apart.
+  const Eigen::Vector3d& binCentroid(std::uint32_t i, bool by_group) const {
+    return by_group ? group_centroid_[groups_[i]] : tris_[i].centroid;
   }
 
   bool holdsSeveralGroups(const Task& task) const {
     if (groups_.empty()) return false;
-    const std::uint32_t first = groups_[order_[task.begin]];
+    const std::uint32_t first = groups_[task.begin];
     for (std::uint32_t i = task.begin + 1; i < task.end; ++i) {
-      if (groups_[order_[i]] != first) return true;
+      if (groups_[i] != first) return true;
     }
     return false;
   }
 
+  // The extents of a split's two sides, where the split measured them.
+  struct Sides {
+    std::optional<Extent> left, right;
+  };
+
+  // Moves the positions of [begin, end) for which goes_left(i) holds before the others (the
+  // triangles, their indices and groups together) and returns where the others start; each side's
+  // extent into *sides, measured as every position is looked at once.
+  template <class Pred>
+  std::uint32_t partition(std::uint32_t begin, std::uint32_t end, Pred&& goes_left,
+                          Sides* sides) {
+    Extent left, right;
+    std::uint32_t i = begin, j = end;
+    while (true) {
+      for (; i < j && goes_left(i); ++i) left.grow(tris_[i]);
+      for (; i < j && !goes_left(j - 1); --j) right.grow(tris_[j - 1]);
+      if (i + 1 >= j) {
+        sides->left = left;
+        sides->right = right;
+        return i;
+      }
+      --j;
+      left.grow(tris_[j]);
+      right.grow(tris_[i]);
+      std::swap(tris_[i], tris_[j]);
+      std::swap(order_[i], order_[j]);
+      if (!groups_.empty()) std::swap(groups_[i], groups_[j]);
+      ++i;
+    }
+  }
+
   // Partitions [begin, end) and returns the split point; begin or end means "make a leaf".
-  std::uint32_t split(const Task& task, const Aabb& bounds, const Aabb& triangle_centroids) {
+  // The sides' extents into *sides where the partition measured them.
+  std::uint32_t split(const Task& task, const Extent& range, Scratch* scratch, Sides* sides) {
+    const Aabb& bounds = range.bounds;
+    const Aabb& triangle_centroids = range.centroids;
     const std::uint32_t count = task.end - task.begin;
     if (count <= 1 || task.depth >= config_.max_depth) return task.begin;
     const bool by_group = holdsSeveralGroups(task);
     Aabb centroids = triangle_centroids;
     if (by_group) {
       centroids = Aabb{};
-      for (std::uint32_t i = task.begin; i < task.end; ++i) {
-        centroids.grow(binCentroid(order_[i], true));
-      }
+      for (std::uint32_t i = task.begin; i < task.end; ++i) centroids.grow(binCentroid(i, true));
     }
     const int nbins = config_.bins;
     const double leaf_cost = count;
     double best_cost = std::numeric_limits<double>::infinity();
     int best_axis = -1, best_bin = 0;
     const Eigen::Vector3d extent = centroids.extent();
-    std::vector<Bin> bins(nbins);
-    std::vector<double> right_area(nbins);
-    std::vector<std::uint32_t> right_count(nbins);
+    // Every axis with an extent binned in one pass over the range.
+    bool binned[3];
+    double scale[3];
     for (int axis = 0; axis < 3; ++axis) {
-      if (!(extent[axis] > 0)) continue;
-      const double scale = nbins / extent[axis];
-      std::fill(bins.begin(), bins.end(), Bin{});
-      for (std::uint32_t i = task.begin; i < task.end; ++i) {
-        const BuildTriangle& t = tris_[order_[i]];
-        Bin& bin =
-            bins[binIndex(binCentroid(order_[i], by_group)[axis], centroids.lo[axis], scale)];
-        bin.bounds.grow(t.bounds);
+      binned[axis] = extent[axis] > 0;
+      scale[axis] = binned[axis] ? nbins / extent[axis] : 0;
+    }
+    Bin* bins = scratch->bins.data();
+    std::fill(scratch->bins.begin(), scratch->bins.end(), Bin{});
+    for (std::uint32_t i = task.begin; i < task.end; ++i) {
+      const Aabb& box = tris_[i].bounds;
+      const Eigen::Vector3d& c = binCentroid(i, by_group);
+      for (int axis = 0; axis < 3; ++axis) {
+        if (!binned[axis]) continue;
+        Bin& bin = bins[axis * nbins + binIndex(c[axis], centroids.lo[axis], scale[axis])];
+        bin.bounds.grow(box);
         ++bin.count;
       }
+    }
+    double* right_area = scratch->right_area.data();
+    std::uint32_t* right_count = scratch->right_count.data();
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!binned[axis]) continue;
+      const Bin* axis_bins = bins + axis * nbins;
       // Sweep from the right, then from the left, to cost each of the nbins - 1 planes.
       Aabb acc;
       std::uint32_t n = 0;
       for (int b = nbins - 1; b > 0; --b) {
-        acc.grow(bins[b].bounds);
-        n += bins[b].count;
+        acc.grow(axis_bins[b].bounds);
+        n += axis_bins[b].count;
         right_area[b] = acc.halfArea();
         right_count[b] = n;
       }
       acc = Aabb{};
       n = 0;
       for (int b = 0; b < nbins - 1; ++b) {
-        acc.grow(bins[b].bounds);
-        n += bins[b].count;
+        acc.grow(axis_bins[b].bounds);
+        n += axis_bins[b].count;
         if (n == 0 || right_count[b + 1] == 0) continue;
         const double cost = n * acc.halfArea() + right_count[b + 1] * right_area[b + 1];
         if (cost < best_cost) {
@@ -222,7 +298,7 @@ class Builder {
     const double split_cost = area > 0 ? config_.traversal_cost + best_cost / area
                                        : std::numeric_limits<double>::infinity();
     if (best_axis < 0) {
-      if (by_group) return splitGroupsByIndex(task);
+      if (by_group) return splitGroupsByIndex(task, sides);
       // All centroids coincide: no plane separates them. Halve by count if the leaf would be too
       // big.
       if (count <= static_cast<std::uint32_t>(config_.max_leaf_size)) return task.begin;
@@ -231,25 +307,24 @@ class Builder {
     const bool leaf_is_cheaper =
         split_cost >= leaf_cost && count <= static_cast<std::uint32_t>(config_.max_leaf_size);
     if (leaf_is_cheaper && !by_group) return task.begin;
-    const double scale = nbins / extent[best_axis];
     const double lo = centroids.lo[best_axis];
-    const auto it = std::partition(
-        order_.begin() + task.begin, order_.begin() + task.end, [&](std::uint32_t i) {
-          return binIndex(binCentroid(i, by_group)[best_axis], lo, scale) <= best_bin;
-        });
-    return static_cast<std::uint32_t>(it - order_.begin());
+    const double best_scale = scale[best_axis];
+    return partition(
+        task.begin, task.end,
+        [&](std::uint32_t i) {
+          return binIndex(binCentroid(i, by_group)[best_axis], lo, best_scale) <= best_bin;
+        },
+        sides);
   }
 
   // Several groups whose centroids coincide: the lower half of their indices goes left.
-  std::uint32_t splitGroupsByIndex(const Task& task) {
-    std::vector<std::uint32_t> present;
-    for (std::uint32_t i = task.begin; i < task.end; ++i) present.push_back(groups_[order_[i]]);
+  std::uint32_t splitGroupsByIndex(const Task& task, Sides* sides) {
+    std::vector<std::uint32_t> present(groups_.begin() + task.begin, groups_.begin() + task.end);
     std::sort(present.begin(), present.end());
     present.erase(std::unique(present.begin(), present.end()), present.end());
     const std::uint32_t pivot = present[present.size() / 2];
-    const auto it = std::partition(order_.begin() + task.begin, order_.begin() + task.end,
-                                   [&](std::uint32_t i) { return groups_[i] < pivot; });
-    return static_cast<std::uint32_t>(it - order_.begin());
+    return partition(
+        task.begin, task.end, [&](std::uint32_t i) { return groups_[i] < pivot; }, sides);
   }
 
   // Clamped before the conversion to int, which is undefined for NaN and out-of-range values:
@@ -260,9 +335,9 @@ class Builder {
     return x < config_.bins ? static_cast<int>(x) : config_.bins - 1;
   }
 
-  const std::vector<BuildTriangle>& tris_;
+  std::vector<BuildTriangle> tris_;     // in the order of order_
   const BvhConfig& config_;
-  const std::vector<std::uint32_t>& groups_;  // per build triangle, or empty
+  std::vector<std::uint32_t> groups_;  // per triangle in the order of order_, or empty
   std::vector<Eigen::Vector3d> group_centroid_;
   std::vector<std::uint32_t> order_;
   std::vector<BuildNode> nodes_;
@@ -392,11 +467,11 @@ BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
     build_groups.reserve(kept.size());
     for (const std::uint32_t i : kept) build_groups.push_back(groups[i]);
   }
-  Builder builder(build_tris, config, build_groups);
+  Builder builder(std::move(build_tris), config, std::move(build_groups));
   builder.run();
   bvh.adoptTree(writeTree<T>(builder.nodes()), builder.depth());
-  bvh.triangle_ids_.reserve(build_tris.size());
-  bvh.vertices_.reserve(build_tris.size());
+  bvh.triangle_ids_.reserve(kept.size());
+  bvh.vertices_.reserve(kept.size());
   for (const std::uint32_t i : builder.order()) {
     const TriangleIndices& tri = triangles[kept[i]];
     bvh.triangle_ids_.push_back(kept[i]);
@@ -418,7 +493,7 @@ BvhT<T> BvhT<T>::buildOverBoxes(const std::vector<Aabb>& boxes, const BvhConfig&
   }
   BvhT<T> bvh;
   if (items.empty()) return bvh;
-  Builder builder(items, config, {});
+  Builder builder(std::move(items), config, {});
   builder.run();
   bvh.adoptTree(writeTree<T>(builder.nodes()), builder.depth());
   for (const std::uint32_t i : builder.order()) bvh.triangle_ids_.push_back(kept[i]);

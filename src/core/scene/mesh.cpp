@@ -81,26 +81,40 @@ void Mesh::findClosedComponents() {
   for (std::size_t t = 0; t < triangles_.size(); ++t) {
     for (const std::uint32_t v : triangles_[t]) component_bounds_[component_[t]].grow(vertices_[v]);
   }
-  // Every directed edge once, and its reverse once: a closed surface wound one way.
+  // A closed surface wound one way has every edge exactly twice, once each way. The edges between
+  // two vertices, as (lower << 33 | higher << 1 | whether it runs from the higher), sorted, hold
+  // each edge's uses side by side. An edge's vertices are in its triangle's component (components
+  // join the triangles that share a vertex), so its lower vertex tells which component it decides.
   std::vector<char> closed(component_count_, 1);
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> edges;  // (from << 32 | to, component)
-  edges.reserve(triangles_.size() * 3);
-  for (std::size_t t = 0; t < triangles_.size(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t from = triangles_[t][k], to = triangles_[t][(k + 1) % 3];
-      if (from == to) closed[component_[t]] = 0;
-      edges.emplace_back(from << 32 | to, component_[t]);
+  if (vertices_.size() > (std::size_t{1} << 31)) {
+    // Vertex indices too wide for the packed edges: taken as open (back faces are tested, which
+    // costs time, never a range).
+    closed.assign(component_count_, 0);
+  } else {
+    std::vector<std::uint32_t> vertex_component(vertices_.size(), 0);
+    std::vector<std::uint64_t> edges;
+    edges.reserve(triangles_.size() * 3);
+    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const std::uint64_t from = triangles_[t][k], to = triangles_[t][(k + 1) % 3];
+        vertex_component[from] = component_[t];
+        if (from == to) {
+          closed[component_[t]] = 0;
+          continue;
+        }
+        edges.push_back(std::min(from, to) << 33 | std::max(from, to) << 1 | (from > to ? 1 : 0));
+      }
     }
-  }
-  std::sort(edges.begin(), edges.end());
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    const std::uint64_t e = edges[i].first;
-    const bool repeated = i + 1 < edges.size() && edges[i + 1].first == e;
-    const std::uint64_t reverse = (e & 0xffffffffull) << 32 | e >> 32;
-    const bool paired =
-        std::binary_search(edges.begin(), edges.end(), std::make_pair(reverse, std::uint32_t{0}),
-                           [](const auto& x, const auto& y) { return x.first < y.first; });
-    if (repeated || !paired) closed[edges[i].second] = 0;
+    std::sort(edges.begin(), edges.end());
+    for (std::size_t i = 0; i < edges.size();) {
+      const std::uint64_t edge = edges[i] >> 1;
+      std::size_t end = i + 1;
+      while (end < edges.size() && edges[end] >> 1 == edge) ++end;
+      // Sorted, the one use each way is (edge << 1 | 0) then (edge << 1 | 1).
+      const bool once_each_way = end - i == 2 && (edges[i] & 1) == 0 && (edges[i + 1] & 1) == 1;
+      if (!once_each_way) closed[vertex_component[edge >> 32]] = 0;
+      i = end;
+    }
   }
   // The orientation: the sign of the enclosed volume (six times it: the tetrahedra from a point of
   // the component's bounds to each triangle), kept only if it stands clear of the rounding.
