@@ -1,6 +1,8 @@
 #include "laser_raycast/core/mesh.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -9,6 +11,28 @@
 
 namespace laser_raycast {
 namespace core {
+namespace {
+
+// Sorts keys in place, least significant 11 bits first, over the bits any key has set: for
+// millions of keys several times faster than std::sort.
+void radixSort(std::vector<std::uint64_t>* keys) {
+  constexpr int kDigitBits = 11;
+  constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
+  std::uint64_t any = 0;
+  for (const std::uint64_t k : *keys) any |= k;
+  std::vector<std::uint64_t> other(keys->size());
+  std::vector<std::size_t> start(kBuckets);
+  for (int shift = 0; shift < 64 && (any >> shift) != 0; shift += kDigitBits) {
+    std::fill(start.begin(), start.end(), 0);
+    for (const std::uint64_t k : *keys) ++start[(k >> shift) & (kBuckets - 1)];
+    std::size_t sum = 0;
+    for (std::size_t& s : start) sum += std::exchange(s, sum);
+    for (const std::uint64_t k : *keys) other[start[(k >> shift) & (kBuckets - 1)]++] = k;
+    keys->swap(other);
+  }
+}
+
+}  // namespace
 
 Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> triangles,
            const BvhConfig& bvh_config, const Eigen::Vector3d& float_scale)
@@ -39,15 +63,18 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
     throw std::invalid_argument(msg.str());
   }
   bvh_.packSlots(float_scale);
-  // Bounds and sphere over the vertices that triangles use.
+  // Bounds and sphere over the vertices that triangles use (marked first, then read in order).
+  std::vector<char> used(vertices_.size(), 0);
   for (const TriangleIndices& tri : triangles_) {
-    for (const std::uint32_t v : tri) bounds_.grow(vertices_[v]);
+    for (const std::uint32_t v : tri) used[v] = 1;
+  }
+  for (std::size_t v = 0; v < vertices_.size(); ++v) {
+    if (used[v]) bounds_.grow(vertices_[v]);
   }
   sphere_center_ = bounds_.center();
   double r2 = 0;
-  for (const TriangleIndices& tri : triangles_) {
-    for (const std::uint32_t v : tri)
-      r2 = std::max(r2, (vertices_[v] - sphere_center_).squaredNorm());
+  for (std::size_t v = 0; v < vertices_.size(); ++v) {
+    if (used[v]) r2 = std::max(r2, (vertices_[v] - sphere_center_).squaredNorm());
   }
   // Rounding of the squared norm and sqrt could put the farthest vertex just outside; widen by a
   // few ulps.
@@ -77,27 +104,31 @@ std::size_t Mesh::bytes() const {
 }
 
 void Mesh::findClosedComponents() {
-  component_bounds_.assign(component_count_, Aabb{});
-  for (std::size_t t = 0; t < triangles_.size(); ++t) {
-    for (const std::uint32_t v : triangles_[t]) component_bounds_[component_[t]].grow(vertices_[v]);
-  }
   // A closed surface wound one way has every edge exactly twice, once each way. The edges between
   // two vertices, as (lower << 33 | higher << 1 | whether it runs from the higher), sorted, hold
   // each edge's uses side by side. An edge's vertices are in its triangle's component (components
   // join the triangles that share a vertex), so its lower vertex tells which component it decides.
+  // Each used vertex's component, from which the components' bounds, read in vertex order.
+  constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> vertex_component(vertices_.size(), kUnused);
+  for (std::size_t t = 0; t < triangles_.size(); ++t) {
+    for (const std::uint32_t v : triangles_[t]) vertex_component[v] = component_[t];
+  }
+  component_bounds_.assign(component_count_, Aabb{});
+  for (std::size_t v = 0; v < vertices_.size(); ++v) {
+    if (vertex_component[v] != kUnused) component_bounds_[vertex_component[v]].grow(vertices_[v]);
+  }
   std::vector<char> closed(component_count_, 1);
   if (vertices_.size() > (std::size_t{1} << 31)) {
     // Vertex indices too wide for the packed edges: taken as open (back faces are tested, which
     // costs time, never a range).
     closed.assign(component_count_, 0);
   } else {
-    std::vector<std::uint32_t> vertex_component(vertices_.size(), 0);
     std::vector<std::uint64_t> edges;
     edges.reserve(triangles_.size() * 3);
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
       for (int k = 0; k < 3; ++k) {
         const std::uint64_t from = triangles_[t][k], to = triangles_[t][(k + 1) % 3];
-        vertex_component[from] = component_[t];
         if (from == to) {
           closed[component_[t]] = 0;
           continue;
@@ -105,7 +136,7 @@ void Mesh::findClosedComponents() {
         edges.push_back(std::min(from, to) << 33 | std::max(from, to) << 1 | (from > to ? 1 : 0));
       }
     }
-    std::sort(edges.begin(), edges.end());
+    radixSort(&edges);
     for (std::size_t i = 0; i < edges.size();) {
       const std::uint64_t edge = edges[i] >> 1;
       std::size_t end = i + 1;
