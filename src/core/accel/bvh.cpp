@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include <emmintrin.h>
+
 #include "util/float_rounding.h"
 #include "util/thread_pool.h"
 
@@ -16,23 +18,60 @@ namespace laser_raycast {
 namespace core {
 namespace {
 
-struct BuildTriangle {
-  Aabb bounds;
-  Eigen::Vector3d centroid;
+// A triangle's (or box's) bounds as the tree stores them, rounded outward to float (lanes x, y, z;
+// the fourth is 0). Rounding outward is monotonic, so the float box of a node's triangles is the
+// rounding of its exact box: the tree's boxes are the same as from exact bounds rounded at the end,
+// and the build works on 16 bytes a corner instead of 48.
+struct BuildBox {
+  __m128 lo = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  __m128 hi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+
+  static BuildBox of(const Aabb& b) {
+    BuildBox box;
+    box.lo = _mm_setr_ps(floatBelow(b.lo.x()), floatBelow(b.lo.y()), floatBelow(b.lo.z()), 0.0f);
+    box.hi = _mm_setr_ps(floatAbove(b.hi.x()), floatAbove(b.hi.y()), floatAbove(b.hi.z()), 0.0f);
+    return box;
+  }
+  void grow(const BuildBox& b) {
+    lo = _mm_min_ps(lo, b.lo);
+    hi = _mm_max_ps(hi, b.hi);
+  }
+  void grow(__m128 p) {
+    lo = _mm_min_ps(lo, p);
+    hi = _mm_max_ps(hi, p);
+  }
+  // Twice the centre (lo + hi): what triangles are binned by.
+  __m128 twiceCenter() const { return _mm_add_ps(lo, hi); }
+  float lower(int axis) const { return lane(lo, axis); }
+  float upper(int axis) const { return lane(hi, axis); }
+  // Half the surface area, in double (0 if empty).
+  double halfArea() const {
+    double e[3];
+    for (int a = 0; a < 3; ++a) {
+      e[a] = static_cast<double>(upper(a)) - lower(a);
+      if (!(e[a] >= 0)) return 0;
+    }
+    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+  }
+  static float lane(__m128 v, int axis) {
+    alignas(16) float f[4];
+    _mm_store_ps(f, v);
+    return f[axis];
+  }
 };
 
 struct BuildNode {
-  Aabb bounds;
+  BuildBox bounds;
   std::uint32_t first = 0;  // inner: left child; leaf: first slot
   std::uint32_t count = 0;  // leaf: triangle count
 };
 
-// The bounds of some triangles and of their centroids.
+// The bounds of some triangles and of their centres (twice: BuildBox::twiceCenter).
 struct Extent {
-  Aabb bounds, centroids;
-  void grow(const BuildTriangle& t) {
-    bounds.grow(t.bounds);
-    centroids.grow(t.centroid);
+  BuildBox bounds, centers;
+  void grow(const BuildBox& t) {
+    bounds.grow(t);
+    centers.grow(t.twiceCenter());
   }
 };
 
@@ -45,8 +84,32 @@ struct Task {
 };
 
 struct Bin {
-  Aabb bounds;
+  BuildBox bounds;
   std::uint32_t count = 0;
+};
+
+// Where centres fall among the bins of each axis: bin (c - lo) * scale, clamped to the bins (a NaN,
+// from coordinates beyond the floats, to the first).
+struct Binning {
+  __m128 lo, scale, last;
+  Binning(const BuildBox& centers, int nbins) {
+    lo = centers.lo;
+    alignas(16) float s[4] = {0, 0, 0, 0};
+    for (int a = 0; a < 3; ++a) {
+      const float extent = centers.upper(a) - centers.lower(a);
+      // A NaN or infinite extent bins every centre into the first bin: no split on that axis.
+      s[a] = extent > 0 && extent <= std::numeric_limits<float>::max() ? nbins / extent : 0.0f;
+    }
+    scale = _mm_load_ps(s);
+    last = _mm_set1_ps(static_cast<float>(nbins - 1));
+  }
+  bool binned(int axis) const { return BuildBox::lane(scale, axis) > 0; }
+  // The bins of center on the three axes.
+  __m128i bins(__m128 center) const {
+    const __m128 x = _mm_mul_ps(_mm_sub_ps(center, lo), scale);
+    // maxps gives its second operand when either is NaN.
+    return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), last));
+  }
 };
 
 // Binned SAH (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies", 2007): for
@@ -59,11 +122,10 @@ struct Bin {
 // The builder keeps its triangles (and their groups) in the order of the tree being built, moved
 // with their indices when a range is partitioned, so that every pass over a node's range reads
 // memory in order: read through the indices instead, a mesh of millions of triangles spent most of
-// its build waiting for memory.
+// its build waiting for memory. It bins the three axes in one pass, in float (SSE2).
 class Builder {
  public:
-  Builder(std::vector<BuildTriangle> tris, const BvhConfig& config,
-          std::vector<std::uint32_t> groups)
+  Builder(std::vector<BuildBox> tris, const BvhConfig& config, std::vector<std::uint32_t> groups)
       : tris_(std::move(tris)),
         config_(config),
         groups_(std::move(groups)),
@@ -72,10 +134,8 @@ class Builder {
     if (groups_.empty()) return;
     std::uint32_t count = 0;
     for (const std::uint32_t g : groups_) count = std::max(count, g + 1);
-    group_centroid_.assign(count, Eigen::Vector3d::Zero());
-    std::vector<Aabb> group_bounds(count);
-    for (std::size_t i = 0; i < tris_.size(); ++i) group_bounds[groups_[i]].grow(tris_[i].bounds);
-    for (std::uint32_t g = 0; g < count; ++g) group_centroid_[g] = group_bounds[g].center();
+    group_bounds_.resize(count);
+    for (std::size_t i = 0; i < tris_.size(); ++i) group_bounds_[groups_[i]].grow(tris_[i]);
   }
 
   // The tree over every triangle. With config_.threads > 1 the top of the tree is built first,
@@ -183,10 +243,10 @@ class Builder {
     for (std::size_t j = 1; j < part.size(); ++j) nodes_.push_back(placed(part[j]));
   }
 
-  // The centroid the triangle at position i of the order is binned by: its own, or its group's
-  // while groups are split apart.
-  const Eigen::Vector3d& binCentroid(std::uint32_t i, bool by_group) const {
-    return by_group ? group_centroid_[groups_[i]] : tris_[i].centroid;
+  // The centre (twice) the triangle at position i of the order is binned by: its own, or its
+  // group's while groups are split apart.
+  __m128 binCenter(std::uint32_t i, bool by_group) const {
+    return (by_group ? group_bounds_[groups_[i]] : tris_[i]).twiceCenter();
   }
 
   bool holdsSeveralGroups(const Task& task) const {
@@ -229,50 +289,43 @@ class Builder {
     }
   }
 
-  // Partitions [begin, end) and returns the split point; begin or end means "make a leaf".
-  // The sides' extents into *sides where the partition measured them.
+  // Partitions [begin, end) and returns the split point; begin or end means "make a leaf". The
+  // sides' extents into *sides where the partition measured them.
   std::uint32_t split(const Task& task, const Extent& range, Scratch* scratch, Sides* sides) {
-    const Aabb& bounds = range.bounds;
-    const Aabb& triangle_centroids = range.centroids;
     const std::uint32_t count = task.end - task.begin;
     if (count <= 1 || task.depth >= config_.max_depth) return task.begin;
     const bool by_group = holdsSeveralGroups(task);
-    Aabb centroids = triangle_centroids;
+    BuildBox centers = range.centers;
     if (by_group) {
-      centroids = Aabb{};
-      for (std::uint32_t i = task.begin; i < task.end; ++i) centroids.grow(binCentroid(i, true));
+      centers = BuildBox{};
+      for (std::uint32_t i = task.begin; i < task.end; ++i) centers.grow(binCenter(i, true));
     }
     const int nbins = config_.bins;
-    const double leaf_cost = count;
-    double best_cost = std::numeric_limits<double>::infinity();
-    int best_axis = -1, best_bin = 0;
-    const Eigen::Vector3d extent = centroids.extent();
-    // Every axis with an extent binned in one pass over the range.
-    bool binned[3];
-    double scale[3];
-    for (int axis = 0; axis < 3; ++axis) {
-      binned[axis] = extent[axis] > 0;
-      scale[axis] = binned[axis] ? nbins / extent[axis] : 0;
-    }
+    const Binning binning(centers, nbins);
+    // Every axis binned in one pass over the range (an axis without an extent puts everything in
+    // its first bin and is not costed).
     Bin* bins = scratch->bins.data();
     std::fill(scratch->bins.begin(), scratch->bins.end(), Bin{});
     for (std::uint32_t i = task.begin; i < task.end; ++i) {
-      const Aabb& box = tris_[i].bounds;
-      const Eigen::Vector3d& c = binCentroid(i, by_group);
+      alignas(16) std::int32_t b[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(b), binning.bins(binCenter(i, by_group)));
+      const BuildBox& box = tris_[i];
       for (int axis = 0; axis < 3; ++axis) {
-        if (!binned[axis]) continue;
-        Bin& bin = bins[axis * nbins + binIndex(c[axis], centroids.lo[axis], scale[axis])];
+        Bin& bin = bins[axis * nbins + b[axis]];
         bin.bounds.grow(box);
         ++bin.count;
       }
     }
+    const double leaf_cost = count;
+    double best_cost = std::numeric_limits<double>::infinity();
+    int best_axis = -1, best_bin = 0;
     double* right_area = scratch->right_area.data();
     std::uint32_t* right_count = scratch->right_count.data();
     for (int axis = 0; axis < 3; ++axis) {
-      if (!binned[axis]) continue;
+      if (!binning.binned(axis)) continue;
       const Bin* axis_bins = bins + axis * nbins;
       // Sweep from the right, then from the left, to cost each of the nbins - 1 planes.
-      Aabb acc;
+      BuildBox acc;
       std::uint32_t n = 0;
       for (int b = nbins - 1; b > 0; --b) {
         acc.grow(axis_bins[b].bounds);
@@ -280,7 +333,7 @@ class Builder {
         right_area[b] = acc.halfArea();
         right_count[b] = n;
       }
-      acc = Aabb{};
+      acc = BuildBox{};
       n = 0;
       for (int b = 0; b < nbins - 1; ++b) {
         acc.grow(axis_bins[b].bounds);
@@ -294,7 +347,7 @@ class Builder {
         }
       }
     }
-    const double area = bounds.halfArea();
+    const double area = range.bounds.halfArea();
     const double split_cost = area > 0 ? config_.traversal_cost + best_cost / area
                                        : std::numeric_limits<double>::infinity();
     if (best_axis < 0) {
@@ -307,12 +360,12 @@ class Builder {
     const bool leaf_is_cheaper =
         split_cost >= leaf_cost && count <= static_cast<std::uint32_t>(config_.max_leaf_size);
     if (leaf_is_cheaper && !by_group) return task.begin;
-    const double lo = centroids.lo[best_axis];
-    const double best_scale = scale[best_axis];
     return partition(
         task.begin, task.end,
         [&](std::uint32_t i) {
-          return binIndex(binCentroid(i, by_group)[best_axis], lo, best_scale) <= best_bin;
+          alignas(16) std::int32_t b[4];
+          _mm_store_si128(reinterpret_cast<__m128i*>(b), binning.bins(binCenter(i, by_group)));
+          return b[best_axis] <= best_bin;
         },
         sides);
   }
@@ -327,18 +380,10 @@ class Builder {
         task.begin, task.end, [&](std::uint32_t i) { return groups_[i] < pivot; }, sides);
   }
 
-  // Clamped before the conversion to int, which is undefined for NaN and out-of-range values:
-  // coordinates near the largest double make centroids, extents and so x overflow to Inf or NaN.
-  int binIndex(double c, double lo, double scale) const {
-    const double x = (c - lo) * scale;
-    if (!(x >= 0)) return 0;
-    return x < config_.bins ? static_cast<int>(x) : config_.bins - 1;
-  }
-
-  std::vector<BuildTriangle> tris_;     // in the order of order_
+  std::vector<BuildBox> tris_;         // in the order of order_
   const BvhConfig& config_;
   std::vector<std::uint32_t> groups_;  // per triangle in the order of order_, or empty
-  std::vector<Eigen::Vector3d> group_centroid_;
+  std::vector<BuildBox> group_bounds_;
   std::vector<std::uint32_t> order_;
   std::vector<BuildNode> nodes_;
   int depth_ = 0;
@@ -354,12 +399,13 @@ AabbT<T> castBounds(const Aabb& b) {
 }
 
 // The builder's tree as BvhT stores it: inner nodes depth first, each holding its children's boxes
-// (rounded outward to float); the two children of a node get adjacent indices.
+// (float, rounded outward); the two children of a node get adjacent indices. bounds: the exact
+// bounds of every triangle.
 template <typename T>
-typename BvhT<T>::Tree writeTree(const std::vector<BuildNode>& tree) {
+typename BvhT<T>::Tree writeTree(const std::vector<BuildNode>& tree, const Aabb& bounds) {
   using Child = typename BvhT<T>::Child;
   typename BvhT<T>::Tree out;
-  out.bounds = castBounds<T>(tree[0].bounds);
+  out.bounds = castBounds<T>(bounds);
   if (tree[0].count > 0) {
     out.root = Child{tree[0].first, tree[0].count};
     return out;
@@ -383,8 +429,8 @@ typename BvhT<T>::Tree writeTree(const std::vector<BuildNode>& tree) {
       auto& node = out.nodes[to];
       node.child[k] = ref;
       for (int a = 0; a < 3; ++a) {
-        node.lo[k][a] = floatBelow(child.bounds.lo[a]);
-        node.hi[k][a] = floatAbove(child.bounds.hi[a]);
+        node.lo[k][a] = child.bounds.lower(a);
+        node.hi[k][a] = child.bounds.upper(a);
       }
     }
   }
@@ -443,8 +489,9 @@ BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
     throw std::invalid_argument("BVH build: " + std::to_string(groups.size()) + " groups for " +
                                 std::to_string(triangles.size()) + " triangles");
   }
-  std::vector<BuildTriangle> build_tris;
+  std::vector<BuildBox> build_tris;
   std::vector<std::uint32_t> kept;  // original index of each build triangle
+  Aabb bounds;                      // exactly
   build_tris.reserve(triangles.size());
   kept.reserve(triangles.size());
   for (std::size_t i = 0; i < triangles.size(); ++i) {
@@ -453,10 +500,10 @@ BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
     const Vec3<T> a = vertices[tri[0]].cast<T>(), b = vertices[tri[1]].cast<T>(),
                   c = vertices[tri[2]].cast<T>();
     if (isDegenerateTriangle(a, b, c)) continue;
-    BuildTriangle bt;
-    for (const auto v : tri) bt.bounds.grow(vertices[v]);
-    bt.centroid = bt.bounds.center();
-    build_tris.push_back(bt);
+    Aabb box;
+    for (const auto v : tri) box.grow(vertices[v]);
+    bounds.grow(box);
+    build_tris.push_back(BuildBox::of(box));
     kept.push_back(static_cast<std::uint32_t>(i));
   }
   BvhT<T> bvh;
@@ -469,7 +516,7 @@ BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
   }
   Builder builder(std::move(build_tris), config, std::move(build_groups));
   builder.run();
-  bvh.adoptTree(writeTree<T>(builder.nodes()), builder.depth());
+  bvh.adoptTree(writeTree<T>(builder.nodes(), bounds), builder.depth());
   bvh.triangle_ids_.reserve(kept.size());
   bvh.vertices_.reserve(kept.size());
   for (const std::uint32_t i : builder.order()) {
@@ -484,18 +531,20 @@ BvhT<T> BvhT<T>::build(const std::vector<Eigen::Vector3d>& vertices,
 template <typename T>
 BvhT<T> BvhT<T>::buildOverBoxes(const std::vector<Aabb>& boxes, const BvhConfig& config) {
   config.validate();
-  std::vector<BuildTriangle> items;
+  std::vector<BuildBox> items;
   std::vector<std::uint32_t> kept;
+  Aabb bounds;
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     if (boxes[i].empty()) continue;
-    items.push_back(BuildTriangle{boxes[i], boxes[i].center()});
+    bounds.grow(boxes[i]);
+    items.push_back(BuildBox::of(boxes[i]));
     kept.push_back(static_cast<std::uint32_t>(i));
   }
   BvhT<T> bvh;
   if (items.empty()) return bvh;
   Builder builder(std::move(items), config, {});
   builder.run();
-  bvh.adoptTree(writeTree<T>(builder.nodes()), builder.depth());
+  bvh.adoptTree(writeTree<T>(builder.nodes(), bounds), builder.depth());
   for (const std::uint32_t i : builder.order()) bvh.triangle_ids_.push_back(kept[i]);
   return bvh;
 }
