@@ -44,14 +44,13 @@ struct BuildBox {
   __m128 twiceCenter() const { return _mm_add_ps(lo, hi); }
   float lower(int axis) const { return lane(lo, axis); }
   float upper(int axis) const { return lane(hi, axis); }
-  // Half the surface area, in double (0 if empty).
-  double halfArea() const {
-    double e[3];
-    for (int a = 0; a < 3; ++a) {
-      e[a] = static_cast<double>(upper(a)) - lower(a);
-      if (!(e[a] >= 0)) return 0;
-    }
-    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+  // Half the surface area of a box that is not empty, in float (infinite beyond the floats).
+  float halfArea() const {
+    const __m128 e = _mm_sub_ps(hi, lo);  // 0 in the fourth lane
+    const __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));
+    // x y + y z + z x, the fourth lane's 0 * 0 added as well.
+    const __m128 s = _mm_add_ps(p, _mm_movehl_ps(p, p));
+    return _mm_cvtss_f32(_mm_add_ss(s, _mm_shuffle_ps(s, s, _MM_SHUFFLE(1, 1, 1, 1))));
   }
   static float lane(__m128 v, int axis) {
     alignas(16) float f[4];
@@ -81,6 +80,8 @@ struct Task {
   int depth;
   // The range's extent, if known (the partition that made the range measures it on the way).
   std::optional<Extent> extent;
+  // Whether the range is known to hold one group (so do the ranges split from it).
+  bool one_group = false;
 };
 
 struct Bin {
@@ -154,7 +155,7 @@ class Builder {
     const std::uint32_t defer_below =
         threads > 1 ? std::max<std::uint32_t>(kMinParallelSubtree, n / (8 * threads)) : 0;
     std::vector<Task> deferred;
-    depth_ = grow({0, 0, n, 0, std::nullopt}, defer_below, &nodes_, &deferred);
+    depth_ = grow({0, 0, n, 0, std::nullopt, groups_.empty()}, defer_below, &nodes_, &deferred);
     if (deferred.empty()) return;
     std::vector<std::vector<BuildNode>> parts(deferred.size());
     std::vector<int> depths(deferred.size(), 0);
@@ -213,7 +214,8 @@ class Builder {
       }
       node.bounds = extent.bounds;
       Sides sides;
-      const std::uint32_t mid = split(task, extent, &scratch, &sides);
+      const bool by_group = !task.one_group && holdsSeveralGroups(task);
+      const std::uint32_t mid = split(task, extent, by_group, &scratch, &sides);
       if (mid == task.begin || mid == task.end) {
         node.first = task.begin;
         node.count = count;
@@ -224,8 +226,8 @@ class Builder {
       node.count = 0;
       nodes->emplace_back();  // invalidates `node`
       nodes->emplace_back();
-      tasks.push_back({left + 1, mid, task.end, task.depth + 1, sides.right});
-      tasks.push_back({left, task.begin, mid, task.depth + 1, sides.left});
+      tasks.push_back({left + 1, mid, task.end, task.depth + 1, sides.right, !by_group});
+      tasks.push_back({left, task.begin, mid, task.depth + 1, sides.left, !by_group});
     }
     return depth;
   }
@@ -291,21 +293,24 @@ class Builder {
 
   // Partitions [begin, end) and returns the split point; begin or end means "make a leaf". The
   // sides' extents into *sides where the partition measured them.
-  std::uint32_t split(const Task& task, const Extent& range, Scratch* scratch, Sides* sides) {
+  // by_group: the range holds several groups, to be split apart.
+  std::uint32_t split(const Task& task, const Extent& range, bool by_group, Scratch* scratch,
+                      Sides* sides) {
     const std::uint32_t count = task.end - task.begin;
     if (count <= 1 || task.depth >= config_.max_depth) return task.begin;
-    const bool by_group = holdsSeveralGroups(task);
     BuildBox centers = range.centers;
     if (by_group) {
       centers = BuildBox{};
       for (std::uint32_t i = task.begin; i < task.end; ++i) centers.grow(binCenter(i, true));
     }
-    const int nbins = config_.bins;
+    // No more bins than triangles: a small node's few centres need no more planes between them,
+    // and its bins are what its split costs (most nodes are small).
+    const int nbins = static_cast<int>(std::min<std::uint32_t>(config_.bins, count));
     const Binning binning(centers, nbins);
     // Every axis binned in one pass over the range (an axis without an extent puts everything in
     // its first bin and is not costed).
     Bin* bins = scratch->bins.data();
-    std::fill(scratch->bins.begin(), scratch->bins.end(), Bin{});
+    std::fill(scratch->bins.begin(), scratch->bins.begin() + 3 * nbins, Bin{});
     for (std::uint32_t i = task.begin; i < task.end; ++i) {
       alignas(16) std::int32_t b[4];
       _mm_store_si128(reinterpret_cast<__m128i*>(b), binning.bins(binCenter(i, by_group)));
