@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_load.h"
 #include "bench_methods.h"
 #include "bench_peers.h"
 #include "bench_report.h"
@@ -43,7 +44,9 @@ const char* const kNotes =
     "sweep_fan, sweep_rings, and the calibrated heads rotating: sweep_vlp16_calibrated,\n"
     "sweep_os1_64_metadata), and measures each\n"
     "beam's error against a long double reference and its agreement with Embree's robust\n"
-    "mode. Writes DIR/results.csv, results.md, pareto.png (one point per method) and\n"
+    "mode. load: each scene's soup of at least 100000 triangles written as a mesh file (STL,\n"
+    "and OBJ without --quick) and loaded as the node does, against assimp reading it and\n"
+    "Embree building its BVH. Writes DIR/results.csv, results.md, pareto.png (one point per method) and\n"
     "pareto_matrix.png (every workload and scene) (DIR defaults to bench_results). Scenes:\n"
     "sphere box_room tb3 million vertex_rows forest warehouse forest_10m (default all,\n"
     "forest_10m not with --quick; tb3 needs tb3_world_data: $LASER_RAYCAST_SHARED_DATA, the\n"
@@ -85,9 +88,13 @@ std::vector<std::string> allMethodNames() {
   return names;
 }
 
+// Not a workload of rays: loading each scene's soup as a mesh file (bench_load.h).
+const char* const kLoadWorkload = "load";
+
 std::vector<std::string> workloadNames() {
   std::vector<std::string> names;
   for (const bench::Workload& workload : bench::workloads()) names.push_back(workload.name);
+  names.push_back(kLoadWorkload);
   return names;
 }
 
@@ -225,9 +232,11 @@ void logMemory(const bench::MemoryRow& memory) {
   std::cerr << "\n";
 }
 
-// The rows, and each scene's memory per triangle in *memory (the scenes with meshes).
+// The rows, each scene's memory per triangle in *memory (the scenes with meshes), and the loads of
+// their soups as files in *loads (the large ones, unless --workload leaves load out).
 std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settings& settings,
-                                     std::vector<bench::MemoryRow>* memory) {
+                                     std::vector<bench::MemoryRow>* memory,
+                                     std::vector<bench::LoadRow>* loads) {
   std::vector<bench::Row> rows;
   const std::string shared_dir =
       contains(options.scenes, "tb3") ? bench::findSharedData() : std::string();
@@ -253,6 +262,15 @@ std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settin
     if (scene_memory) {
       logMemory(*scene_memory);
       memory->push_back(*scene_memory);
+    }
+    if (options.workloads.empty() || contains(options.workloads, kLoadWorkload)) {
+      // --quick: the STL only, one round (a smoke test of the row).
+      const std::vector<std::string> formats =
+          options.quick ? std::vector<std::string>{"stl"} : std::vector<std::string>{"stl", "obj"};
+      for (bench::LoadRow& row :
+           bench::measureLoads(*scene, formats, options.quick ? 1 : 3, options.threads)) {
+        loads->push_back(std::move(row));
+      }
     }
     for (const bench::Workload& workload : bench::workloads()) {
       if (!options.workloads.empty() && !contains(options.workloads, workload.name)) continue;
@@ -333,15 +351,20 @@ int run(const Options& options) {
   const std::filesystem::path out(options.out_dir);
   std::filesystem::create_directories(out);
   std::vector<bench::MemoryRow> memory;
-  const std::vector<bench::Row> rows = runBenchmark(options, settings, &memory);
-  if (rows.empty()) throw std::runtime_error("no scene ran");
+  std::vector<bench::LoadRow> loads;
+  const std::vector<bench::Row> rows = runBenchmark(options, settings, &memory, &loads);
+  if (rows.empty() && loads.empty()) throw std::runtime_error("no scene ran");
   const std::string csv = (out / "results.csv").string();
   const std::string md = (out / "results.md").string();
   const std::string png = (out / "pareto.png").string();
   const std::string matrix_png = (out / "pareto_matrix.png").string();
   bench::writeCsv(csv, rows);
-  bench::writeMarkdown(md, rows, memory,
+  bench::writeMarkdown(md, rows, memory, loads,
                        runInfo(options, settings, rows, bench::secondsSince(start)));
+  if (rows.empty()) {  // only loads: nothing to plot
+    std::cerr << "bench: done in " << bench::secondsSince(start) << " s: " << md << "\n";
+    return 0;
+  }
   const std::string plot_error = bench::runPlot(
       plotScript(), {csv, png, "--matrix", matrix_png, "--source", "Run: " + runLabel(options)});
   if (!plot_error.empty()) throw std::runtime_error("plotting failed: " + plot_error);

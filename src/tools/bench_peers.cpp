@@ -8,7 +8,12 @@
 #include <stdexcept>
 
 #ifdef LASER_RAYCAST_HAVE_EMBREE
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
 #include <embree3/rtcore.h>
+
+#include <assimp/Importer.hpp>
+#include <chrono>
 #endif
 #ifdef LASER_RAYCAST_HAVE_BULLET
 #include <BulletCollision/CollisionShapes/btBvhTriangleMeshShape.h>
@@ -222,6 +227,48 @@ std::optional<std::size_t> embreeMeshBytes([[maybe_unused]] const core::Mesh& me
   // of padding that lets Embree read its last vertex with a 16-byte load).
   const EmbreeScene scene(mesh.vertices(), mesh.triangles(), false);
   return static_cast<std::size_t>(monitor.held());
+#else
+  return std::nullopt;
+#endif
+}
+
+std::optional<double> assimpEmbreeLoadSeconds([[maybe_unused]] const std::string& path) {
+#ifdef LASER_RAYCAST_HAVE_EMBREE
+  const auto start = std::chrono::steady_clock::now();
+  Assimp::Importer importer;
+  const aiScene* read =
+      importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                  aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  if (!read) throw std::runtime_error("assimp cannot read " + path + ": " + importer.GetErrorString());
+  RTCDevice device = embreeDevice();
+  const std::unique_ptr<RTCSceneTy, void (*)(RTCScene)> scene(rtcNewScene(device),
+                                                               rtcReleaseScene);
+  for (unsigned m = 0; m < read->mNumMeshes; ++m) {
+    const aiMesh& mesh = *read->mMeshes[m];
+    if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                          mesh.mNumVertices));
+    auto* idx = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(unsigned), mesh.mNumFaces));
+    checkEmbree("rtcSetNewGeometryBuffer");
+    for (unsigned i = 0; i < mesh.mNumVertices; ++i) {
+      v[3 * i] = mesh.mVertices[i].x;
+      v[3 * i + 1] = mesh.mVertices[i].y;
+      v[3 * i + 2] = mesh.mVertices[i].z;
+    }
+    for (unsigned i = 0; i < mesh.mNumFaces; ++i) {
+      for (unsigned k = 0; k < 3; ++k) idx[3 * i + k] = mesh.mFaces[i].mIndices[k];
+    }
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene.get(), geometry);
+    rtcReleaseGeometry(geometry);
+  }
+  rtcCommitScene(scene.get());
+  checkEmbree("building the scene");
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 #else
   return std::nullopt;
 #endif

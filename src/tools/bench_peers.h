@@ -29,6 +29,11 @@ std::string peerVersions();
 // counts them: its BVH with triangle leaves and its vertex and index buffers. Nullopt without
 // Embree. Throws std::runtime_error if Embree reports an error.
 std::optional<std::size_t> embreeMeshBytes(const core::Mesh& mesh);
+// Wall clock seconds for assimp to read the mesh file (with the mesh importer's post-processing)
+// and Embree to build its BVH (default flags, one build thread, its meshes as geometries of one
+// scene, their float vertices copied straight into Embree's buffers). Nullopt without Embree.
+// Throws std::runtime_error if assimp cannot read the file or Embree reports an error.
+std::optional<double> assimpEmbreeLoadSeconds(const std::string& path);
 
 }  // namespace bench
 }  // namespace laser_raycast

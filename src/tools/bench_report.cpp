@@ -13,6 +13,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "bench_methods.h"
+
 namespace laser_raycast {
 namespace bench {
 namespace {
@@ -158,8 +160,44 @@ void writeCsv(const std::string& path, const std::vector<Row>& rows) {
   if (!out) throw std::runtime_error("writing " + path + " failed");
 }
 
+namespace {
+
+// The loads' table of results.md.
+void writeLoadTable(std::ostream& out, const std::vector<LoadRow>& loads) {
+  out << "\n## Loading a mesh file\n\n";
+  out << "Each scene's soup (at least " << kLoadMinTriangles
+      << " triangles) written as one file and loaded as a node's start-up does: ours, the "
+         "loader from nothing to the mesh built (its STL reader or, for other formats, assimp in "
+         "its importer process; the BVHs on `threads` threads); peer, assimp reading the file "
+         "in this process with the importer's post-processing and Embree building its BVH on "
+         "one thread. Wall clock, median of the alternated rounds; vs_peer = the peer's median / "
+         "ours (> 1: faster).\n\n";
+  if (loads.empty()) {
+    out << "No scene run has a soup that large.\n";
+    return;
+  }
+  out << "| scene | format | triangles | file_mb | threads | ours_s | assimp_embree_s | vs_peer "
+         "|\n";
+  out << "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  for (const LoadRow& r : loads) {
+    const double ours = median(r.ours_seconds);
+    out << "| " << r.scene << " | " << r.format << " | " << r.triangles << " | "
+        << format("%.1f", r.file_bytes / 1e6) << " | " << r.threads << " | "
+        << format("%.3g", ours) << " | ";
+    if (r.peer_seconds.empty()) {
+      out << "n/a | n/a |\n";
+    } else {
+      const double peer = median(r.peer_seconds);
+      out << format("%.3g", peer) << " | " << format("%.3g", peer / ours) << " |\n";
+    }
+  }
+}
+
+}  // namespace
+
 void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
-                   const std::vector<MemoryRow>& memory, const std::string& run_info) {
+                   const std::vector<MemoryRow>& memory, const std::vector<LoadRow>& loads,
+                   const std::string& run_info) {
   std::map<std::pair<std::string, std::string>, double> embree;
   for (const Row& r : rows) {
     if (r.method == "embree_default") embree[{r.workload, r.scene}] = r.ns_per_ray;
@@ -189,6 +227,7 @@ void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
     }
   }
   writeMemoryTable(out, memory);
+  writeLoadTable(out, loads);
   if (!out) throw std::runtime_error("writing " + path + " failed");
 }
 

@@ -66,6 +66,19 @@ struct MemoryRow {
   std::optional<std::size_t> embree_bytes;
 };
 
+// Loading one scene's soup written as a mesh file (bench_load.h).
+struct LoadRow {
+  std::string scene, format;  // whose soup the file holds; stl (binary) or obj
+  std::size_t triangles = 0, file_bytes = 0;
+  int threads = 1;  // the loader's BVH build threads (0: every core)
+  // Wall clock of each round, alternated: the loader's (file to built mesh), and assimp's read
+  // plus Embree's build (one build thread), empty without Embree.
+  std::vector<double> ours_seconds, peer_seconds;
+};
+
+// Soups with fewer triangles are not written: either side loads them in well under a second.
+constexpr std::size_t kLoadMinTriangles = 100000;
+
 // The stable header of results.csv.
 extern const char* const kCsvHeader;
 
@@ -74,8 +87,10 @@ void writeCsv(const std::string& path, const std::vector<Row>& rows);
 // workload and scene), after a few lines that say how the run was made (run_info, markdown), then
 // the memory per triangle of each scene that has meshes (Embree's columns only with Embree).
 // Unavailable agreement columns are empty in the CSV and n/a in the table.
+// Then the loads ("Loading a mesh file": medians, and vs_peer, the peer's median over ours).
 void writeMarkdown(const std::string& path, const std::vector<Row>& rows,
-                   const std::vector<MemoryRow>& memory, const std::string& run_info);
+                   const std::vector<MemoryRow>& memory, const std::vector<LoadRow>& loads,
+                   const std::string& run_info);
 
 // Runs /usr/bin/python3 script args... Returns "" on success, else what went wrong.
 std::string runPlot(const std::string& script, const std::vector<std::string>& args);

@@ -206,11 +206,14 @@ void expectAgreementFields(const std::string& fraction_text, const std::string& 
 // results.md's memory table: a row for each scene with meshes (the analytic sphere and box room
 // have none), whose figures are positive and consistent: at least a slot's 36 bytes and a
 // triangle's indices per triangle, and the ratio the two columns give.
-void expectMemoryTable(const std::string& md, bool has_embree) {
-  const std::size_t start = md.find("## Memory per triangle");
-  ASSERT_NE(start, std::string::npos) << md;
-  std::set<std::string> scenes;
-  for (const std::string& line : splitLines(md.substr(start))) {
+// The rows of results.md's table under `heading` (up to the next heading), each split into its
+// cells.
+std::vector<std::vector<std::string>> tableRows(const std::string& md, const std::string& heading) {
+  const std::size_t start = md.find(heading);
+  if (start == std::string::npos) return {};
+  const std::size_t end = md.find("\n## ", start + heading.size());
+  std::vector<std::vector<std::string>> rows;
+  for (const std::string& line : splitLines(md.substr(start, end - start))) {
     if (line.rfind("| ", 0) != 0 || line.rfind("| scene", 0) == 0 || line.rfind("| ---", 0) == 0) {
       continue;  // not a row, the header, or the rule under it
     }
@@ -220,6 +223,16 @@ void expectMemoryTable(const std::string& md, bool has_embree) {
       const auto first = cell.find_first_not_of(' '), last = cell.find_last_not_of(' ');
       f.push_back(first == std::string::npos ? "" : cell.substr(first, last - first + 1));
     }
+    rows.push_back(f);
+  }
+  return rows;
+}
+
+void expectMemoryTable(const std::string& md, bool has_embree) {
+  ASSERT_NE(md.find("## Memory per triangle"), std::string::npos) << md;
+  std::set<std::string> scenes;
+  for (const std::vector<std::string>& f : tableRows(md, "## Memory per triangle")) {
+    const std::string line = ::testing::PrintToString(f);
     ASSERT_EQ(f.size(), has_embree ? 5u : 3u) << line;
     scenes.insert(f[0]);
     long triangles = 0;
@@ -234,6 +247,38 @@ void expectMemoryTable(const std::string& md, bool has_embree) {
   }
   scenes.erase("tb3");  // where its data is
   EXPECT_EQ(scenes, (std::set<std::string>{"million", "vertex_rows", "forest", "warehouse"}));
+}
+
+// results.md's load table (--quick: binary STL, one thread): a row for each scene whose soup has
+// at least 100000 triangles, the file's size that of a binary STL of them (84 + 50 bytes a
+// triangle), positive times, and the ratio the two columns give.
+void expectLoadTable(const std::string& md, bool has_embree) {
+  ASSERT_NE(md.find("## Loading a mesh file"), std::string::npos) << md;
+  std::set<std::string> scenes;
+  for (const std::vector<std::string>& f : tableRows(md, "## Loading a mesh file")) {
+    const std::string line = ::testing::PrintToString(f);
+    ASSERT_EQ(f.size(), 8u) << line;
+    scenes.insert(f[0]);
+    EXPECT_EQ(f[1], "stl") << line;
+    long triangles = 0, threads = 0;
+    double mb = 0, ours = 0;
+    ASSERT_TRUE(parseCount(f[2], &triangles) && triangles >= 100000) << line;
+    EXPECT_TRUE(parseDouble(f[3], &mb)) << line;
+    EXPECT_NEAR(mb, (84 + 50.0 * triangles) / 1e6, 0.051) << line;
+    EXPECT_TRUE(parseCount(f[4], &threads) && threads == 1) << line;
+    EXPECT_TRUE(parseDouble(f[5], &ours) && ours > 0) << line;
+    if (!has_embree) {
+      EXPECT_EQ(f[6], "n/a") << line;
+      continue;
+    }
+    double peer = 0, ratio = 0;
+    EXPECT_TRUE(parseDouble(f[6], &peer) && peer > 0) << line;
+    EXPECT_TRUE(parseDouble(f[7], &ratio)) << line;
+    EXPECT_NEAR(ratio, peer / ours, 0.01 * ratio + 0.005) << line;
+  }
+  // The soups of a million triangles and more (sphere's, box_room's and vertex_rows' are smaller).
+  scenes.erase("tb3");  // where its data is
+  EXPECT_EQ(scenes, (std::set<std::string>{"million", "forest", "warehouse"}));
 }
 
 TEST(BenchSmoke, QuickRunWritesEveryRow) {
@@ -298,6 +343,7 @@ TEST(BenchSmoke, QuickRunWritesEveryRow) {
   expectMovingRatios(lines, has_robust);
 
   expectMemoryTable(readFile(dir + "/results.md"), has_robust);
+  expectLoadTable(readFile(dir + "/results.md"), has_robust);
   for (const std::string name : {"pareto.png", "pareto_matrix.png"}) {
     const std::string png = readFile(dir + "/" + name);
     ASSERT_GT(png.size(), 8u) << name;
