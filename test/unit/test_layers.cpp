@@ -460,14 +460,18 @@ TEST(Layers, TheCoreLibraryLinksNothingFromRosOrTheLoader) {
 
 // The tools depend directly only on what they use: the core, the loader, the kinematics and their
 // own libraries (program_options, the bench's peers). The loader's libraries (urdfdom, assimp,
-// roslib, KDL) reach them only through it, so the package:// resolver stays the loader's.
+// roslib, KDL) reach them only through it, so the package:// resolver stays the loader's. One
+// exception: the bench's load row times assimp itself as a peer (assimp reading a mesh file, then
+// Embree's build), so the bench may link assimp; it never resolves a URI with it.
 TEST(Layers, TheToolsDependDirectlyOnlyOnWhatTheyUse) {
   static const std::regex kForbidden(
       "^lib(ros|urdf|assimp|console_bridge|tinyxml|orocos|python|tf2|message|xmlrpc|cpp_common)");
+  static const std::regex kAssimp("^libassimp");
   for (const std::string tool : {CAST_SCAN_PATH, BENCH_PATH}) {
     const std::vector<std::string> needed = neededLibraries(tool);
     for (const std::string& library : needed) {
-      EXPECT_FALSE(std::regex_search(library, kForbidden)) << tool << " links " << library;
+      const bool peer = tool == std::string(BENCH_PATH) && std::regex_search(library, kAssimp);
+      EXPECT_FALSE(std::regex_search(library, kForbidden) && !peer) << tool << " links " << library;
     }
     for (const std::string used : {"liblaser_raycast_core.so", "liblaser_raycast_scene_loader.so",
                                    "liblaser_raycast_kinematics.so"}) {
