@@ -46,15 +46,16 @@ const char* const kNotes =
     "beam's error against a long double reference and its agreement with Embree's robust\n"
     "mode. load: each scene's soup of at least 100000 triangles written as a mesh file (STL,\n"
     "and OBJ without --quick) and loaded as the node does, against assimp reading it and\n"
-    "Embree building its BVH. Writes DIR/results.csv, results.md, pareto.png (one point per method) and\n"
-    "pareto_matrix.png (every workload and scene) (DIR defaults to bench_results). Scenes:\n"
+    "Embree building its BVH. Writes DIR/results.csv, results.md, pareto.png (one point per\n"
+    "method) and pareto_matrix.png (every workload and scene) (DIR defaults to\n"
+    "bench_results). Scenes:\n"
     "sphere box_room tb3 million vertex_rows forest warehouse forest_10m (default all,\n"
     "forest_10m not with --quick; tb3 needs tb3_world_data: $LASER_RAYCAST_SHARED_DATA, the\n"
     "ROS package, or ../shared/data beside the source). --workload: only these workloads\n"
     "(default all). --method: only these rows (default\n"
-    "all; --list-methods names them). --quick: fewer poses, scans and repetitions (a few\n"
-    "minutes). --threads N: a second pipeline row cast with N threads (0: every core); every\n"
-    "other row is single-threaded.\n"
+    "all; --list-methods names them). --quick: fewer poses, scans and repetitions (14\n"
+    "minutes on 2 cores). --threads N: a second pipeline row cast with N threads (0: every\n"
+    "core); every other row is single-threaded.\n"
     "Exit status: 0 ok, 1 the run failed, 2 bad arguments.\n";
 
 struct Options {
