@@ -99,6 +99,7 @@ const std::map<std::string, std::string>& publicHeaderLayers() {
       {"primitives.h", "geometry"},
       {"pose.h", "geometry"},
       {"bvh.h", "accel"},
+      {"bvh_config.h", "accel"},
       {"mesh.h", "scene"},
       {"scene.h", "scene"},
       {"pose_samples.h", "scene"},

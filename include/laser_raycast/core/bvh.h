@@ -13,23 +13,13 @@
 #include <vector>
 
 #include "laser_raycast/core/aabb.h"
+#include "laser_raycast/core/bvh_config.h"
 #include "laser_raycast/core/triangle.h"
 
 namespace laser_raycast {
 namespace core {
 
 using TriangleIndices = std::array<std::uint32_t, 3>;
-
-struct BvhConfig {
-  int max_leaf_size = 8;        // a node with more triangles is always split
-  int bins = 16;                // SAH candidate planes per axis, minus one
-  double traversal_cost = 1.0;  // cost of visiting a node, in units of one triangle test
-  int max_depth = 60;           // deeper nodes become leaves; bounds the traversal stack (64)
-  int threads = 1;              // building the tree (0: every core); the same tree for any number
-
-  // Throws std::invalid_argument naming the field and its value.
-  void validate() const;
-};
 
 // x rounded to float, kept a float: GCC 12's SLP vectorizer folds a double taken to float and back
 // into the double itself (at -O2, a vectorised (double)(float)x gave x unrounded); the empty asm
