@@ -104,6 +104,10 @@ class Slicer {
     if (!plane_.crossing(v, &p, &q)) return;
     testSegment(p, q, slot, first, last, std::forward<Hit>(hit), std::forward<Open>(open));
   }
+  // Where the triangle in `slot` meets the one beam `beam` with t in [tmin, tmax], into *t: the
+  // test sliceSlot makes for that beam, without finding which beams the segment can reach (for a
+  // beam traced on its own, that costs more than the test).
+  bool sliceBeam(std::uint32_t slot, int beam, double* t) const;
   // The same for a segment given in plane coordinates (a cached slice's): the triangle in `slot`
   // crosses the plane there.
   template <class Hit, class Open>
@@ -243,6 +247,18 @@ void Slicer::testSegment(const Eigen::Vector2d& plane_p, const Eigen::Vector2d& 
   testSegmentInFan(fan_, plane_.toSensor(plane_p), plane_.toSensor(plane_q), tmin_, tmax_,
                    cull_backfaces_ ? &front : nullptr, first, last, std::forward<Hit>(hit),
                    std::forward<Open>(open));
+}
+
+inline bool Slicer::sliceBeam(std::uint32_t slot, int beam, double* t) const {
+  Eigen::Vector3d v[3];
+  frameTriangle(slot, v);
+  Eigen::Vector2d p, q;
+  if (!plane_.crossing(v, &p, &q) || p == q) return false;
+  Eigen::Vector2d front;
+  if (cull_backfaces_) front = planarFront(rot_, mesh_.bvh().triangleVertices()[slot]);
+  const Eigen::Vector3d& dir = fan_.directions()[beam];
+  return beamCrossesSegment(dir.x(), dir.y(), plane_.toSensor(p), plane_.toSensor(q), tmin_,
+                            tmax_, cull_backfaces_ ? &front : nullptr, t);
 }
 
 }  // namespace core

@@ -313,15 +313,11 @@ class MeshWalk {
 
   // The slot's segment in the scan plane against one beam, as slicing tests it.
   void sliceOne(std::uint32_t slot, int col, double* tmax, Best* best) const {
-    slicer_->sliceSlot(
-        slot, col, col,
-        [&](int, double t) {
-          if (t <= *tmax && best->improves(t, ids_[slot])) {
-            *best = Best{t, ids_[slot], slot};
-            *tmax = t;
-          }
-        },
-        [&](int, double segment_near) { return segment_near <= *tmax; });
+    double t;
+    if (slicer_->sliceBeam(slot, col, &t) && t <= *tmax && best->improves(t, ids_[slot])) {
+      *best = Best{t, ids_[slot], slot};
+      *tmax = t;
+    }
   }
 
   // A few beams against each triangle of a leaf, directly.
