@@ -245,41 +245,85 @@ class MeshWalk {
     return rayAlong(row, col, beams_.grid().rebuiltDirection(row, col));
   }
 
-  // Each open beam of the rect through the node's subtree, one ray at a time.
-  void traceRect(const Entry& e) {
-    // One ray through the node's subtree, its boxes entered as box_ray, each triangle tested
-    // exactly as ray: its nearest hit into best.
-    auto trace = [&](const PreparedRay<double, M>& ray, const WideBoxRay& box_ray, double tmax,
-                     Best* best) {
-      traceWide(wide_, e.ref, box_ray, &tmax, [&](std::uint32_t slot) {
-        if (!hidden(slot)) testSlot(ray, slot, &tmax, best);
-      });
+  // A beam traced on its own through a subtree: its rays, its far limit and its nearest hit.
+  struct Traced {
+    int row, col;
+    double tmax;
+    Best best;
+    WideBoxRay box_ray;
+    std::optional<PreparedRay<double, M>> ray;  // for the 3D tests (not when slicing)
+  };
+
+  // What a traced beam does with each triangle slot of a leaf it enters: its segment in the scan
+  // plane (slicing), or the exact 3D test.
+  auto leafOf(Traced* b) {
+    return [this, b](std::uint32_t slot) {
+      if (hidden(slot)) return;
+      if (slicing_) {
+        sliceOne(slot, b->col, &b->tmax, &b->best);
+      } else {
+        testSlot(*b->ray, slot, &b->tmax, &b->best);
+      }
     };
+  }
+
+  // Each open beam of the rect through the node's subtree, two at a time (their walks side by
+  // side, traceWidePair: the same visits and tests as one at a time); a bundle's sub-rays one at a
+  // time.
+  void traceRect(const Entry& e) {
+    if (bundle_) {
+      traceSubRays(e);
+      return;
+    }
+    Traced pair[2];
+    int n = 0;
     for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
         if (!(range >= e.near)) continue;  // a hit nearer than this node can be
-        if (bundle_) {
-          // Each sub-ray traced on its own: the boxes it enters are its own.
-          for (int s = beams_.subBegin(row, col), end = beams_.subEnd(row, col); s < end; ++s) {
-            const double sub_tmax = std::min(config_.tmax, beams_.subRange(s));
-            if (!(sub_tmax >= e.near)) continue;
-            Best sub_best;
-            trace(subRay(s, row, col), subBoxRay(s, row, col), sub_tmax, &sub_best);
-            if (sub_best.found()) offerSub(s, row, col, sub_best);
-          }
-          continue;
+        Traced& b = pair[n++];
+        b.row = row;
+        b.col = col;
+        b.tmax = std::min(config_.tmax, range);
+        b.best = Best{};
+        b.box_ray = boxRay(row, col);
+        if (!slicing_) b.ray.emplace(beamRay(row, col));
+        if (n == 2) {
+          traceWidePair(wide_, e.ref, pair[0].box_ray, &pair[0].tmax, leafOf(&pair[0]),
+                        pair[1].box_ray, &pair[1].tmax, leafOf(&pair[1]));
+          finish(pair[0]);
+          finish(pair[1]);
+          n = 0;
         }
-        Best best;
-        if (slicing_) {
-          double tmax = std::min(config_.tmax, range);
-          traceWide(wide_, e.ref, boxRay(row, col), &tmax, [&](std::uint32_t slot) {
-            if (!hidden(slot)) sliceOne(slot, col, &tmax, &best);
+      }
+    }
+    if (n == 1) {
+      traceWide(wide_, e.ref, pair[0].box_ray, &pair[0].tmax, leafOf(&pair[0]));
+      finish(pair[0]);
+    }
+  }
+
+  void finish(const Traced& b) {
+    if (b.best.found()) offer(b.row, b.col, b.best);
+  }
+
+  // Each open beam's sub-rays (a bundle's) through the node's subtree, one ray at a time: the
+  // boxes each enters are its own.
+  void traceSubRays(const Entry& e) {
+    for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
+      for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
+        const double range = beams_.range(row, col);
+        if (!(range >= e.near)) continue;
+        for (int s = beams_.subBegin(row, col), end = beams_.subEnd(row, col); s < end; ++s) {
+          double tmax = std::min(config_.tmax, beams_.subRange(s));
+          if (!(tmax >= e.near)) continue;
+          Best best;
+          const PreparedRay<double, M> ray = subRay(s, row, col);
+          traceWide(wide_, e.ref, subBoxRay(s, row, col), &tmax, [&](std::uint32_t slot) {
+            if (!hidden(slot)) testSlot(ray, slot, &tmax, &best);
           });
-        } else {
-          trace(beamRay(row, col), boxRay(row, col), std::min(config_.tmax, range), &best);
+          if (best.found()) offerSub(s, row, col, best);
         }
-        if (best.found()) offer(row, col, best);
       }
     }
   }
