@@ -1,7 +1,9 @@
 #include "walk/mesh_walk.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 
 #include "beams/column_motion.h"
@@ -167,9 +169,22 @@ class MeshWalk {
     const Eigen::Isometry3d& pose = motion_->refFromBeam(row, col);
     const Eigen::Vector3d dir = active_.body_from_sensor_rot * (pose.linear() * d);
     if (spread_.shift == 0) return WideBoxRay(origin_, dir);
-    const Eigen::Vector3d o =
-        active_.body_from_sensor_rot * pose.translation() + active_.sensor_in_body;
-    return WideBoxRay(WideBoxRay::Origin(o, mesh_.bvh().bounds(), config_.tmin), dir);
+    return WideBoxRay(originOf(pose), dir);
+  }
+
+  // Where the beams leaving from a sweep's pose start, for box tests in the body's frame: the same
+  // for every beam from that pose, so the last few are kept, by the pose's address (the block's
+  // poses stay where they are for the walk).
+  const WideBoxRay::Origin& originOf(const Eigen::Isometry3d& pose) const {
+    const auto key = reinterpret_cast<std::uintptr_t>(&pose);
+    KeptOrigin& kept = origins_[(key / sizeof(Eigen::Isometry3d)) % origins_.size()];
+    if (kept.pose != &pose) {
+      kept.pose = &pose;
+      const Eigen::Vector3d o =
+          active_.body_from_sensor_rot * pose.translation() + active_.sensor_in_body;
+      kept.origin.emplace(o, mesh_.bvh().bounds(), config_.tmin);
+    }
+    return *kept.origin;
   }
 
   // A triangle slot moved into the sensor frame. Every 3D test of this body's triangles is the
@@ -523,6 +538,11 @@ class MeshWalk {
   bool closed_;  // the mesh has closed components
   const ViewBasis basis_;
   const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame
+  struct KeptOrigin {
+    const Eigen::Isometry3d* pose = nullptr;
+    std::optional<WideBoxRay::Origin> origin;
+  };
+  mutable std::array<KeptOrigin, 64> origins_;  // originOf()'s last ones
   std::optional<Slicer> slicer_;
   WalkStack<Entry> stack_;
 };
