@@ -15,6 +15,7 @@
 #include "beams/beam_window.h"
 #include "laser_raycast/core/ray.h"
 #include "laser_raycast/core/scan_pattern.h"
+#include "laser_raycast/core/triangle.h"
 
 namespace laser_raycast {
 namespace core {
@@ -56,7 +57,7 @@ class ColumnMotion {
   bool translationsOnly() const { return translations_only_; }
 
   // The pose the beam at (row, col) leaves from: its column's, or its row's class's.
-  const Eigen::Isometry3d& refFromBeam(int row, int col) const {
+  LASER_RAYCAST_HOT_INLINE const Eigen::Isometry3d& refFromBeam(int row, int col) const {
     if (class_of_row_.empty() || class_of_row_[row] == 0) return refFromColumn(col);
     return ref_from_class_[class_of_row_[row] - 1][col - col_lo_];
   }
@@ -68,7 +69,8 @@ class ColumnMotion {
     return rayFrom(refFromColumn(col), d, tmin);
   }
   // Beam d at (row, col), from its row's class's pose.
-  Ray ray(int row, int col, const Eigen::Vector3d& d, double tmin) const {
+  LASER_RAYCAST_HOT_INLINE Ray ray(int row, int col, const Eigen::Vector3d& d,
+                                   double tmin) const {
     return rayFrom(refFromBeam(row, col), d, tmin);
   }
   // A unit normal in the reference sensor frame as column col's sensor frame has it (the frame
@@ -99,7 +101,8 @@ class ColumnMotion {
   int col_lo_;
   std::vector<Eigen::Isometry3d> ref_from_column_;
   Spread spread_;
-  Ray rayFrom(const Eigen::Isometry3d& m, const Eigen::Vector3d& d, double tmin) const {
+  LASER_RAYCAST_HOT_INLINE Ray rayFrom(const Eigen::Isometry3d& m, const Eigen::Vector3d& d,
+                                       double tmin) const {
     Ray r;
     r.origin = m.translation();
     // Turning by the identity gives d's bits: skipped where no column turns.

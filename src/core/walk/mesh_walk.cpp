@@ -248,7 +248,8 @@ class MeshWalk {
   }
   // The beam at (row, col) along sensor-frame direction d for the triangle tests: from the
   // sensor, or for a sweep's block from the beam's pose, in the reference sensor frame.
-  PreparedRay<double, M> rayAlong(int row, int col, const Eigen::Vector3d& d) const {
+  LASER_RAYCAST_HOT_INLINE PreparedRay<double, M> rayAlong(int row, int col,
+                                                            const Eigen::Vector3d& d) const {
     Ray ray{Eigen::Vector3d::Zero(), d, config_.tmin};
     if (motion_) ray = motion_->ray(row, col, d, config_.tmin);
     return PreparedRay<double, M>(ray, config_.cull_backfaces);
