@@ -31,7 +31,8 @@ void PoseSamples::validate(const Scene& scene) const {
     msg << "PoseSamples: " << times.size() << " times but " << world_from_sensor.size()
         << " sensor poses and " << frames.size() << " frame pose sets";
   } else {
-    for (std::size_t i = 0; i < times.size() && msg.str().empty(); ++i) {
+    // tellp(), not str(): str() copies the message at every sample.
+    for (std::size_t i = 0; i < times.size() && msg.tellp() == 0; ++i) {
       if (!std::isfinite(times[i])) {
         msg << "PoseSamples: time " << i << " is not finite (" << times[i] << ")";
       } else if (i > 0 && !(times[i] > times[i - 1])) {
