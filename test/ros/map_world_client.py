@@ -126,8 +126,15 @@ class MapWorld(unittest.TestCase):
         # The node's beams: samples 720 from angle_min to angle_max (its parameters).
         node = rospy.get_param('/laser_raycast/sensors')[0]
         samples = int(node['samples'])
-        scan = scans.after(rospy.Time(0), timeout=60)
-        self.assertIsNotNone(scan, 'no scan on /scan')
+        first = scans.after(rospy.Time(0), timeout=60)
+        self.assertIsNotNone(first, 'no scan on /scan')
+        # A scan stamped before this listener heard its first transform cannot be looked up (the
+        # node may have been scanning for a while): start from one stamped after the buffer has
+        # the laser's pose.
+        self.assertTrue(tf.can_transform('map', first.header.frame_id, rospy.Time(0),
+                                         rospy.Duration(10)), 'no transform map -> laser')
+        scan = scans.after(rospy.Time.now(), timeout=60)
+        self.assertIsNotNone(scan, 'no scan on /scan after the transforms came')
         for k in range(SCANS):
             self.assertEqual(len(scan.ranges), samples)
             laser = tf.lookup_transform('map', scan.header.frame_id, scan.header.stamp,
