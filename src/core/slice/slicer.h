@@ -98,10 +98,8 @@ class Slicer {
   }
   template <class Hit, class Open>
   void sliceSlot(std::uint32_t slot, int first, int last, Hit&& hit, Open&& open) const {
-    Eigen::Vector3d v[3];
-    frameTriangle(slot, v);
     Eigen::Vector2d p, q;
-    if (!plane_.crossing(v, &p, &q)) return;
+    if (!cut(slot, &p, &q)) return;
     testSegment(p, q, slot, first, last, std::forward<Hit>(hit), std::forward<Open>(open));
   }
   // Where the triangle in `slot` meets the one beam `beam` with t in [tmin, tmax], into *t: the
@@ -122,6 +120,21 @@ class Slicer {
   }
 
  private:
+  // Where the triangle in `slot`, moved into the frame, crosses the plane (plane coordinates);
+  // false if it does not.
+  bool cut(std::uint32_t slot, Eigen::Vector2d* p, Eigen::Vector2d* q) const {
+    Eigen::Vector3d v[3];
+    frameTriangle(slot, v);
+    return plane_.crossing(v, p, q);
+  }
+  // The triangle's front normal's sensor x, y into *front, which is returned, where back faces are
+  // culled; else null.
+  const Eigen::Vector2d* frontOf(std::uint32_t slot, Eigen::Vector2d* front) const {
+    if (!cull_backfaces_) return nullptr;
+    *front = planarFront(rot_, mesh_.bvh().triangleVertices()[slot]);
+    return front;
+  }
+
   const Mesh& mesh_;
   const ScanPattern& fan_;
   Eigen::Matrix3d rot_;
@@ -241,24 +254,19 @@ void Slicer::testSegment(const Eigen::Vector2d& plane_p, const Eigen::Vector2d& 
                               std::uint32_t slot, int first, int last, Hit&& hit,
                               Open&& open) const {
   Eigen::Vector2d front;
-  if (cull_backfaces_) {
-    front = planarFront(rot_, mesh_.bvh().triangleVertices()[slot]);
-  }
   testSegmentInFan(fan_, plane_.toSensor(plane_p), plane_.toSensor(plane_q), tmin_, tmax_,
-                   cull_backfaces_ ? &front : nullptr, first, last, std::forward<Hit>(hit),
+                   frontOf(slot, &front), first, last, std::forward<Hit>(hit),
                    std::forward<Open>(open));
 }
 
 inline bool Slicer::sliceBeam(std::uint32_t slot, int beam, double* t) const {
-  Eigen::Vector3d v[3];
-  frameTriangle(slot, v);
   Eigen::Vector2d p, q;
-  if (!plane_.crossing(v, &p, &q) || p == q) return false;
+  // p == q: the triangle touches the plane at a vertex, which no beam crosses (forSegmentColumns).
+  if (!cut(slot, &p, &q) || p == q) return false;
   Eigen::Vector2d front;
-  if (cull_backfaces_) front = planarFront(rot_, mesh_.bvh().triangleVertices()[slot]);
   const Eigen::Vector3d& dir = fan_.directions()[beam];
   return beamCrossesSegment(dir.x(), dir.y(), plane_.toSensor(p), plane_.toSensor(q), tmin_,
-                            tmax_, cull_backfaces_ ? &front : nullptr, t);
+                            tmax_, frontOf(slot, &front), t);
 }
 
 }  // namespace core
