@@ -53,7 +53,7 @@ const char* const kNotes =
     "forest_10m not with --quick; tb3 needs tb3_world_data: $LASER_RAYCAST_SHARED_DATA, the\n"
     "ROS package, or ../shared/data beside the source). --workload: only these workloads\n"
     "(default all). --method: only these rows (default\n"
-    "all; --list-methods names them). --quick: fewer poses, scans and repetitions (14\n"
+    "all; --list-methods names them). --quick: fewer poses, scans and repetitions (6\n"
     "minutes on 2 cores). --threads N: a second pipeline row cast with N threads (0: every\n"
     "core); every other row is single-threaded.\n"
     "Exit status: 0 ok, 1 the run failed, 2 bad arguments.\n";

@@ -4,7 +4,7 @@
 // the production rows (watertight_bvh, pipeline) neither leak nor hit what is not there, that the
 // agreement columns compare beam for beam (embree_robust agrees with itself on every beam), and
 // that --method keeps only the rows asked for. Never timings: the machine may be busy. The quick
-// run takes about 2.5 minutes on an idle core; catkin ignores a gtest TIMEOUT, so the command
+// run takes about 6 minutes on an idle core; catkin ignores a gtest TIMEOUT, so the command
 // itself is bounded by timeout(1) at 15 minutes.
 #include <gtest/gtest.h>
 #include <unistd.h>
