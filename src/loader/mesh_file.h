@@ -3,6 +3,9 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -20,6 +23,15 @@ namespace mesh_file {
 // an error. Throws SceneLoadError with the problem; the caller names the URI.
 std::string resolveUri(const std::string& uri, const std::string& base_dir,
                        const PackageResolver& resolver);
+
+// The path's extension in lower case (".stl" for "a/B.STL"): assimp chooses its importer by it, in
+// any case, and so do the loader's own readers.
+inline std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
 
 // A mesh file's triangles (import_process.h reads them), in link-local coordinates.
 struct MeshData {

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <assimp/Importer.hpp>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -80,10 +79,7 @@ bool isCollada(const aiScene& scene, const std::string& path) {
   if (scene.mMetaData && scene.mMetaData->Get("SourceAsset_Format", format)) {
     return std::string(format.C_Str()).find("Collada") != std::string::npos;
   }
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  return ext == ".dae";
+  return lowerExtension(path) == ".dae";
 }
 
 // The Collada <asset><unit meter="..."/>, read from the file as RViz does: assimp puts it into the

@@ -1,5 +1,6 @@
 // laser_raycast_mesh_import: reads mesh files for the scene loader (STL with the loader's own
-// streaming reader, stl_reader.h; every other format with assimp), under the bounds it is given: a
+// streaming reader, stl_reader.h; OBJ of plain triangles with obj_reader.h; every other format and
+// OBJ that is more than that with assimp), under the bounds it is given: a
 // request (a file and a scale) on standard input, the triangles or why not on standard output
 // (import_protocol.h), until the input ends. The loader runs it as a child process
 // (import_process.cpp says why); it is not meant to be run by hand.
@@ -19,10 +20,12 @@
 #include <exception>
 #include <iostream>
 #include <new>
+#include <optional>
 #include <string>
 
 #include "import_protocol.h"
 #include "mesh_import.h"
+#include "obj_reader.h"
 #include "stl_reader.h"
 
 namespace {
@@ -95,9 +98,15 @@ bool serve(const std::string& path, const Eigen::Vector3d& scale) {
   using laser_raycast::import_protocol::writeFailure;
   try {
     namespace mesh_file = laser_raycast::mesh_file;
-    const mesh_file::MeshData mesh = mesh_file::isStlPath(path)
-                                         ? mesh_file::readStl(path, scale)
-                                         : mesh_file::importMeshInProcess(path, scale);
+    const auto read = [&]() -> mesh_file::MeshData {
+      if (mesh_file::isStlPath(path)) return mesh_file::readStl(path, scale);
+      if (mesh_file::isObjPath(path)) {
+        std::optional<mesh_file::MeshData> plain = mesh_file::readPlainObj(path, scale);
+        if (plain) return std::move(*plain);
+      }
+      return mesh_file::importMeshInProcess(path, scale);
+    };
+    const mesh_file::MeshData mesh = read();
     return laser_raycast::import_protocol::writeMesh(STDOUT_FILENO, mesh);
   } catch (const laser_raycast::SceneLoadError& e) {
     return writeFailure(STDOUT_FILENO, Status::kError, e.what());
