@@ -26,6 +26,7 @@
 #include "import_protocol.h"
 #include "mesh_import.h"
 #include "obj_reader.h"
+#include "ply_reader.h"
 #include "stl_reader.h"
 
 namespace {
@@ -102,6 +103,10 @@ bool serve(const std::string& path, const Eigen::Vector3d& scale) {
       if (mesh_file::isStlPath(path)) return mesh_file::readStl(path, scale);
       if (mesh_file::isObjPath(path)) {
         std::optional<mesh_file::MeshData> plain = mesh_file::readPlainObj(path, scale);
+        if (plain) return std::move(*plain);
+      }
+      if (mesh_file::isPlyPath(path)) {
+        std::optional<mesh_file::MeshData> plain = mesh_file::readPlainPly(path, scale);
         if (plain) return std::move(*plain);
       }
       return mesh_file::importMeshInProcess(path, scale);

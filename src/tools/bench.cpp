@@ -45,7 +45,7 @@ const char* const kNotes =
     "sweep_os1_64_metadata), and measures each\n"
     "beam's error against a long double reference and its agreement with Embree's robust\n"
     "mode. load: each scene's soup of at least 100000 triangles written as a mesh file (STL,\n"
-    "and OBJ without --quick) and loaded as the node does, against assimp reading it and\n"
+    "and OBJ and PLY without --quick) and loaded as the node does, against assimp reading it and\n"
     "Embree building its BVH. Writes DIR/results.csv, results.md, pareto.png (one point per\n"
     "method) and pareto_matrix.png (every workload and scene) (DIR defaults to\n"
     "bench_results). Scenes:\n"
@@ -267,7 +267,8 @@ std::vector<bench::Row> runBenchmark(const Options& options, const bench::Settin
     if (options.workloads.empty() || contains(options.workloads, kLoadWorkload)) {
       // --quick: the STL only, one round (a smoke test of the row).
       const std::vector<std::string> formats =
-          options.quick ? std::vector<std::string>{"stl"} : std::vector<std::string>{"stl", "obj"};
+          options.quick ? std::vector<std::string>{"stl"}
+                        : std::vector<std::string>{"stl", "obj", "ply"};
       for (bench::LoadRow& row :
            bench::measureLoads(*scene, formats, options.quick ? 1 : 3, options.threads)) {
         loads->push_back(std::move(row));

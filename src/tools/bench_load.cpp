@@ -56,6 +56,29 @@ void writeObj(const MeshData& soup, const std::string& path) {
   if (!out) throw std::runtime_error("writing " + path + " failed");
 }
 
+// The soup as a binary little-endian PLY: its vertices in float, faces of three int indices.
+void writePly(const MeshData& soup, const std::string& path) {
+  std::ofstream out(path, std::ios::binary);
+  out << "ply\nformat binary_little_endian 1.0\ncomment laser_raycast bench\nelement vertex "
+      << soup.vertices.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << "element face " << soup.triangles.size()
+      << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const Eigen::Vector3d& v : soup.vertices) {
+    const float xyz[3] = {static_cast<float>(v.x()), static_cast<float>(v.y()),
+                          static_cast<float>(v.z())};
+    out.write(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  }
+  char face[13] = {3};
+  for (const core::TriangleIndices& tri : soup.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const auto index = static_cast<std::int32_t>(tri[k]);
+      std::memcpy(face + 1 + 4 * k, &index, 4);
+    }
+    out.write(face, sizeof face);
+  }
+  if (!out) throw std::runtime_error("writing " + path + " failed");
+}
+
 // The loader's time from nothing to the mesh built, as a node's start-up spends it (its importer
 // process started, the file read, the BVHs built).
 double loaderSeconds(const std::string& path, int threads) {
@@ -82,6 +105,8 @@ std::vector<LoadRow> measureLoads(const BenchScene& scene, const std::vector<std
       const std::string path = (dir / (scene.name + "." + format)).string();
       if (format == "stl") {
         writeStl(scene.soup, path);
+      } else if (format == "ply") {
+        writePly(scene.soup, path);
       } else {
         writeObj(scene.soup, path);
       }

@@ -167,8 +167,9 @@ void writeLoadTable(std::ostream& out, const std::vector<LoadRow>& loads) {
   out << "\n## Loading a mesh file\n\n";
   out << "Each scene's soup (at least " << kLoadMinTriangles
       << " triangles) written as one file and loaded as a node's start-up does: ours, the "
-         "loader from nothing to the mesh built (its STL reader or, for other formats, assimp in "
-         "its importer process; the BVHs on `threads` threads); peer, assimp reading the file "
+         "loader from nothing to the mesh built (its own readers of STL and of plain OBJ and "
+         "binary PLY, assimp for anything else, in its importer process; the BVHs on `threads` "
+         "threads); peer, assimp reading the file "
          "in this process with the importer's post-processing and Embree building its BVH on "
          "one thread. Wall clock, median of the alternated rounds; vs_peer = the peer's median / "
          "ours (> 1: faster).\n\n";
