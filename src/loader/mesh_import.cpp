@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <sstream>
 #include <utility>
@@ -130,6 +131,7 @@ Eigen::Affine3d toAffine(const aiNode& node) {
 struct SurfaceCollector {
   core::SurfaceAttributes surface;
   bool all_colors = true, all_normals = true, any_uvs = false;
+  bool file_materials = true;  // false: the file has none (assimp's materials are its own)
   std::vector<int> material_slot;  // assimp material index -> index in surface.materials, -1: none
 };
 
@@ -165,6 +167,23 @@ std::shared_ptr<const core::Texture> readTexture(const std::string& mesh_path,
   }
 }
 
+// Whether a PLY file's header declares a material element. assimp's PLY importer gives a file
+// without one a white material of its own, on every face: the file says nothing of its surface's
+// colour, so that is no material (the URDF's colour or default_reflectivity applies).
+bool plyHasMaterials(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  // The header ends at end_header; a binary body after it is not read.
+  for (int lines = 0; lines < 4096 && std::getline(in, line); ++lines) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line == "end_header") return false;
+    std::istringstream words(line);
+    std::string keyword, element;
+    if (words >> keyword >> element && keyword == "element" && element == "material") return true;
+  }
+  return false;
+}
+
 // The index in surface.materials of assimp's material m, added at its first use; -1 for assimp's
 // default material (the file named none).
 int materialSlot(const aiScene& scene, unsigned m, const std::string& path,
@@ -175,6 +194,7 @@ int materialSlot(const aiScene& scene, unsigned m, const std::string& path,
   }
   int& slot = collector->material_slot[m];
   if (slot != -2) return slot;
+  if (!collector->file_materials) return slot = -1;
   const aiMaterial& material = *scene.mMaterials[m];
   aiString name;
   if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
@@ -286,6 +306,7 @@ MeshData collectTriangles(const aiScene& scene, const Eigen::Affine3d& scale_uni
                           const std::string& path) {
   MeshData out;
   SurfaceCollector collector;
+  collector.file_materials = lowerExtension(path) != ".ply" || plyHasMaterials(path);
   std::vector<std::pair<const aiNode*, Eigen::Affine3d>> stack;
   for (unsigned c = 0; c < scene.mRootNode->mNumChildren; ++c) {
     stack.emplace_back(scene.mRootNode->mChildren[c], Eigen::Affine3d::Identity());

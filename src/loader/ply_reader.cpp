@@ -12,7 +12,6 @@
 #include <string_view>
 #include <vector>
 
-#include "laser_raycast/core/surface.h"
 #include "laser_raycast/loader/errors.h"
 #include "vertex_joiner.h"
 
@@ -196,15 +195,6 @@ std::optional<MeshData> readPlainPly(const std::string& path, const Eigen::Vecto
   for (std::size_t f = 0; f < out.triangles.size(); ++f) {
     for (int k = 0; k < 3; ++k) out.triangles[f][k] = joined[corners[3 * f + k]];
   }
-  // assimp's PLY importer gives a file without materials one of its own, white, which the assimp
-  // path keeps for every triangle (and then the one without a colour it adds after the file's).
-  auto surface = std::make_shared<core::SurfaceAttributes>();
-  core::SurfaceMaterial white;
-  white.has_diffuse = true;
-  white.diffuse = Eigen::Vector3d::Ones();
-  surface->materials = {white, core::SurfaceMaterial{}};
-  surface->triangle_material.assign(out.triangles.size(), 0);
-  out.surface = std::move(surface);
   return out;
 }
 

@@ -3,8 +3,7 @@
 // triangles. This reader reads a binary little-endian file whose vertices have x, y, z in float and
 // nothing else, and whose faces have only their vertex indices, three a face, and gives the result
 // the assimp path gives: the vertices that faces use, in the file's order, joined where their
-// coordinates are equal, and the white material assimp's importer gives every triangle of a file
-// without materials. Every other PLY (ASCII or big-endian, double coordinates, colours,
+// coordinates are equal, and no surface attributes. Every other PLY (ASCII or big-endian, double coordinates, colours,
 // normals, texture coordinates, other elements or properties, polygons, anything malformed or out
 // of range) it leaves to assimp, which reads those and reports what is wrong. The importer
 // executable (laser_raycast_mesh_import) calls it for *.ply files. Private to the loader.

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -231,6 +233,49 @@ TEST(SurfaceReflectance, TheUrdfMaterialColourAppliesWhereTheMeshGivesNone) {
   EXPECT_NEAR(s.surface.reflectance[0], 0.5, 1e-12);
   // The triangle turned to face +y: the beam along +y meets its (y, z) = (0, 0) point.
   EXPECT_NEAR(s.surface.reflectance[1], 0.2126 * 0.25 + 0.7152 * 0.25 + 0.0722 * 0.5, 1e-6);
+}
+
+TEST(SurfaceReflectance, APlyWithoutMaterialsTakesTheUrdfColour) {
+  // A PLY names no material unless its header has a material element; assimp still gives it a
+  // white one of its own. Neither the file read by assimp (an ASCII cuboid, x from 3 to 4 ahead)
+  // nor one read by the loader's reader of plain binary PLY (a wall at y = 3, both windings) may
+  // stand for the surface's colour: their links' URDF materials give the reflectance.
+  std::string wall =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 2\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  const float corners[9] = {-1, 3, -1, 1, 3, -1, 0, 3, 1};
+  wall.append(reinterpret_cast<const char*>(corners), sizeof corners);
+  for (const std::int32_t order : {0x00020100, 0x00010200}) {  // (0, 1, 2) and (0, 2, 1)
+    wall.push_back(3);
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t index = (order >> (8 * k)) & 0xff;
+      wall.append(reinterpret_cast<const char*>(&index), 4);
+    }
+  }
+  const std::string wall_path = testing::TempDir() + "plain_wall.ply";
+  std::ofstream(wall_path, std::ios::binary) << wall;
+  const std::string urdf = R"(<robot name="r">
+    <link name="base">
+      <visual><origin xyz="3 -1 -1.5"/>
+        <geometry><mesh filename="../meshes/cuboid.ply"/></geometry>
+        <material name="grey"><color rgba="0.5 0.5 0.5 1"/></material></visual>
+      <visual><geometry><mesh filename="file://)" +
+                           wall_path + R"("/></geometry>
+        <material name="red"><color rgba="1 0 0 1"/></material></visual>
+    </link></robot>)";
+  core::Scene scene;
+  SceneLoader loader(nullptr);
+  loader.addUrdfString(urdf, kDir, {}, &scene);
+  core::FanSpec fan;
+  fan.angle_min = 0;
+  fan.angle_max = M_PI / 2;
+  fan.samples = 2;
+  const Sampled s = castAndSample(scene, core::ScanPattern(fan));
+  ASSERT_NEAR(s.result.range[0], 3, 1e-12);
+  ASSERT_NEAR(s.result.range[1], 3, 1e-12);
+  EXPECT_NEAR(s.surface.reflectance[0], 0.5, 1e-12);
+  EXPECT_NEAR(s.surface.reflectance[1], 0.2126, 1e-12);
 }
 
 TEST(SurfaceReflectance, BarycentricCoordinatesByCramersRule) {
