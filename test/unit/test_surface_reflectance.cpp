@@ -59,6 +59,18 @@ Sampled castAndSample(const core::Scene& scene, const core::ScanPattern& pattern
   return out;
 }
 
+// A URDF (its meshes relative to kDir) cast with two beams, along +x and +y.
+Sampled castAlongXAndY(const std::string& urdf) {
+  core::Scene scene;
+  SceneLoader loader(nullptr);
+  loader.addUrdfString(urdf, kDir, {}, &scene);
+  core::FanSpec fan;
+  fan.angle_min = 0;
+  fan.angle_max = M_PI / 2;
+  fan.samples = 2;
+  return castAndSample(scene, core::ScanPattern(fan));
+}
+
 // A grid of beams towards the plane x = distance, over y and z in (-extent, extent).
 core::ScanPattern gridTowards(double distance, double extent, int azimuths, int rings) {
   core::FanSpec fan;
@@ -219,15 +231,7 @@ TEST(SurfaceReflectance, TheUrdfMaterialColourAppliesWhereTheMeshGivesNone) {
         <geometry><mesh filename="rgb_triangle.ply"/></geometry>
         <material name="red"><color rgba="1 0 0 1"/></material></visual>
     </link></robot>)";
-  core::Scene scene;
-  SceneLoader loader(nullptr);
-  loader.addUrdfString(urdf, kDir, {}, &scene);
-  core::FanSpec fan;
-  fan.angle_min = 0;
-  fan.angle_max = M_PI / 2;
-  fan.samples = 2;
-  const core::ScanPattern pattern(fan);
-  const Sampled s = castAndSample(scene, pattern);
+  const Sampled s = castAlongXAndY(urdf);
   ASSERT_TRUE(std::isfinite(s.result.range[0]));
   ASSERT_TRUE(std::isfinite(s.result.range[1]));
   EXPECT_NEAR(s.surface.reflectance[0], 0.5, 1e-12);
@@ -264,14 +268,7 @@ TEST(SurfaceReflectance, APlyWithoutMaterialsTakesTheUrdfColour) {
                            wall_path + R"("/></geometry>
         <material name="red"><color rgba="1 0 0 1"/></material></visual>
     </link></robot>)";
-  core::Scene scene;
-  SceneLoader loader(nullptr);
-  loader.addUrdfString(urdf, kDir, {}, &scene);
-  core::FanSpec fan;
-  fan.angle_min = 0;
-  fan.angle_max = M_PI / 2;
-  fan.samples = 2;
-  const Sampled s = castAndSample(scene, core::ScanPattern(fan));
+  const Sampled s = castAlongXAndY(urdf);
   ASSERT_NEAR(s.result.range[0], 3, 1e-12);
   ASSERT_NEAR(s.result.range[1], 3, 1e-12);
   EXPECT_NEAR(s.surface.reflectance[0], 0.5, 1e-12);
