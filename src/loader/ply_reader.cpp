@@ -168,28 +168,27 @@ std::optional<MeshData> readPlainPly(const std::string& path, const Eigen::Vecto
     const unsigned char* p = face_data + f * face_bytes;
     if (readInteger(p, layout.count_bytes, false) != 3) return std::nullopt;
     for (int k = 0; k < 3; ++k) {
-      const std::int64_t v =
-          readInteger(p + layout.count_bytes + k * layout.index_bytes, layout.index_bytes,
-                      layout.index_signed);
+      const std::int64_t v = readInteger(p + layout.count_bytes + k * layout.index_bytes,
+                                         layout.index_bytes, layout.index_signed);
       if (v < 0 || v >= vertex_count) return std::nullopt;
       corners[3 * f + k] = static_cast<std::uint32_t>(v);
       used[v] = true;
     }
   }
-  // The used vertices joined in the file's order, as the assimp path keeps them.
+  // The used vertices joined in the file's order, as the assimp path keeps them. A vertex that is
+  // not finite, used or not, the assimp path reports.
   constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
   std::vector<std::uint32_t> joined(vertex_count, kUnused);
   MeshData out;
   VertexJoiner joiner(scale, &out.vertices);
   joiner.reserve(vertex_count);
   for (std::uint32_t v = 0; v < vertex_count; ++v) {
-    if (!used[v]) continue;
     float xyz[3];
     std::memcpy(xyz, vertex_data + 12 * static_cast<std::size_t>(v), sizeof xyz);
     if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2])) {
-      return std::nullopt;  // the assimp path reports it
+      return std::nullopt;
     }
-    joined[v] = joiner.add(xyz[0], xyz[1], xyz[2]);
+    if (used[v]) joined[v] = joiner.add(xyz[0], xyz[1], xyz[2]);
   }
   out.triangles.resize(layout.faces);
   for (std::size_t f = 0; f < out.triangles.size(); ++f) {

@@ -3,10 +3,11 @@
 // triangles. This reader reads a binary little-endian file whose vertices have x, y, z in float and
 // nothing else, and whose faces have only their vertex indices, three a face, and gives the result
 // the assimp path gives: the vertices that faces use, in the file's order, joined where their
-// coordinates are equal, and no surface attributes. Every other PLY (ASCII or big-endian, double coordinates, colours,
-// normals, texture coordinates, other elements or properties, polygons, anything malformed or out
-// of range) it leaves to assimp, which reads those and reports what is wrong. The importer
-// executable (laser_raycast_mesh_import) calls it for *.ply files. Private to the loader.
+// coordinates are equal, and no surface attributes. Every other PLY (ASCII or big-endian, double
+// coordinates, colours, normals, texture coordinates, other elements or properties, polygons,
+// anything malformed or out of range) it leaves to assimp, which reads those and reports what is
+// wrong. The importer executable (laser_raycast_mesh_import) calls it for *.ply files. Private to
+// the loader.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -32,8 +33,9 @@ bool isPlyPath(const std::string& path);
 //                                                count, I an 8-, 16- or 32-bit index)
 //   end_header
 // then N vertices and M faces, every face of three indices, each naming one of the N vertices,
-// every coordinate finite. Vertices scaled as readStl's (v' = scale ⊙ v, rounded as the assimp
-// path's). Throws SceneLoadError when the file cannot be read.
+// every coordinate finite (of used vertices and unused ones alike, as the assimp path checks).
+// Vertices scaled as readStl's (v' = scale ⊙ v, rounded as the assimp path's). Throws
+// SceneLoadError when the file cannot be read.
 std::optional<MeshData> readPlainPly(const std::string& path, const Eigen::Vector3d& scale);
 
 }  // namespace mesh_file
