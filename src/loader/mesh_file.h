@@ -5,6 +5,9 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -31,6 +34,16 @@ inline std::string lowerExtension(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
+}
+
+// A file the loader's own readers read (stl_reader, obj_reader, ply_reader), closed when it goes.
+using File = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
+
+// The file at path opened for reading; throws SceneLoadError saying why if it cannot be.
+inline File openMeshFile(const std::string& path) {
+  File file(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!file) throw SceneLoadError(std::string("cannot open it: ") + std::strerror(errno));
+  return file;
 }
 
 // A mesh file's triangles (import_process.h reads them), in link-local coordinates.

@@ -19,8 +19,6 @@ namespace laser_raycast {
 namespace mesh_file {
 namespace {
 
-using File = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
-
 constexpr std::size_t kChunkBytes = std::size_t(1) << 20;  // read at a time
 
 // What the lines read so far hold: the vertices' coordinates, x y z each, and the triangles'
@@ -116,8 +114,7 @@ bool readLine(std::string_view line, Plain* plain) {
 bool isObjPath(const std::string& path) { return lowerExtension(path) == ".obj"; }
 
 std::optional<MeshData> readPlainObj(const std::string& path, const Eigen::Vector3d& scale) {
-  const File file(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!file) throw SceneLoadError(std::string("cannot open it: ") + std::strerror(errno));
+  const File file = openMeshFile(path);
   Plain plain;
   std::vector<char> buffer;
   std::size_t kept = 0;  // bytes of an unfinished line at the buffer's start

@@ -19,8 +19,6 @@ namespace laser_raycast {
 namespace mesh_file {
 namespace {
 
-using File = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
-
 // A header longer than this is not a plain one.
 constexpr std::size_t kMaxHeaderBytes = 1 << 16;
 
@@ -129,8 +127,7 @@ bool readHeader(std::string_view header, Layout* layout) {
 bool isPlyPath(const std::string& path) { return lowerExtension(path) == ".ply"; }
 
 std::optional<MeshData> readPlainPly(const std::string& path, const Eigen::Vector3d& scale) {
-  const File file(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!file) throw SceneLoadError(std::string("cannot open it: ") + std::strerror(errno));
+  const File file = openMeshFile(path);
   std::vector<unsigned char> data;
   for (;;) {
     const std::size_t size = data.size();

@@ -32,8 +32,6 @@ constexpr std::size_t kChunkRecords = 1 << 16;  // 3.2 MB read at a time
 
 std::string inQuotes(std::string_view s) { return "'" + std::string(s) + "'"; }
 
-using File = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
-
 // A file that is not ASCII STL after all (readStl then says what it is not as binary STL either).
 class NotAscii : public SceneLoadError {
  public:
@@ -272,8 +270,7 @@ MeshData readAscii(std::FILE* file, const Eigen::Vector3d& scale) {
 bool isStlPath(const std::string& path) { return lowerExtension(path) == ".stl"; }
 
 MeshData readStl(const std::string& path, const Eigen::Vector3d& scale) {
-  const File file(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!file) throw SceneLoadError(std::string("cannot open it: ") + std::strerror(errno));
+  const File file = openMeshFile(path);
   std::error_code ec;
   const std::uint64_t size = fs::file_size(path, ec);
   if (ec) throw SceneLoadError("cannot tell its size: " + ec.message());

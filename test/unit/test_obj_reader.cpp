@@ -19,9 +19,9 @@
 
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/loader/errors.h"
-#include "laser_raycast/loader/scene_loader.h"
 #include "mesh_import.h"
 #include "obj_reader.h"
+#include "loader_against_assimp.h"
 #include "temp_files.h"
 
 namespace laser_raycast_test {
@@ -135,13 +135,8 @@ TEST(ObjReader, ForwardNumbersAndNoFinalNewline) {
 
 // Through the scene loader, whose importer process reads the file: the mesh assimp gives, scaled.
 TEST(ObjReader, TheLoaderGivesAssimpsMesh) {
-  const std::string path = writeFile("loaded.obj", randomObj(2000, 4000, true, "\n"));
-  const Vector3d scale(0.5, 2, 0.25);
-  laser_raycast::SceneLoader loader(nullptr);
-  const auto mesh = loader.loadMesh(path, "", scale, {});
-  const MeshData theirs = importMeshInProcess(path, scale);
-  EXPECT_EQ(mesh->vertices(), theirs.vertices);
-  EXPECT_EQ(mesh->triangles(), theirs.triangles);
+  expectLoaderGivesAssimpsMesh(writeFile("loaded.obj", randomObj(2000, 4000, true, "\n")),
+                               Vector3d(0.5, 2, 0.25));
 }
 
 // Each of these holds something beyond plain vertices and triangles, or is broken: assimp reads it

@@ -16,9 +16,9 @@
 
 #include "laser_raycast/core/mesh.h"
 #include "laser_raycast/loader/errors.h"
-#include "laser_raycast/loader/scene_loader.h"
 #include "mesh_import.h"
 #include "ply_reader.h"
+#include "loader_against_assimp.h"
 #include "temp_files.h"
 
 namespace laser_raycast_test {
@@ -127,14 +127,10 @@ TEST(PlyReader, PlainTrianglesAsAssimpReadsThem) {
 
 // Through the scene loader, whose importer process reads the file: the mesh assimp gives, scaled.
 TEST(PlyReader, TheLoaderGivesAssimpsMesh) {
-  const std::string path = writeFile(
-      "loaded.ply", randomPly<std::uint8_t, std::int32_t>(2000, 4000, "uchar", "int").text());
-  const Vector3d scale(0.5, 2, 0.25);
-  laser_raycast::SceneLoader loader(nullptr);
-  const auto mesh = loader.loadMesh(path, "", scale, {});
-  const MeshData theirs = importMeshInProcess(path, scale);
-  EXPECT_EQ(mesh->vertices(), theirs.vertices);
-  EXPECT_EQ(mesh->triangles(), theirs.triangles);
+  expectLoaderGivesAssimpsMesh(
+      writeFile("loaded.ply",
+                randomPly<std::uint8_t, std::int32_t>(2000, 4000, "uchar", "int").text()),
+      Vector3d(0.5, 2, 0.25));
 }
 
 // Each of these holds something beyond plain float vertices and triangles, or is broken: assimp
