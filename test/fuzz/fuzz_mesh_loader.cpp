@@ -56,18 +56,12 @@ MeshImportBounds fuzzBounds() {
   return bounds;
 }
 
-// Where the inputs are written, removed at exit.
-const fs::path& workDir() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("fuzz_mesh_loader_" + std::to_string(getpid()));
-    fs::create_directories(d);
-    std::atexit([] {
-      std::error_code ec;
-      fs::remove_all(workDir(), ec);
-    });
-    return d;
-  }();
-  return dir;
+// Where an input is written (removed after it is loaded): a file of its own in the temporary
+// directory. libFuzzer may end the process without running atexit handlers, so nothing is left
+// for them to remove.
+fs::path inputFile(std::uint64_t count, const std::string& extension) {
+  return fs::temp_directory_path() / ("fuzz_mesh_loader_" + std::to_string(getpid()) + "_" +
+                                      std::to_string(count) + extension);
 }
 
 }  // namespace
@@ -78,7 +72,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static std::unique_ptr<SceneLoader> loader;
   static std::uint64_t count = 0;
   if (!loader || count % 256 == 0) loader = std::make_unique<SceneLoader>(nullptr);
-  const fs::path file = workDir() / ("input" + std::to_string(count++) + extensionFor(data, size));
+  const fs::path file = inputFile(count++, extensionFor(data, size));
   std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(data), size);
   try {
     const auto mesh =
