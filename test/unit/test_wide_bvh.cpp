@@ -125,6 +125,10 @@ TEST(WideBvh, ComponentsFillWholeSubtrees) {
     }
   }
   EXPECT_GT(tagged, 40);
+  // The counts ride in the nodes' count fields: the root's is every slot, and an inner child is
+  // never taken for a leaf.
+  EXPECT_EQ(w.rootTriangles(), mesh.bvh().triangleIds().size());
+  EXPECT_FALSE(w.root().isLeaf());
   for (std::int32_t g = 0; g < 40; ++g) EXPECT_FALSE(groupInMixedLeaf(mesh, g));
 }
 

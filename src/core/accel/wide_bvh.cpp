@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <stdexcept>
 
 namespace laser_raycast {
 namespace core {
@@ -37,12 +38,12 @@ class WideBvh::Builder {
   // The binary tree's depth is bounded (BvhConfig::max_depth), so the recursion is too.
   Summary collapse(const Bvh::Child& child) {
     if (const auto leaf = asLeaf(child)) {
+      if (leaf->count >= kInner) throw std::length_error("a BVH leaf of 2^31 or more triangles");
       return Summary{Ref{leaf->index, leaf->count}, leaf->count};
     }
     const std::vector<Gathered> gathered = gather(child);
     const auto index = static_cast<std::uint32_t>(out_.nodes_.size());
     out_.nodes_.emplace_back();
-    out_.child_triangles_.resize(out_.nodes_.size() * kWidth, 0);
     Summary summary{Ref{index, 0}, 0};
     for (int k = 0; k < kWidth; ++k) {
       if (k >= static_cast<int>(gathered.size())) {
@@ -57,9 +58,9 @@ class WideBvh::Builder {
       }
       node.index[k] = sub.ref.index;
       node.count[k] = sub.ref.count;
-      out_.child_triangles_[index * kWidth + k] = sub.triangles;
       summary.triangles += sub.triangles;
     }
+    summary.ref.count = kInner | std::min<std::uint32_t>(summary.triangles, kInner - 1);
     return summary;
   }
 
@@ -149,13 +150,10 @@ class WideBvh::Builder {
 WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) : bvh_(&bvh) {
   if (bvh.empty()) return;
   Builder builder(this, bvh, slot_group);
-  const Builder::Summary root = builder.collapse(bvh.root());
-  root_ = root.ref;
-  root_triangles_ = root.triangles;
-  // Grown one node at a time, the arrays hold up to twice what they use (38 bytes a triangle of a
+  root_ = builder.collapse(bvh.root()).ref;
+  // Grown one node at a time, the nodes hold up to twice what they use (38 bytes a triangle of a
   // 20M-triangle terrain): given back once the tree is whole.
   nodes_.shrink_to_fit();
-  child_triangles_.shrink_to_fit();
 }
 
 WideBoxRay::WideBoxRay(const Ray& ray, const Aabb& bounds) {

@@ -45,14 +45,20 @@ class WideBvh {
   // Binary subtrees of one group with at most this many triangles become one leaf.
   static constexpr std::uint32_t kMaxLeafTriangles = 2;
 
-  // A subtree: an inner node (count == 0, index into nodes()), a leaf (count triangle slots of the
-  // binary BVH from index on), or nothing (index == kEmpty).
+  // A subtree: an inner node (index into nodes(); count: kInner | the triangles below it), a leaf
+  // (count triangle slots of the binary BVH from index on, 1 to kInner - 1), or nothing (index ==
+  // kEmpty, count == 0). An inner node's triangle count rides in the bits a leaf's count uses, so
+  // that a node holds it at no cost (the walks' heuristics read it); it saturates at kInner - 1.
   // Trivially constructible, so that a traversal's stack of them costs nothing to set up.
+  static constexpr std::uint32_t kInner = std::uint32_t{1} << 31;
   struct Ref {
     std::uint32_t index;
     std::uint32_t count;
-    bool isLeaf() const { return count > 0; }
+    // One signed compare, as cheap as count > 0: an inner node's count is negative as int32.
+    bool isLeaf() const { return static_cast<std::int32_t>(count) > 0; }
     bool isEmpty() const { return index == kEmpty; }
+    // The triangles below: a leaf's count, or an inner node's (saturated) count.
+    std::uint32_t triangles() const { return count & ~kInner; }
   };
 
   // Four children. An empty child has lo = +inf and hi = -inf, but a box test alone cannot be
@@ -83,15 +89,13 @@ class WideBvh {
   const std::vector<Node>& nodes() const { return nodes_; }
   Ref root() const { return root_; }
   bool empty() const { return root_.isEmpty(); }
-  // Triangles below a node's child k, and below the root.
+  // Triangles below a node's child k, and below the root (an inner node's saturate at kInner - 1).
   std::uint32_t childTriangles(std::uint32_t node, int k) const {
-    return child_triangles_[node * kWidth + k];
+    return nodes_[node].child(k).triangles();
   }
-  std::uint32_t rootTriangles() const { return root_triangles_; }
+  std::uint32_t rootTriangles() const { return root_.triangles(); }
   // Bytes the nodes take (not the binary BVH's slots).
-  std::size_t bytes() const {
-    return nodes_.capacity() * sizeof(Node) + child_triangles_.capacity() * sizeof(std::uint32_t);
-  }
+  std::size_t bytes() const { return nodes_.capacity() * sizeof(Node); }
 
   // Depth-first walk over the subtrees whose box satisfies descend(box) (the root's: the binary
   // BVH's bounds; below it, the nodes' float boxes, which contain the exact ones); calls leaf(slot)
@@ -127,8 +131,6 @@ class WideBvh {
   const Bvh* bvh_ = nullptr;
   std::vector<Node> nodes_;
   Ref root_{kEmpty, 0};
-  std::vector<std::uint32_t> child_triangles_;
-  std::uint32_t root_triangles_ = 0;
 };
 
 // A ray prepared for conservative box tests against a wide node's four children in its first kAxes
