@@ -14,6 +14,7 @@ namespace laser_raycast_test {
 
 // The component of every triangle below ref, or -1 if they are of several.
 inline std::int32_t subtreeGroup(const laser_raycast::core::Mesh& mesh,
+                                 const std::vector<std::uint32_t>& components,
                                  laser_raycast::core::WideBvh::Ref ref) {
   using laser_raycast::core::WideBvh;
   const WideBvh& w = mesh.wideBvh();
@@ -25,7 +26,7 @@ inline std::int32_t subtreeGroup(const laser_raycast::core::Mesh& mesh,
     todo.pop_back();
     if (r.isLeaf()) {
       for (std::uint32_t s = r.index; s < r.index + r.count; ++s) {
-        groups.insert(mesh.components()[ids[s]]);
+        groups.insert(components[ids[s]]);
       }
       continue;
     }
@@ -37,14 +38,17 @@ inline std::int32_t subtreeGroup(const laser_raycast::core::Mesh& mesh,
 }
 
 // The same for child k of node (-1 for an empty child).
-inline std::int32_t childGroup(const laser_raycast::core::Mesh& mesh, std::uint32_t node, int k) {
+inline std::int32_t childGroup(const laser_raycast::core::Mesh& mesh,
+                               const std::vector<std::uint32_t>& components, std::uint32_t node,
+                               int k) {
   const auto& w = mesh.wideBvh();
   if (w.nodes()[node].index[k] == laser_raycast::core::WideBvh::kEmpty) return -1;
-  return subtreeGroup(mesh, w.nodes()[node].child(k));
+  return subtreeGroup(mesh, components, w.nodes()[node].child(k));
 }
 
 // Whether some of the group's triangles share a leaf with another group's.
-inline bool groupInMixedLeaf(const laser_raycast::core::Mesh& mesh, std::int32_t group) {
+inline bool groupInMixedLeaf(const laser_raycast::core::Mesh& mesh,
+                             const std::vector<std::uint32_t>& components, std::int32_t group) {
   using laser_raycast::core::WideBvh;
   const WideBvh& w = mesh.wideBvh();
   const auto& ids = mesh.bvh().triangleIds();
@@ -52,7 +56,7 @@ inline bool groupInMixedLeaf(const laser_raycast::core::Mesh& mesh, std::int32_t
   auto leaf = [&](WideBvh::Ref r) {
     std::set<std::uint32_t> groups;
     for (std::uint32_t s = r.index; s < r.index + r.count; ++s) {
-      groups.insert(mesh.components()[ids[s]]);
+      groups.insert(components[ids[s]]);
     }
     if (groups.size() > 1 && groups.count(static_cast<std::uint32_t>(group))) mixed = true;
   };

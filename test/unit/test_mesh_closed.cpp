@@ -47,20 +47,21 @@ TEST(MeshClosed, ClosedComponentsAndTheirWinding) {
   const core::Mesh mesh(m.vertices, m.triangles);
   ASSERT_TRUE(mesh.hasClosedComponents());
   const auto& ids = mesh.bvh().triangleIds();
+  const std::vector<std::uint32_t> components = mesh.components();
   for (std::size_t slot = 0; slot < ids.size(); ++slot) {
     // Components are numbered in order of their first triangle, as they were appended.
-    const std::uint32_t component = mesh.components()[ids[slot]];
-    EXPECT_EQ(mesh.slotFacing()[slot], component % 3 == 0 ? -1 : 1) << "slot " << slot;
+    const std::uint32_t component = components[ids[slot]];
+    EXPECT_EQ(mesh.slotFacing(slot), component % 3 == 0 ? -1 : 1) << "slot " << slot;
   }
   // Open: one triangle of each solid taken away; and two boxes sharing an edge's vertex indices
   // four times are not a closed surface either.
   TriMesh open = m;
   open.triangles.erase(open.triangles.begin());
   const core::Mesh open_mesh(open.vertices, open.triangles);
-  EXPECT_EQ(open_mesh.slotFacing()[0] != 0, true);  // the other solids stay closed
+  EXPECT_EQ(open_mesh.slotFacing(0) != 0, true);  // the other solids stay closed
   int open_slots = 0;
-  for (std::size_t slot = 0; slot < open_mesh.slotFacing().size(); ++slot) {
-    open_slots += open_mesh.slotFacing()[slot] == 0;
+  for (std::uint32_t slot = 0; slot < open_mesh.bvh().triangleIds().size(); ++slot) {
+    open_slots += open_mesh.slotFacing(slot) == 0;
   }
   EXPECT_GT(open_slots, 0);
   const TriMesh sheet{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}}};
@@ -105,8 +106,9 @@ TEST(MeshClosed, ClosedAsCountingEveryEdgeSays) {
     const core::Mesh mesh(m.vertices, m.triangles);
     std::map<std::uint32_t, std::map<std::pair<std::uint32_t, std::uint32_t>, int>> uses;
     std::set<std::uint32_t> collapsed;
+    const std::vector<std::uint32_t> components = mesh.components();
     for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-      const std::uint32_t c = mesh.components()[t];
+      const std::uint32_t c = components[t];
       auto& edges = uses[c];
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t from = m.triangles[t][k], to = m.triangles[t][(k + 1) % 3];
@@ -125,8 +127,8 @@ TEST(MeshClosed, ClosedAsCountingEveryEdgeSays) {
     }
     const auto& ids = mesh.bvh().triangleIds();
     for (std::size_t slot = 0; slot < ids.size(); ++slot) {
-      const std::uint32_t c = mesh.components()[ids[slot]];
-      ASSERT_EQ(mesh.slotFacing()[slot] != 0, closed[c])
+      const std::uint32_t c = components[ids[slot]];
+      ASSERT_EQ(mesh.slotFacing(slot) != 0, closed[c])
           << "scene " << scene << " slot " << slot << " component " << c;
     }
     for (const auto& [c, ok] : closed) (ok ? closed_seen : open_seen)++;

@@ -97,10 +97,11 @@ TEST(WideBvh, ComponentsFillWholeSubtrees) {
   ASSERT_EQ(mesh.componentCount(), 40u);
   const WideBvh& w = mesh.wideBvh();
   const auto& ids = mesh.bvh().triangleIds();
+  const std::vector<std::uint32_t> components = mesh.components();
   int tagged = 0;
   for (std::uint32_t n = 0; n < w.nodes().size(); ++n) {
     for (int k = 0; k < WideBvh::kWidth; ++k) {
-      const std::int32_t group = childGroup(mesh, n, k);
+      const std::int32_t group = childGroup(mesh, components, n, k);
       if (group < 0 || w.nodes()[n].index[k] == WideBvh::kEmpty) continue;
       ++tagged;
       // Every slot below carries that group.
@@ -111,7 +112,7 @@ TEST(WideBvh, ComponentsFillWholeSubtrees) {
         todo.pop_back();
         if (r.isLeaf()) {
           for (std::uint32_t s = r.index; s < r.index + r.count; ++s, ++count) {
-            EXPECT_EQ(mesh.components()[ids[s]], static_cast<std::uint32_t>(group));
+            EXPECT_EQ(components[ids[s]], static_cast<std::uint32_t>(group));
           }
           continue;
         }
@@ -129,7 +130,7 @@ TEST(WideBvh, ComponentsFillWholeSubtrees) {
   // never taken for a leaf.
   EXPECT_EQ(w.rootTriangles(), mesh.bvh().triangleIds().size());
   EXPECT_FALSE(w.root().isLeaf());
-  for (std::int32_t g = 0; g < 40; ++g) EXPECT_FALSE(groupInMixedLeaf(mesh, g));
+  for (std::int32_t g = 0; g < 40; ++g) EXPECT_FALSE(groupInMixedLeaf(mesh, components, g));
 }
 
 template <TriangleMethod M>

@@ -49,19 +49,26 @@ class Mesh {
   // leaf.
   void visit(const std::function<bool(const Aabb&)>& descend,
              const std::function<void(std::uint32_t)>& leaf) const;
-  // The connected component of each triangle, numbered from 0, and how many there are.
-  const std::vector<std::uint32_t>& components() const { return component_; }
+  // The connected component of each triangle, numbered from 0 in order of first triangle
+  // (triangles sharing a vertex index are in one), and how many there are. Not kept: components()
+  // labels them anew at each call.
+  std::vector<std::uint32_t> components() const;
   std::uint32_t componentCount() const { return component_count_; }
-  // Closed surfaces, whose back faces a sensor outside them never sees first: per BVH slot, +1 if
+  // Closed surfaces, whose back faces a sensor outside them never sees first: for a BVH slot, +1 if
   // its triangle's component is closed and consistently wound with the front normals
   // ((b - a) x (c - a)) pointing out of the solid, -1 if pointing in, 0 if the component is open,
   // inconsistently wound, or encloses no volume. A component is closed when every edge between two
   // of its vertex indices is used by exactly two of its triangles, once in each direction.
-  const std::vector<std::int8_t>& slotFacing() const { return slot_facing_; }
-  bool hasClosedComponents() const { return has_closed_; }
-  // Per BVH slot, the bounds of its triangle's component (the sensor must be outside them).
+  int slotFacing(std::uint32_t slot) const {
+    return slot_closed_.empty() || slot_closed_[slot] == 0
+               ? 0
+               : closed_components_[slot_closed_[slot] - 1].facing;
+  }
+  bool hasClosedComponents() const { return !slot_closed_.empty(); }
+  // For a slot whose slotFacing is not 0, the bounds of its triangle's component (the sensor must
+  // be outside them).
   const Aabb& slotComponentBounds(std::uint32_t slot) const {
-    return component_bounds_[component_[bvh_.triangleIds()[slot]]];
+    return closed_components_[slot_closed_[slot] - 1].bounds;
   }
   const Aabb& bounds() const { return bounds_; }
   // A sphere containing every vertex that a triangle uses: centre of their bounds, radius to the
@@ -76,26 +83,30 @@ class Mesh {
   // Throws std::invalid_argument if surface does not fit this mesh (SurfaceAttributes::validate).
   // Set it before the mesh is shared.
   void setSurface(std::shared_ptr<const SurfaceAttributes> surface);
-  // Bytes the mesh holds: vertices, triangles, components, its BVH's slots and nodes (not the
-  // surface attributes, which may be shared).
+  // Bytes the mesh holds: vertices, triangles, closed components, its BVH's slots and nodes (not
+  // the surface attributes, which may be shared).
   std::size_t bytes() const;
   // Geometric unit normal of a triangle, (b - a) x (c - a) normalised (the front face's side).
   Eigen::Vector3d normal(std::uint32_t triangle) const;
 
  private:
-  void labelComponents();
-  void findClosedComponents();
+  void findClosedComponents(const std::vector<std::uint32_t>& component);
 
   std::vector<Eigen::Vector3d> vertices_;
   std::vector<TriangleIndices> triangles_;
   Aabb bounds_;
   Eigen::Vector3d sphere_center_;
   double sphere_radius_ = 0;
-  std::vector<std::uint32_t> component_;
+  // A closed component's bounds and facing (+1 or -1), and per BVH slot 1 + the index of its
+  // triangle's closed component, or 0 if open; slot_closed_ is empty if none is closed (an open
+  // mesh keeps no bytes per triangle for them).
+  struct ClosedComponent {
+    Aabb bounds;
+    int facing;
+  };
   std::uint32_t component_count_ = 0;
-  std::vector<Aabb> component_bounds_;
-  std::vector<std::int8_t> slot_facing_;
-  bool has_closed_ = false;
+  std::vector<ClosedComponent> closed_components_;
+  std::vector<std::uint32_t> slot_closed_;
   Bvh bvh_;
   std::unique_ptr<const WideBvh> wide_;  // refers to bvh_
   std::shared_ptr<const SurfaceAttributes> surface_;
@@ -107,7 +118,7 @@ class Mesh {
 // triangle. Only clear cases count: the triangle's plane must pass the eye by more than rounding.
 inline bool hiddenBackFace(const Mesh& mesh, std::uint32_t slot, const Eigen::Vector3d& eye,
                            double tmin, double spread = 0) {
-  const int facing = mesh.slotFacing()[slot];
+  const int facing = mesh.slotFacing(slot);
   if (!facing) return false;
   const Aabb& box = mesh.slotComponentBounds(slot);
   const double gap2 = (box.lo - eye).cwiseMax(eye - box.hi).cwiseMax(0.0).squaredNorm();
@@ -125,7 +136,8 @@ inline bool hiddenBackFace(const Mesh& mesh, std::uint32_t slot, const Eigen::Ve
   // the spread: an eye moved by d changes it by at most |n| |d|).
   const Eigen::Vector3d n = ab.cross(ac);
   const double side = n.dot(from_eye);
-  const double tolerance = 1e-10 * ab.lpNorm<1>() * ac.lpNorm<1>() * (from_eye.lpNorm<1>() + 3 * spread);
+  const double tolerance =
+      1e-10 * ab.lpNorm<1>() * ac.lpNorm<1>() * (from_eye.lpNorm<1>() + 3 * spread);
   return facing * side > tolerance + (spread > 0 ? n.norm() * spread * (1 + 1e-9) : 0.0);
 }
 

@@ -33,8 +33,10 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
       }
     }
   }
-  labelComponents();
-  bvh_ = Bvh::build(vertices_, triangles_, bvh_config, component_);
+  const std::vector<std::uint32_t> component = components();
+  component_count_ =
+      component.empty() ? 0 : *std::max_element(component.begin(), component.end()) + 1;
+  bvh_ = Bvh::build(vertices_, triangles_, bvh_config, component);
   if (bvh_.empty()) {
     std::ostringstream msg;
     msg << "mesh has " << triangles_.size() << " triangles but all of them have zero area";
@@ -59,11 +61,11 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
   sphere_radius_ = std::sqrt(r2) * (1 + 4 * std::numeric_limits<double>::epsilon());
   std::vector<std::uint32_t> slot_component;
   slot_component.reserve(bvh_.triangleIds().size());
-  for (const std::uint32_t id : bvh_.triangleIds()) slot_component.push_back(component_[id]);
+  for (const std::uint32_t id : bvh_.triangleIds()) slot_component.push_back(component[id]);
   wide_ = std::make_unique<const WideBvh>(bvh_, slot_component);
   // Everything walks the wide BVH from here on.
   bvh_.releaseTree();
-  findClosedComponents();
+  findClosedComponents(component);
 }
 
 void Mesh::visit(const std::function<bool(const Aabb&)>& descend,
@@ -76,21 +78,20 @@ Mesh::~Mesh() = default;
 std::size_t Mesh::bytes() const {
   return vertices_.capacity() * sizeof(Eigen::Vector3d) +
          triangles_.capacity() * sizeof(TriangleIndices) +
-         component_.capacity() * sizeof(std::uint32_t) +
-         component_bounds_.capacity() * sizeof(Aabb) +
-         slot_facing_.capacity() * sizeof(std::int8_t) + bvh_.bytes() + wide_->bytes();
+         closed_components_.capacity() * sizeof(ClosedComponent) +
+         slot_closed_.capacity() * sizeof(std::uint32_t) + bvh_.bytes() + wide_->bytes();
 }
 
-void Mesh::findClosedComponents() {
+void Mesh::findClosedComponents(const std::vector<std::uint32_t>& component) {
   // Each used vertex's component, from which the components' bounds, read in vertex order.
   constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
   std::vector<std::uint32_t> vertex_component(vertices_.size(), kUnused);
   for (std::size_t t = 0; t < triangles_.size(); ++t) {
-    for (const std::uint32_t v : triangles_[t]) vertex_component[v] = component_[t];
+    for (const std::uint32_t v : triangles_[t]) vertex_component[v] = component[t];
   }
-  component_bounds_.assign(component_count_, Aabb{});
+  std::vector<Aabb> component_bounds(component_count_);
   for (std::size_t v = 0; v < vertices_.size(); ++v) {
-    if (vertex_component[v] != kUnused) component_bounds_[vertex_component[v]].grow(vertices_[v]);
+    if (vertex_component[v] != kUnused) component_bounds[vertex_component[v]].grow(vertices_[v]);
   }
   // A closed surface wound one way has every edge exactly twice, once each way. Each edge between
   // two vertices is listed under its lower vertex as (higher << 1 | whether it runs from the
@@ -108,7 +109,7 @@ void Mesh::findClosedComponents() {
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t from = triangles_[t][k], to = triangles_[t][(k + 1) % 3];
         if (from == to) {
-          closed[component_[t]] = 0;
+          closed[component[t]] = 0;
           continue;
         }
         ++start[std::min(from, to) + 1];
@@ -141,27 +142,31 @@ void Mesh::findClosedComponents() {
   // the component's bounds to each triangle), kept only if it stands clear of the rounding.
   std::vector<double> volume(component_count_, 0.0), magnitude(component_count_, 0.0);
   for (std::size_t t = 0; t < triangles_.size(); ++t) {
-    const std::uint32_t c = component_[t];
-    const Eigen::Vector3d o = component_bounds_[c].center();
+    const std::uint32_t c = component[t];
+    const Eigen::Vector3d o = component_bounds[c].center();
     const auto& v = triangles_[t];
     const Eigen::Vector3d a = vertices_[v[0]] - o, b = vertices_[v[1]] - o, d = vertices_[v[2]] - o;
     const double term = a.dot(b.cross(d));
     volume[c] += term;
     magnitude[c] += a.norm() * b.norm() * d.norm();
   }
-  slot_facing_.clear();
-  slot_facing_.reserve(bvh_.triangleIds().size());
-  for (const std::uint32_t id : bvh_.triangleIds()) {
-    const std::uint32_t c = component_[id];
-    const bool clear = std::abs(volume[c]) > 1e-9 * magnitude[c];
-    slot_facing_.push_back(!closed[c] || !clear ? 0 : (volume[c] > 0 ? 1 : -1));
-    has_closed_ = has_closed_ || slot_facing_.back() != 0;
+  // The closed components with a clear facing, numbered from 1 in a slot's entry.
+  std::vector<std::uint32_t> closed_number(component_count_, 0);
+  for (std::uint32_t c = 0; c < component_count_; ++c) {
+    if (!closed[c] || !(std::abs(volume[c]) > 1e-9 * magnitude[c])) continue;
+    closed_components_.push_back({component_bounds[c], volume[c] > 0 ? 1 : -1});
+    closed_number[c] = static_cast<std::uint32_t>(closed_components_.size());
   }
+  closed_components_.shrink_to_fit();
+  if (closed_components_.empty()) return;
+  slot_closed_.reserve(bvh_.triangleIds().size());
+  for (const std::uint32_t id : bvh_.triangleIds())
+    slot_closed_.push_back(closed_number[component[id]]);
 }
 
 // Union-find over vertex indices: triangles sharing a vertex index are in one component. Only
 // shared indices count (not equal positions): they are what makes a shared edge watertight.
-void Mesh::labelComponents() {
+std::vector<std::uint32_t> Mesh::components() const {
   std::vector<std::uint32_t> parent(vertices_.size());
   for (std::uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
   auto find = [&](std::uint32_t v) {
@@ -175,13 +180,14 @@ void Mesh::labelComponents() {
     }
   }
   std::vector<std::uint32_t> number(vertices_.size(), std::numeric_limits<std::uint32_t>::max());
-  component_.resize(triangles_.size());
-  component_count_ = 0;
+  std::vector<std::uint32_t> component(triangles_.size());
+  std::uint32_t count = 0;
   for (std::size_t t = 0; t < triangles_.size(); ++t) {
     std::uint32_t& n = number[find(triangles_[t][0])];
-    if (n == std::numeric_limits<std::uint32_t>::max()) n = component_count_++;
-    component_[t] = n;
+    if (n == std::numeric_limits<std::uint32_t>::max()) n = count++;
+    component[t] = n;
   }
+  return component;
 }
 
 Eigen::Vector3d Mesh::normal(std::uint32_t triangle) const {
