@@ -225,7 +225,7 @@ std::optional<std::size_t> embreeMeshBytes([[maybe_unused]] const core::Mesh& me
   // What the scene holds once built: the build's temporary arrays are freed by then, and the
   // buffers made by rtcSetNewGeometryBuffer are counted too (the vertex buffer with the 4 bytes
   // of padding that lets Embree read its last vertex with a 16-byte load).
-  const EmbreeScene scene(mesh.vertices(), mesh.triangles(), false);
+  const EmbreeScene scene(mesh.vertices().toVector(), mesh.triangles(), false);
   return static_cast<std::size_t>(monitor.held());
 #else
   return std::nullopt;

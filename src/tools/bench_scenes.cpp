@@ -30,7 +30,7 @@ MeshData flattenToSoup(const BenchScene& s) {
     const core::Shape& shape = s.scene.bodies()[b].shape;
     MeshData local;
     if (const auto* mesh = std::get_if<std::shared_ptr<const core::Mesh>>(&shape)) {
-      local.vertices = (*mesh)->vertices();
+      local.vertices = (*mesh)->vertices().toVector();
       local.triangles = (*mesh)->triangles();
     } else if (const auto* box = std::get_if<core::Box>(&shape)) {
       local = boxMesh(box->size);

@@ -60,8 +60,8 @@ MeshImportBounds fuzzBounds() {
 // directory. libFuzzer may end the process without running atexit handlers, so nothing is left
 // for them to remove.
 fs::path inputFile(std::uint64_t count, const std::string& extension) {
-  return fs::temp_directory_path() / ("fuzz_mesh_loader_" + std::to_string(getpid()) + "_" +
-                                      std::to_string(count) + extension);
+  return fs::temp_directory_path() /
+         ("fuzz_mesh_loader_" + std::to_string(getpid()) + "_" + std::to_string(count) + extension);
 }
 
 }  // namespace
@@ -78,8 +78,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const auto mesh =
         loader->loadMesh(file.string(), "", Eigen::Vector3d::Ones(), {}, fuzzBounds());
     if (!mesh || mesh->triangles().empty()) fail("a mesh without triangles");
-    for (const Eigen::Vector3d& v : mesh->vertices()) {
-      if (!v.allFinite()) fail("a vertex that is not finite");
+    for (std::size_t i = 0; i < mesh->vertices().size(); ++i) {
+      if (!mesh->vertices()[i].allFinite()) fail("a vertex that is not finite");
     }
     for (const auto& triangle : mesh->triangles()) {
       for (const std::uint32_t index : triangle) {

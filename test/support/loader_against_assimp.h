@@ -21,7 +21,7 @@ inline void expectLoaderGivesAssimpsMesh(const std::string& path, const Eigen::V
   const auto mesh = loader.loadMesh(path, "", scale, {});
   const laser_raycast::mesh_file::MeshData theirs =
       laser_raycast::mesh_file::importMeshInProcess(path, scale);
-  EXPECT_EQ(mesh->vertices(), theirs.vertices);
+  EXPECT_EQ(mesh->vertices().toVector(), theirs.vertices);
   EXPECT_EQ(mesh->triangles(), theirs.triangles);
 }
 

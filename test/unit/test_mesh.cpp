@@ -118,14 +118,35 @@ TEST(Mesh, KeepsOnlyTheWideTreeAndVisitsThroughIt) {
   return ::testing::AssertionSuccess();
 }
 
-// A mesh read from a file has float coordinates, scaled: its slots keep them in float, half the
-// bytes, and give back the same doubles; any other mesh keeps them in double.
+// Whether the mesh gives back exactly the vertices it was built from, bit for bit.
+::testing::AssertionResult holdsTheVertices(const Mesh& mesh,
+                                            const std::vector<Eigen::Vector3d>& vertices) {
+  if (mesh.vertices().size() != vertices.size()) {
+    return ::testing::AssertionFailure()
+           << mesh.vertices().size() << " vertices, not " << vertices.size();
+  }
+  const std::vector<Eigen::Vector3d> all = mesh.vertices().toVector();
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    const Eigen::Vector3d v = mesh.vertices()[i];
+    if (std::memcmp(v.data(), vertices[i].data(), sizeof(double) * 3) != 0 ||
+        std::memcmp(all[i].data(), vertices[i].data(), sizeof(double) * 3) != 0) {
+      return ::testing::AssertionFailure()
+             << "vertex " << i << " is " << v.transpose() << ", not " << vertices[i].transpose();
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// A mesh read from a file has float coordinates, scaled: its vertices and its slots keep them in
+// float, half the bytes, and give back the same doubles; any other mesh keeps them in double.
 TEST(Mesh, KeepsSlotsInFloatOnlyWhenThatLosesNothing) {
   Rng rng(73);
   const Soup s = clusteredSoup(rng, 3000);
   const Mesh doubles(s.vertices, s.triangles);
   EXPECT_FALSE(doubles.bvh().triangleVertices().packed());
+  EXPECT_FALSE(doubles.vertices().packed());
   EXPECT_TRUE(slotsHoldTheVertices(doubles));
+  EXPECT_TRUE(holdsTheVertices(doubles, s.vertices));
 
   // As an STL file gives them (floats), and scaled per axis as a URDF's <mesh scale> does.
   const Eigen::Vector3d scale(0.001, 0.0254, 2.5);
@@ -136,22 +157,38 @@ TEST(Mesh, KeepsSlotsInFloatOnlyWhenThatLosesNothing) {
   }
   const Mesh floats(read, s.triangles);
   EXPECT_TRUE(floats.bvh().triangleVertices().packed());
+  EXPECT_TRUE(floats.vertices().packed());
   EXPECT_TRUE(slotsHoldTheVertices(floats));
+  EXPECT_TRUE(holdsTheVertices(floats, read));
   const Mesh scaled_floats(scaled, s.triangles, BvhConfig{}, scale);
   EXPECT_TRUE(scaled_floats.bvh().triangleVertices().packed());
+  EXPECT_TRUE(scaled_floats.vertices().packed());
   EXPECT_TRUE(slotsHoldTheVertices(scaled_floats));
+  EXPECT_TRUE(holdsTheVertices(scaled_floats, scaled));
 
   // The same vertices with a scale they were not read with, or none that can be: in double, and
-  // the only difference in bytes is the slots' (36 a slot: nine floats instead of nine doubles).
+  // the only difference in bytes is the slots' (36 a slot: nine floats instead of nine doubles)
+  // and the vertices' (12 a vertex).
   for (const Eigen::Vector3d& wrong :
        {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(0.001, 0.0254, 2.6),
         Eigen::Vector3d(0.001, 0, 2.5), Eigen::Vector3d(0.001, -0.0254, 2.5),
         Eigen::Vector3d(0.001, 0.0254, std::nan(""))}) {
     const Mesh unpacked(scaled, s.triangles, BvhConfig{}, wrong);
     EXPECT_FALSE(unpacked.bvh().triangleVertices().packed()) << wrong.transpose();
+    EXPECT_FALSE(unpacked.vertices().packed()) << wrong.transpose();
     EXPECT_TRUE(slotsHoldTheVertices(unpacked));
-    EXPECT_EQ(unpacked.bytes() - scaled_floats.bytes(), 36 * unpacked.bvh().triangleIds().size());
+    EXPECT_TRUE(holdsTheVertices(unpacked, scaled));
+    EXPECT_EQ(unpacked.bytes() - scaled_floats.bytes(),
+              36 * unpacked.bvh().triangleIds().size() + 12 * scaled.size());
   }
+  // A vertex that no triangle uses and that is not a float: the slots are kept in float, the
+  // vertices (which hold it too) in double.
+  std::vector<Eigen::Vector3d> with_unused = scaled;
+  with_unused.emplace_back(0.1, 0.2, 0.3);
+  const Mesh unused_double(with_unused, s.triangles, BvhConfig{}, scale);
+  EXPECT_TRUE(unused_double.bvh().triangleVertices().packed());
+  EXPECT_FALSE(unused_double.vertices().packed());
+  EXPECT_TRUE(holdsTheVertices(unused_double, with_unused));
   // What a mesh holds, counted: 3000 triangles cannot fit in fewer bytes than their slots.
   EXPECT_GT(scaled_floats.bytes(), 36 * 3000u + 12 * 3000u);
   EXPECT_LT(scaled_floats.bytes(), doubles.bytes());

@@ -10,14 +10,14 @@
 #include <optional>
 #include <vector>
 
-#include "laser_raycast/core/mesh.h"
 #include "accel/wide_bvh.h"
-#include "wide_bvh_groups.h"
-#include "wide_ray.h"
+#include "laser_raycast/core/mesh.h"
 #include "mesh_builder.h"
 #include "random.h"
 #include "test_geometry.h"
 #include "triangle_soup.h"
+#include "wide_bvh_groups.h"
+#include "wide_ray.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -154,7 +154,8 @@ std::optional<MeshHit> wideHit(const core::Mesh& mesh, const core::Ray& ray) {
 template <TriangleMethod M>
 void expectLikeBruteForce(const core::Mesh& mesh, const core::Ray& ray) {
   const auto wide = wideHit<M>(mesh, ray);
-  const auto brute = core::bruteForceClosestHit(M, mesh.vertices(), mesh.triangles(), ray, false);
+  const auto brute =
+      core::bruteForceClosestHit(M, mesh.vertices().toVector(), mesh.triangles(), ray, false);
   ASSERT_EQ(wide.has_value(), brute.has_value())
       << core::toString(M) << " origin " << ray.origin.transpose() << " dir "
       << ray.dir.transpose();

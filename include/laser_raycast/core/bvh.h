@@ -32,6 +32,16 @@ inline float keptFloat(double x) {
   return f;
 }
 
+// Whether coordinate c is, bit for bit, T(float(c / s)) * s (s: its axis' scale, positive and
+// finite): a mesh file's float coordinate scaled as the URDF says. If so, *f is that float, from
+// which T(*f) * s gives c back exactly.
+template <typename T>
+inline bool floatTimesScale(T c, T s, float* f) {
+  *f = keptFloat(c / s);
+  const T back = static_cast<T>(*f) * s;
+  return std::memcmp(&back, &c, sizeof(T)) == 0;
+}
+
 // The vertices of a BVH's triangle slots, copied in slot order so that a leaf's triangles are the
 // next bytes. For T = double they can be kept in float (36 bytes a slot instead of 72): pack(scale)
 // does so when every coordinate is exactly a float times that axis' scale (a mesh file's float
@@ -73,11 +83,7 @@ class SlotVertices {
     for (std::size_t slot = 0; slot < full_.size(); ++slot) {
       for (int k = 0; k < 3; ++k) {
         for (int a = 0; a < 3; ++a) {
-          const T c = full_[slot][k][a];
-          const float f = keptFloat(c / scale[a]);
-          const T back = static_cast<T>(f) * scale[a];
-          if (std::memcmp(&back, &c, sizeof(T)) != 0) return false;
-          packed[slot][3 * k + a] = f;
+          if (!floatTimesScale(full_[slot][k][a], scale[a], &packed[slot][3 * k + a])) return false;
         }
       }
     }

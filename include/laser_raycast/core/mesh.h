@@ -3,11 +3,13 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "laser_raycast/core/bvh.h"
@@ -18,6 +20,39 @@ namespace core {
 
 class WideBvh;
 
+// A mesh's vertices, kept in float (12 bytes a vertex instead of 24) when every coordinate is
+// exactly a float times its axis' scale (floatTimesScale: a mesh file's float coordinates, scaled
+// as the URDF says); operator[] gives back the same doubles, bit for bit, either way.
+class MeshVertices {
+ public:
+  MeshVertices() = default;
+  explicit MeshVertices(std::vector<Eigen::Vector3d> vertices) : full_(std::move(vertices)) {}
+
+  std::size_t size() const { return packed_.empty() ? full_.size() : packed_.size(); }
+  bool empty() const { return size() == 0; }
+  Eigen::Vector3d operator[](std::size_t i) const {
+    if (packed_.empty()) return full_[i];
+    const std::array<float, 3>& f = packed_[i];
+    return {static_cast<double>(f[0]) * scale_[0], static_cast<double>(f[1]) * scale_[1],
+            static_cast<double>(f[2]) * scale_[2]};
+  }
+  // Every vertex, in double.
+  std::vector<Eigen::Vector3d> toVector() const;
+  bool packed() const { return !packed_.empty(); }
+  // Keeps the vertices in float if every coordinate is a float times scale (positive and finite
+  // on each axis); returns whether they are.
+  bool pack(const Eigen::Vector3d& scale);
+  // Bytes the vertices take (what the vectors hold).
+  std::size_t bytes() const {
+    return full_.capacity() * sizeof(Eigen::Vector3d) + packed_.capacity() * sizeof(packed_[0]);
+  }
+
+ private:
+  std::vector<Eigen::Vector3d> full_;
+  std::vector<std::array<float, 3>> packed_;
+  Eigen::Vector3d scale_ = Eigen::Vector3d::Ones();
+};
+
 class Mesh {
  public:
   // Throws std::invalid_argument naming the problem: no triangles, a non-finite vertex (with its
@@ -25,8 +60,9 @@ class Mesh {
   // triangles() but left out of the BVH; a mesh whose triangles are all degenerate is rejected.
   // float_scale: the per-axis scale the vertices were read with if they came from a file's float
   // coordinates (an STL's, scaled as the URDF says). When every vertex is exactly such a float
-  // times it, the BVH's slots keep their vertices in float, half the bytes, giving back the same
-  // doubles (SlotVertices::pack); otherwise, or for any other scale, in double.
+  // times it, the vertices and the BVH's slots are kept in float, half the bytes, giving back the
+  // same doubles (MeshVertices::pack, SlotVertices::pack); otherwise, or for any other scale, in
+  // double.
   Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> triangles,
        const BvhConfig& bvh_config = {},
        const Eigen::Vector3d& float_scale = Eigen::Vector3d::Ones());
@@ -35,7 +71,7 @@ class Mesh {
   Mesh& operator=(const Mesh&) = delete;
   ~Mesh();
 
-  const std::vector<Eigen::Vector3d>& vertices() const { return vertices_; }
+  const MeshVertices& vertices() const { return vertices_; }
   const std::vector<TriangleIndices>& triangles() const { return triangles_; }
   // The triangles' BVH slots (triangleVertices, triangleIds) and bounds. Its binary tree is
   // released once the wide BVH is built from it (Bvh::releaseTree): walk the mesh's boxes with
@@ -92,7 +128,7 @@ class Mesh {
  private:
   void findClosedComponents(const std::vector<std::uint32_t>& component);
 
-  std::vector<Eigen::Vector3d> vertices_;
+  MeshVertices vertices_;
   std::vector<TriangleIndices> triangles_;
   Aabb bounds_;
   Eigen::Vector3d sphere_center_;

@@ -11,38 +11,92 @@
 
 namespace laser_raycast {
 namespace core {
+namespace {
+
+// Union-find over vertex indices: triangles sharing a vertex index are in one component. Only
+// shared indices count (not equal positions): they are what makes a shared edge watertight.
+std::vector<std::uint32_t> labelComponents(std::size_t vertex_count,
+                                           const std::vector<TriangleIndices>& triangles) {
+  std::vector<std::uint32_t> parent(vertex_count);
+  for (std::uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
+  auto find = [&](std::uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const TriangleIndices& tri : triangles) {
+    for (int k = 1; k < 3; ++k) {
+      const std::uint32_t a = find(tri[0]), b = find(tri[k]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<std::uint32_t> number(vertex_count, std::numeric_limits<std::uint32_t>::max());
+  std::vector<std::uint32_t> component(triangles.size());
+  std::uint32_t count = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    std::uint32_t& n = number[find(triangles[t][0])];
+    if (n == std::numeric_limits<std::uint32_t>::max()) n = count++;
+    component[t] = n;
+  }
+  return component;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> MeshVertices::toVector() const {
+  if (!packed()) return full_;
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(size());
+  for (std::size_t i = 0; i < size(); ++i) out.push_back((*this)[i]);
+  return out;
+}
+
+bool MeshVertices::pack(const Eigen::Vector3d& scale) {
+  if (full_.empty() || packed()) return packed();
+  if (!(scale.array() > 0).all() || !scale.allFinite()) return false;
+  std::vector<std::array<float, 3>> packed(full_.size());
+  for (std::size_t i = 0; i < full_.size(); ++i) {
+    for (int a = 0; a < 3; ++a) {
+      if (!floatTimesScale(full_[i][a], scale[a], &packed[i][a])) return false;
+    }
+  }
+  packed_ = std::move(packed);
+  scale_ = scale;
+  std::vector<Eigen::Vector3d>().swap(full_);
+  return true;
+}
 
 Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> triangles,
            const BvhConfig& bvh_config, const Eigen::Vector3d& float_scale)
-    : vertices_(std::move(vertices)), triangles_(std::move(triangles)) {
+    : triangles_(std::move(triangles)) {
   if (triangles_.empty()) throw std::invalid_argument("mesh has no triangles");
-  for (std::size_t i = 0; i < vertices_.size(); ++i) {
-    if (!vertices_[i].allFinite()) {
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    if (!vertices[i].allFinite()) {
       std::ostringstream msg;
-      msg << "mesh vertex " << i << " is not finite (" << vertices_[i].transpose() << ")";
+      msg << "mesh vertex " << i << " is not finite (" << vertices[i].transpose() << ")";
       throw std::invalid_argument(msg.str());
     }
   }
   for (std::size_t i = 0; i < triangles_.size(); ++i) {
     for (const std::uint32_t v : triangles_[i]) {
-      if (v >= vertices_.size()) {
+      if (v >= vertices.size()) {
         std::ostringstream msg;
         msg << "mesh triangle " << i << " refers to vertex " << v << " but there are only "
-            << vertices_.size() << " vertices";
+            << vertices.size() << " vertices";
         throw std::invalid_argument(msg.str());
       }
     }
   }
-  const std::vector<std::uint32_t> component = components();
+  const std::vector<std::uint32_t> component = labelComponents(vertices.size(), triangles_);
   component_count_ =
       component.empty() ? 0 : *std::max_element(component.begin(), component.end()) + 1;
-  bvh_ = Bvh::build(vertices_, triangles_, bvh_config, component);
+  bvh_ = Bvh::build(vertices, triangles_, bvh_config, component);
   if (bvh_.empty()) {
     std::ostringstream msg;
     msg << "mesh has " << triangles_.size() << " triangles but all of them have zero area";
     throw std::invalid_argument(msg.str());
   }
   bvh_.packSlots(float_scale);
+  vertices_ = MeshVertices(std::move(vertices));
   // Bounds and sphere over the vertices that triangles use (marked first, then read in order).
   std::vector<char> used(vertices_.size(), 0);
   for (const TriangleIndices& tri : triangles_) {
@@ -66,6 +120,7 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
   // Everything walks the wide BVH from here on.
   bvh_.releaseTree();
   findClosedComponents(component);
+  vertices_.pack(float_scale);
 }
 
 void Mesh::visit(const std::function<bool(const Aabb&)>& descend,
@@ -76,8 +131,7 @@ void Mesh::visit(const std::function<bool(const Aabb&)>& descend,
 Mesh::~Mesh() = default;
 
 std::size_t Mesh::bytes() const {
-  return vertices_.capacity() * sizeof(Eigen::Vector3d) +
-         triangles_.capacity() * sizeof(TriangleIndices) +
+  return vertices_.bytes() + triangles_.capacity() * sizeof(TriangleIndices) +
          closed_components_.capacity() * sizeof(ClosedComponent) +
          slot_closed_.capacity() * sizeof(std::uint32_t) + bvh_.bytes() + wide_->bytes();
 }
@@ -164,30 +218,8 @@ void Mesh::findClosedComponents(const std::vector<std::uint32_t>& component) {
     slot_closed_.push_back(closed_number[component[id]]);
 }
 
-// Union-find over vertex indices: triangles sharing a vertex index are in one component. Only
-// shared indices count (not equal positions): they are what makes a shared edge watertight.
 std::vector<std::uint32_t> Mesh::components() const {
-  std::vector<std::uint32_t> parent(vertices_.size());
-  for (std::uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
-  auto find = [&](std::uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const TriangleIndices& tri : triangles_) {
-    for (int k = 1; k < 3; ++k) {
-      const std::uint32_t a = find(tri[0]), b = find(tri[k]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-  }
-  std::vector<std::uint32_t> number(vertices_.size(), std::numeric_limits<std::uint32_t>::max());
-  std::vector<std::uint32_t> component(triangles_.size());
-  std::uint32_t count = 0;
-  for (std::size_t t = 0; t < triangles_.size(); ++t) {
-    std::uint32_t& n = number[find(triangles_[t][0])];
-    if (n == std::numeric_limits<std::uint32_t>::max()) n = count++;
-    component[t] = n;
-  }
-  return component;
+  return labelComponents(vertices_.size(), triangles_);
 }
 
 Eigen::Vector3d Mesh::normal(std::uint32_t triangle) const {
