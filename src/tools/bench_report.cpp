@@ -54,7 +54,8 @@ void writeMemoryTable(std::ostream& out, const std::vector<MemoryRow>& memory) {
   out << "\n## Memory per triangle\n\n";
   out << "Each scene's distinct meshes, each once however many bodies instance it, in its own "
          "frame (primitives hold no triangles and are left out); ours: core::Mesh::bytes(), its "
-         "vertices in double, triangles, components, BVH slots and wide nodes";
+         "vertices (in float where they are a file's floats), triangles, closed components, BVH "
+         "slots and wide nodes";
   if (embree) {
     out << "; Embree: the bytes its device's memory monitor counts for the mesh built alone as "
            "embree_default builds the soup, its BVH with triangle leaves plus its float vertex "
