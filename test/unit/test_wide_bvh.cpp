@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <tuple>
 #include <vector>
 
 #include "accel/wide_bvh.h"
@@ -166,6 +167,49 @@ void expectLikeBruteForce(const core::Mesh& mesh, const core::Ray& ray) {
                                                   mesh.vertices()[t[2]]);
     ASSERT_TRUE(again.has_value());
     EXPECT_EQ(again->t, wide->t);
+  }
+}
+
+// The collapse spreads a small subtree over its parent's free slots where that costs less than a
+// node of its own: on a terrain and a wood of cylinders (what the bench's scenes are made of) the
+// nodes hold over three children on average. (The greedy collapse it replaced, which opened the
+// largest child until four, held 3.13 on this terrain and 2.98 on this wood; 3.17 and 3.26 now.)
+TEST(WideBvh, NodesAreWellFilled) {
+  std::vector<Eigen::Vector3d> terrain;
+  std::vector<core::TriangleIndices> cells;
+  const int n = 100;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) {
+      terrain.emplace_back(i * 0.5, j * 0.5, 0.3 * std::sin(i * 0.37) * std::cos(j * 0.23));
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const auto v = static_cast<std::uint32_t>(i * (n + 1) + j);
+      cells.push_back({v, v + n + 1, v + n + 2});
+      cells.push_back({v, v + n + 2, v + 1});
+    }
+  }
+  std::vector<Eigen::Vector3d> wood;
+  std::vector<core::TriangleIndices> trunks;
+  Rng rng(11);
+  for (int k = 0; k < 40; ++k) {
+    const auto trunk = makePrism(circle(24, uniform(rng, 0.1, 0.4)), steps(0, 10, 20));
+    const Eigen::Vector3d at(uniform(rng, -20, 20), uniform(rng, -20, 20), 0);
+    const auto base = static_cast<std::uint32_t>(wood.size());
+    for (const auto& v : trunk.vertices) wood.push_back(v + at);
+    for (auto t : trunk.triangles) trunks.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  for (const auto& [vertices, triangles, least] :
+       {std::tuple{terrain, cells, 3.05}, std::tuple{wood, trunks, 3.15}}) {
+    const core::Mesh mesh(vertices, triangles);
+    const WideBvh& w = mesh.wideBvh();
+    std::size_t children = 0;
+    for (const WideBvh::Node& node : w.nodes()) {
+      for (int k = 0; k < WideBvh::kWidth; ++k) children += node.index[k] != WideBvh::kEmpty;
+    }
+    const double fill = static_cast<double>(children) / w.nodes().size();
+    EXPECT_GT(fill, least) << triangles.size() << " triangles, " << w.nodes().size() << " nodes";
   }
 }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstddef>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 namespace laser_raycast {
 namespace core {
@@ -13,10 +15,6 @@ namespace {
 struct Gathered {
   Bvh::Child child;
   float lo[3], hi[3];
-  float halfArea() const {
-    const float x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
-    return x * y + y * z + z * x;
-  }
 };
 
 }  // namespace
@@ -33,6 +31,7 @@ class WideBvh::Builder {
   Builder(WideBvh* out, const Bvh& bvh, const std::vector<std::uint32_t>& slot_group)
       : out_(*out), binary_(bvh.nodes()), slot_group_(slot_group), span_(binary_.size()) {
     computeSpans();
+    computeCosts();
   }
 
   // The binary tree's depth is bounded (BvhConfig::max_depth), so the recursion is too.
@@ -101,34 +100,107 @@ class WideBvh::Builder {
     return std::nullopt;
   }
 
-  // The inner node's children, opening the largest inner one until there are kWidth or only
-  // leaves.
-  std::vector<Gathered> gather(const Bvh::Child& inner) const {
-    std::vector<Gathered> gathered;
-    auto open = [&](const Bvh::Child& c) {
-      const auto& node = binary_[c.index];
-      for (int k = 0; k < 2; ++k) {
-        Gathered g;
-        g.child = node.child[k];
-        for (int a = 0; a < 3; ++a) {
-          g.lo[a] = node.lo[k][a];
-          g.hi[a] = node.hi[k][a];
-        }
-        gathered.push_back(g);
-      }
-    };
-    open(inner);
-    while (static_cast<int>(gathered.size()) < kWidth) {
-      int best = -1;
-      for (int k = 0; k < static_cast<int>(gathered.size()); ++k) {
-        if (asLeaf(gathered[k].child)) continue;
-        if (best < 0 || gathered[k].halfArea() > gathered[best].halfArea()) best = k;
-      }
-      if (best < 0) break;
-      const Bvh::Child opened = gathered[best].child;
-      gathered.erase(gathered.begin() + best);
-      open(opened);
+  // How a binary subtree is spread over a wide node's child slots, chosen by surface area cost
+  // (the expected cost of a ray through the subtree's box: a wide node visited costs one, a leaf
+  // its triangles, each weighted by its box's area) over every way to collapse it, bottom up (a
+  // dynamic programme over the binary nodes, as for compressed wide BVHs on GPUs). Taking a small
+  // subtree's children into its parent's free slots saves the node it would have been: the greedy
+  // collapse this replaced (open the largest child until four) left 37% of the nodes of a
+  // height field and of a forest of trunks with two children only.
+  //
+  // For binary inner node n (not taken as a leaf) and k = 2..4: spread_[n][k] is the least cost of
+  // n's subtree spread over k slots (its two children sharing them), and split_[n][k] how many of
+  // them its first child takes. own_[n] is its cost as one slot: a wide node of its own.
+  struct Cost {
+    double spread[kWidth + 1];
+    std::int8_t split[kWidth + 1];
+    double own;
+  };
+
+  static float halfArea(const float lo[3], const float hi[3]) {
+    const float x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
+    return x * y + y * z + z * x;
+  }
+
+  // The least cost of child k of binary node n in at most `slots` slots, and how many it uses.
+  std::pair<double, int> childCost(std::uint32_t n, int k, int slots) const {
+    const Bvh::Child c = binary_[n].child[k];
+    const double area = halfArea(binary_[n].lo[k], binary_[n].hi[k]);
+    if (const auto leaf = asLeaf(c)) return {area * leaf->count, 1};
+    const Cost& sub = cost_[c.index];
+    std::pair<double, int> best{area * sub.own, 1};
+    for (int j = 2; j <= slots; ++j) {
+      if (area * sub.spread[j] < best.first) best = {area * sub.spread[j], j};
     }
+    return best;
+  }
+
+  // Children come after their parent, so one backward pass sees every child before its parent.
+  // Costs are relative to the node's own box: a child's are scaled by its area over the parent's
+  // (the parent's area cancels, so the child's area alone is used, and each node's costs are
+  // divided by its own area to keep them at the scale of one).
+  void computeCosts() {
+    cost_.resize(binary_.size());
+    for (std::size_t n = binary_.size(); n-- > 0;) {
+      Cost& c = cost_[n];
+      float lo[3], hi[3];
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(binary_[n].lo[0][a], binary_[n].lo[1][a]);
+        hi[a] = std::max(binary_[n].hi[0][a], binary_[n].hi[1][a]);
+      }
+      const double area = std::max(halfArea(lo, hi), std::numeric_limits<float>::min());
+      double best_spread = std::numeric_limits<double>::infinity();
+      for (int k = 2; k <= kWidth; ++k) {
+        c.spread[k] = std::numeric_limits<double>::infinity();
+        c.split[k] = 1;
+        for (int j = 1; j < k; ++j) {
+          const double total = childCost(static_cast<std::uint32_t>(n), 0, j).first +
+                               childCost(static_cast<std::uint32_t>(n), 1, k - j).first;
+          if (total < c.spread[k]) {
+            c.spread[k] = total;
+            c.split[k] = static_cast<std::int8_t>(j);
+          }
+        }
+        c.spread[k] /= area;
+        best_spread = std::min(best_spread, c.spread[k]);
+      }
+      c.own = 1 + best_spread;
+    }
+  }
+
+  // Child k of binary node n spread over at most `slots` slots, appended to out.
+  void spread(std::uint32_t n, int k, int slots, std::vector<Gathered>* out) const {
+    const int used = childCost(n, k, slots).second;
+    const Bvh::Child c = binary_[n].child[k];
+    if (used == 1) {
+      Gathered g;
+      g.child = c;
+      for (int a = 0; a < 3; ++a) {
+        g.lo[a] = binary_[n].lo[k][a];
+        g.hi[a] = binary_[n].hi[k][a];
+      }
+      out->push_back(g);
+      return;
+    }
+    spreadNode(c.index, used, out);
+  }
+  // Binary inner node n spread over exactly `slots` slots (2 to kWidth).
+  void spreadNode(std::uint32_t n, int slots, std::vector<Gathered>* out) const {
+    const int first = cost_[n].split[slots];
+    spread(n, 0, first, out);
+    spread(n, 1, slots - first, out);
+  }
+
+  // A wide node's children for binary inner node n: its subtree spread over the number of slots
+  // that costs least.
+  std::vector<Gathered> gather(const Bvh::Child& inner) const {
+    const Cost& c = cost_[inner.index];
+    int best = 2;
+    for (int k = 3; k <= kWidth; ++k) {
+      if (c.spread[k] < c.spread[best]) best = k;
+    }
+    std::vector<Gathered> gathered;
+    spreadNode(inner.index, best, &gathered);
     return gathered;
   }
 
@@ -145,6 +217,7 @@ class WideBvh::Builder {
   const std::vector<Bvh::Node>& binary_;
   const std::vector<std::uint32_t>& slot_group_;
   std::vector<Span> span_;
+  std::vector<Cost> cost_;
 };
 
 WideBvh::WideBvh(const Bvh& bvh, const std::vector<std::uint32_t>& slot_group) : bvh_(&bvh) {
