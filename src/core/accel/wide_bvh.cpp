@@ -108,9 +108,11 @@ class WideBvh::Builder {
   // collapse this replaced (open the largest child until four) left 37% of the nodes of a
   // height field and of a forest of trunks with two children only.
   //
-  // For binary inner node n (not taken as a leaf) and k = 2..4: spread_[n][k] is the least cost of
-  // n's subtree spread over k slots (its two children sharing them), and split_[n][k] how many of
-  // them its first child takes. own_[n] is its cost as one slot: a wide node of its own.
+  // For binary inner node n and k = 2..4: cost_[n].spread[k] is the least cost of n's subtree
+  // spread over k slots (its two children sharing them), and cost_[n].split[k] how many of them
+  // its first child takes; cost_[n].own is its cost in one slot, a wide node of its own. Each is
+  // per unit of n's box's area (the chance that a ray through n's box enters a child's is the
+  // ratio of their areas).
   struct Cost {
     double spread[kWidth + 1];
     std::int8_t split[kWidth + 1];
@@ -135,10 +137,9 @@ class WideBvh::Builder {
     return best;
   }
 
-  // Children come after their parent, so one backward pass sees every child before its parent.
-  // Costs are relative to the node's own box: a child's are scaled by its area over the parent's
-  // (the parent's area cancels, so the child's area alone is used, and each node's costs are
-  // divided by its own area to keep them at the scale of one).
+  // Children come after their parent, so one backward pass sees every child before its parent. A
+  // child's cost, per unit of its own area, is multiplied by that area (childCost), and the sum
+  // over the node's children divided by the node's area.
   void computeCosts() {
     cost_.resize(binary_.size());
     for (std::size_t n = binary_.size(); n-- > 0;) {
