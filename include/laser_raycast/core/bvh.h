@@ -32,6 +32,12 @@ inline float keptFloat(double x) {
   return f;
 }
 
+// Whether a per-axis scale can be one that float coordinates were read with: positive and finite.
+template <typename T>
+inline bool packableScale(const Vec3<T>& scale) {
+  return (scale.array() > 0).all() && scale.allFinite();
+}
+
 // Whether coordinate c is, bit for bit, T(float(c / s)) * s (s: its axis' scale, positive and
 // finite): a mesh file's float coordinate scaled as the URDF says. If so, *f is that float, from
 // which T(*f) * s gives c back exactly.
@@ -78,7 +84,7 @@ class SlotVertices {
   // s_a (scale: s, positive and finite); returns whether they are. A no-op for T = float.
   bool pack(const Vec3<T>& scale) {
     if (sizeof(T) == sizeof(float) || full_.empty() || packed()) return packed();
-    if (!(scale.array() > 0).all() || !scale.allFinite()) return false;
+    if (!packableScale(scale)) return false;
     std::vector<std::array<float, 9>> packed(full_.size());
     for (std::size_t slot = 0; slot < full_.size(); ++slot) {
       for (int k = 0; k < 3; ++k) {

@@ -110,13 +110,15 @@ class WideBvh::Builder {
   //
   // For binary inner node n and k = 2..4: cost_[n].spread[k] is the least cost of n's subtree
   // spread over k slots (its two children sharing them), and cost_[n].split[k] how many of them
-  // its first child takes; cost_[n].own is its cost in one slot, a wide node of its own. Each is
-  // per unit of n's box's area (the chance that a ray through n's box enters a child's is the
-  // ratio of their areas).
+  // its first child takes; cost_[n].best is the k that costs least (the fewest slots among equal
+  // costs), and 1 + spread[best] n's cost in one slot, a wide node of its own. Each is per unit of
+  // n's box's area (the chance that a ray through n's box enters a child's is the ratio of their
+  // areas).
   struct Cost {
     double spread[kWidth + 1];
     std::int8_t split[kWidth + 1];
-    double own;
+    std::int8_t best;
+    double own() const { return 1 + spread[best]; }
   };
 
   static float halfArea(const float lo[3], const float hi[3]) {
@@ -130,7 +132,7 @@ class WideBvh::Builder {
     const double area = halfArea(binary_[n].lo[k], binary_[n].hi[k]);
     if (const auto leaf = asLeaf(c)) return {area * leaf->count, 1};
     const Cost& sub = cost_[c.index];
-    std::pair<double, int> best{area * sub.own, 1};
+    std::pair<double, int> best{area * sub.own(), 1};
     for (int j = 2; j <= slots; ++j) {
       if (area * sub.spread[j] < best.first) best = {area * sub.spread[j], j};
     }
@@ -149,8 +151,10 @@ class WideBvh::Builder {
         lo[a] = std::min(binary_[n].lo[0][a], binary_[n].lo[1][a]);
         hi[a] = std::max(binary_[n].hi[0][a], binary_[n].hi[1][a]);
       }
+      // A box of no area (a point or a segment) would divide by 0: the floor changes only which
+      // tree is built, never what a walk finds.
       const double area = std::max(halfArea(lo, hi), std::numeric_limits<float>::min());
-      double best_spread = std::numeric_limits<double>::infinity();
+      c.best = 2;
       for (int k = 2; k <= kWidth; ++k) {
         c.spread[k] = std::numeric_limits<double>::infinity();
         c.split[k] = 1;
@@ -163,9 +167,8 @@ class WideBvh::Builder {
           }
         }
         c.spread[k] /= area;
-        best_spread = std::min(best_spread, c.spread[k]);
+        if (c.spread[k] < c.spread[c.best]) c.best = static_cast<std::int8_t>(k);
       }
-      c.own = 1 + best_spread;
     }
   }
 
@@ -195,13 +198,8 @@ class WideBvh::Builder {
   // A wide node's children for binary inner node n: its subtree spread over the number of slots
   // that costs least.
   std::vector<Gathered> gather(const Bvh::Child& inner) const {
-    const Cost& c = cost_[inner.index];
-    int best = 2;
-    for (int k = 3; k <= kWidth; ++k) {
-      if (c.spread[k] < c.spread[best]) best = k;
-    }
     std::vector<Gathered> gathered;
-    spreadNode(inner.index, best, &gathered);
+    spreadNode(inner.index, cost_[inner.index].best, &gathered);
     return gathered;
   }
 

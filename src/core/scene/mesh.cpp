@@ -15,8 +15,10 @@ namespace {
 
 // Union-find over vertex indices: triangles sharing a vertex index are in one component. Only
 // shared indices count (not equal positions): they are what makes a shared edge watertight.
+// count (if not null): how many there are.
 std::vector<std::uint32_t> labelComponents(std::size_t vertex_count,
-                                           const std::vector<TriangleIndices>& triangles) {
+                                           const std::vector<TriangleIndices>& triangles,
+                                           std::uint32_t* count = nullptr) {
   std::vector<std::uint32_t> parent(vertex_count);
   for (std::uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
   auto find = [&](std::uint32_t v) {
@@ -31,13 +33,67 @@ std::vector<std::uint32_t> labelComponents(std::size_t vertex_count,
   }
   std::vector<std::uint32_t> number(vertex_count, std::numeric_limits<std::uint32_t>::max());
   std::vector<std::uint32_t> component(triangles.size());
-  std::uint32_t count = 0;
+  std::uint32_t next = 0;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     std::uint32_t& n = number[find(triangles[t][0])];
-    if (n == std::numeric_limits<std::uint32_t>::max()) n = count++;
+    if (n == std::numeric_limits<std::uint32_t>::max()) n = next++;
     component[t] = n;
   }
+  if (count) *count = next;
   return component;
+}
+
+// Which of the count components are closed: every edge between two of their vertex indices used by
+// exactly two of their triangles, once in each direction. component: each triangle's;
+// vertex_component: each used vertex's.
+std::vector<char> closedByEdges(std::size_t vertex_count,
+                                const std::vector<TriangleIndices>& triangles,
+                                const std::vector<std::uint32_t>& component,
+                                const std::vector<std::uint32_t>& vertex_component,
+                                std::uint32_t count) {
+  // A closed surface wound one way has every edge exactly twice, once each way. Each edge between
+  // two vertices is listed under its lower vertex as (higher << 1 | whether it runs from the
+  // higher); sorted, a vertex's list holds each of its edges' uses side by side. An edge's vertices
+  // are in its triangle's component (components join the triangles that share a vertex), so the
+  // vertex tells which component the edge decides.
+  // Vertex indices too wide for the packed edges: taken as open (back faces are tested, which costs
+  // time, never a range).
+  if (vertex_count > (std::size_t{1} << 31)) return std::vector<char>(count, 0);
+  std::vector<char> closed(count, 1);
+  std::vector<std::uint32_t> start(vertex_count + 1, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t from = triangles[t][k], to = triangles[t][(k + 1) % 3];
+      if (from == to) {
+        closed[component[t]] = 0;
+        continue;
+      }
+      ++start[std::min(from, to) + 1];
+    }
+  }
+  for (std::size_t v = 0; v < vertex_count; ++v) start[v + 1] += start[v];
+  std::vector<std::uint32_t> edges(start.back()), next(start.begin(), start.end() - 1);
+  for (const TriangleIndices& tri : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t from = tri[k], to = tri[(k + 1) % 3];
+      if (from == to) continue;
+      edges[next[std::min(from, to)]++] = std::max(from, to) << 1 | (from > to ? 1 : 0);
+    }
+  }
+  for (std::size_t v = 0; v < vertex_count; ++v) {
+    const auto first = edges.begin() + start[v], last = edges.begin() + start[v + 1];
+    std::sort(first, last);
+    for (auto i = first; i != last;) {
+      const std::uint32_t higher = *i >> 1;
+      auto end = i + 1;
+      while (end != last && *end >> 1 == higher) ++end;
+      // Sorted, the one use each way is (higher << 1 | 0) then (higher << 1 | 1).
+      const bool once_each_way = end - i == 2 && (i[0] & 1) == 0 && (i[1] & 1) == 1;
+      if (!once_each_way) closed[vertex_component[v]] = 0;
+      i = end;
+    }
+  }
+  return closed;
 }
 
 }  // namespace
@@ -52,7 +108,7 @@ std::vector<Eigen::Vector3d> MeshVertices::toVector() const {
 
 bool MeshVertices::pack(const Eigen::Vector3d& scale) {
   if (full_.empty() || packed()) return packed();
-  if (!(scale.array() > 0).all() || !scale.allFinite()) return false;
+  if (!packableScale(scale)) return false;
   std::vector<std::array<float, 3>> packed(full_.size());
   for (std::size_t i = 0; i < full_.size(); ++i) {
     for (int a = 0; a < 3; ++a) {
@@ -86,9 +142,8 @@ Mesh::Mesh(std::vector<Eigen::Vector3d> vertices, std::vector<TriangleIndices> t
       }
     }
   }
-  const std::vector<std::uint32_t> component = labelComponents(vertices.size(), triangles_);
-  component_count_ =
-      component.empty() ? 0 : *std::max_element(component.begin(), component.end()) + 1;
+  const std::vector<std::uint32_t> component =
+      labelComponents(vertices.size(), triangles_, &component_count_);
   bvh_ = Bvh::build(vertices, triangles_, bvh_config, component);
   if (bvh_.empty()) {
     std::ostringstream msg;
@@ -147,51 +202,8 @@ void Mesh::findClosedComponents(const std::vector<std::uint32_t>& component) {
   for (std::size_t v = 0; v < vertices_.size(); ++v) {
     if (vertex_component[v] != kUnused) component_bounds[vertex_component[v]].grow(vertices_[v]);
   }
-  // A closed surface wound one way has every edge exactly twice, once each way. Each edge between
-  // two vertices is listed under its lower vertex as (higher << 1 | whether it runs from the
-  // higher); sorted, a vertex's list holds each of its edges' uses side by side. An edge's vertices
-  // are in its triangle's component (components join the triangles that share a vertex), so the
-  // vertex tells which component the edge decides.
-  std::vector<char> closed(component_count_, 1);
-  if (vertices_.size() > (std::size_t{1} << 31)) {
-    // Vertex indices too wide for the packed edges: taken as open (back faces are tested, which
-    // costs time, never a range).
-    closed.assign(component_count_, 0);
-  } else {
-    std::vector<std::uint32_t> start(vertices_.size() + 1, 0);
-    for (std::size_t t = 0; t < triangles_.size(); ++t) {
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t from = triangles_[t][k], to = triangles_[t][(k + 1) % 3];
-        if (from == to) {
-          closed[component[t]] = 0;
-          continue;
-        }
-        ++start[std::min(from, to) + 1];
-      }
-    }
-    for (std::size_t v = 0; v < vertices_.size(); ++v) start[v + 1] += start[v];
-    std::vector<std::uint32_t> edges(start.back()), next(start.begin(), start.end() - 1);
-    for (const TriangleIndices& tri : triangles_) {
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t from = tri[k], to = tri[(k + 1) % 3];
-        if (from == to) continue;
-        edges[next[std::min(from, to)]++] = std::max(from, to) << 1 | (from > to ? 1 : 0);
-      }
-    }
-    for (std::size_t v = 0; v < vertices_.size(); ++v) {
-      const auto first = edges.begin() + start[v], last = edges.begin() + start[v + 1];
-      std::sort(first, last);
-      for (auto i = first; i != last;) {
-        const std::uint32_t higher = *i >> 1;
-        auto end = i + 1;
-        while (end != last && *end >> 1 == higher) ++end;
-        // Sorted, the one use each way is (higher << 1 | 0) then (higher << 1 | 1).
-        const bool once_each_way = end - i == 2 && (i[0] & 1) == 0 && (i[1] & 1) == 1;
-        if (!once_each_way) closed[vertex_component[v]] = 0;
-        i = end;
-      }
-    }
-  }
+  const std::vector<char> closed =
+      closedByEdges(vertices_.size(), triangles_, component, vertex_component, component_count_);
   // The orientation: the sign of the enclosed volume (six times it: the tetrahedra from a point of
   // the component's bounds to each triangle), kept only if it stands clear of the rounding.
   std::vector<double> volume(component_count_, 0.0), magnitude(component_count_, 0.0);
