@@ -157,6 +157,8 @@ TEST(RecordedRanges, EveryCaseHasTheBitsItWasRecordedWith) {
   if (const char* record = std::getenv("LASER_RAYCAST_RECORD_RANGES")) {  // write, then compare
     std::ofstream out(record);
     ASSERT_TRUE(out) << "cannot write " << record;
+    out << "# Written by test_recorded_ranges with LASER_RAYCAST_RECORD_RANGES (see that test): "
+           "case, hash, beams, hits.\n";
     for (const auto& [name, r] : now) out << line(name, r) << '\n';
   }
   const char* record = std::getenv("LASER_RAYCAST_RECORD_RANGES");

@@ -15,12 +15,11 @@ namespace {
 void addMeshSegments(const Mesh& mesh, int body, const Eigen::Isometry3d& frame_from_mesh,
                      const ScanPlane& plane, std::vector<KeptSlice::Item>* items) {
   const auto& slots = mesh.bvh().triangleVertices();
+  const MeshCut cut(plane, frame_from_mesh);
   mesh.wideBvh().visit([&](const Aabb& box) { return plane.mayMeet(frame_from_mesh, box); },
                        [&](std::uint32_t slot) {
-                         Eigen::Vector3d v[3];
-                         for (int k = 0; k < 3; ++k) v[k] = frame_from_mesh * slots[slot][k];
                          Eigen::Vector2d p, q;
-                         if (!plane.crossing(v, &p, &q) || p == q) return;
+                         if (!cut.crossing(slots[slot], &p, &q) || p == q) return;
                          items->push_back(KeptSlice::Item{p, q, body, slot});
                        });
 }
@@ -53,7 +52,7 @@ void addPrimitive(const Scene& scene, int body, const ScanPlane& plane,
 }  // namespace
 
 std::unique_ptr<KeptSlice> KeptSlice::build(const Scene& scene, const SceneIndex::Group& group,
-                                              const ScanPlane& plane) {
+                                            const ScanPlane& plane) {
   auto slice = std::make_unique<KeptSlice>();
   for (const int body : group.bodies) {
     const Body& b = scene.bodies()[body];
@@ -107,7 +106,7 @@ std::size_t KeptSlices::KeyHash::operator()(const Key& k) const {
 }
 
 const KeptSlice* KeptSlices::find(const Scene& scene, const SceneIndex::Group& group,
-                                        const ScanPlane& plane) {
+                                  const ScanPlane& plane) {
   const Key key{scene.version(), &group, {plane.n.x(), plane.n.y(), plane.n.z()}, plane.offset};
   std::lock_guard<std::mutex> lock(mutex_);
   Entry& entry = entries_[key];

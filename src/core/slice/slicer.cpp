@@ -12,18 +12,18 @@ bool lexicographicLess(const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
   return p.z() < q.z();
 }
 
-// Where edge (p, q) crosses the plane, given the vertices' signed distances, sp <= 0 < sq or the
-// other way round. A vertex on the plane (distance 0) is its own crossing, bit for bit. Otherwise
-// the vertices are put in lexicographic order first, so both triangles sharing the edge get the
+// Where edge (p, q) (mesh coordinates) crosses the plane, in plane coordinates, given the vertices'
+// signed distances, sp <= 0 < sq or the other way round, and their plane coordinates wp, wq. A
+// vertex on the plane (distance 0) is its own crossing, bit for bit. Otherwise the crossing is
+// interpolated from the lexicographically first vertex, so both triangles sharing the edge get the
 // same bits.
-Eigen::Vector3d edgeCrossing(Eigen::Vector3d p, double sp, Eigen::Vector3d q, double sq) {
-  if (sp == 0) return p;
-  if (sq == 0) return q;
-  if (lexicographicLess(q, p)) {
-    std::swap(p, q);
-    std::swap(sp, sq);
-  }
-  return p + (q - p) * (sp / (sp - sq));  // sp and sq differ in sign: no cancellation
+Eigen::Vector2d edgeCrossing(const Eigen::Vector3d& p, double sp, const Eigen::Vector2d& wp,
+                             const Eigen::Vector3d& q, double sq, const Eigen::Vector2d& wq) {
+  if (sp == 0) return wp;
+  if (sq == 0) return wq;
+  // sp and sq differ in sign: no cancellation.
+  if (lexicographicLess(q, p)) return wq + (wp - wq) * (sq / (sq - sp));
+  return wp + (wq - wp) * (sp / (sp - sq));
 }
 
 // A unit vector perpendicular to n, from n alone: n crossed with the axis it is least aligned with
@@ -51,9 +51,24 @@ ScanPlane::ScanPlane(const Eigen::Isometry3d& sensor_from_frame) {
   ty = trans.y();
 }
 
-bool ScanPlane::crossing(const Eigen::Vector3d (&v)[3], Eigen::Vector2d* p,
-                          Eigen::Vector2d* q) const {
-  const double s[3] = {side(v[0]), side(v[1]), side(v[2])};
+MeshCut::MeshCut(const ScanPlane& plane, const Eigen::Isometry3d& frame_from_mesh) {
+  const Eigen::Matrix3d& rot = frame_from_mesh.linear();
+  const Eigen::Vector3d& trans = frame_from_mesh.translation();
+  const Eigen::Vector3d* axes[3] = {&plane.n, &plane.u, &plane.v};
+  for (int r = 0; r < 3; ++r) {
+    const Eigen::Vector3d row = rot.transpose() * *axes[r];
+    for (int k = 0; k < 3; ++k) rows_[r][k] = row[k];
+    offsets_[r] = axes[r]->dot(trans);
+  }
+  offsets_[0] += plane.offset;
+}
+
+bool MeshCut::crossing(const std::array<Eigen::Vector3d, 3>& v, Eigen::Vector2d* p,
+                       Eigen::Vector2d* q) const {
+  // Each row's value at a vertex, always summed in the same order (map()), so that a vertex gets
+  // the same bits in every triangle.
+  double s[3];
+  for (int k = 0; k < 3; ++k) s[k] = map(0, v[k]);
   // A vertex exactly on the plane counts as just below it (the plane nudged up by an
   // infinitesimal): an edge lying in the plane is then cut once, by the triangle above it, not
   // twice; a triangle touching the plane from below, or lying in it, is not cut (as a ray in a
@@ -61,14 +76,14 @@ bool ScanPlane::crossing(const Eigen::Vector3d (&v)[3], Eigen::Vector2d* p,
   // beam crosses. Every crossing triangle has exactly two edges with one end below and one above.
   const bool above[3] = {s[0] > 0, s[1] > 0, s[2] > 0};
   if (above[0] == above[1] && above[1] == above[2]) return false;  // also NaN: never above
-  Eigen::Vector3d points[2];
+  Eigen::Vector2d w[3];
+  for (int k = 0; k < 3; ++k) w[k] = {map(1, v[k]), map(2, v[k])};
+  Eigen::Vector2d* out[2] = {p, q};
   int count = 0;
   for (int k = 0; k < 3; ++k) {
     const int j = k == 2 ? 0 : k + 1;
-    if (above[k] != above[j]) points[count++] = edgeCrossing(v[k], s[k], v[j], s[j]);
+    if (above[k] != above[j]) *out[count++] = edgeCrossing(v[k], s[k], w[k], v[j], s[j], w[j]);
   }
-  *p = planeCoords(points[0]);
-  *q = planeCoords(points[1]);
   return true;
 }
 
@@ -93,21 +108,21 @@ void boxInFrame(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box, Eigen
            (abs_r * (c.cwiseAbs() + e) + frame_from_mesh.translation().cwiseAbs() + *half);
 }
 
-Slicer::Slicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh,
-                         const ScanPattern& fan, double tmin, double tmax, bool cull_backfaces)
-    : Slicer(mesh, ScanPlane(sensor_from_mesh), Eigen::Isometry3d::Identity(),
-                  sensor_from_mesh, fan, tmin, tmax, cull_backfaces) {}
+Slicer::Slicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
+               double tmin, double tmax, bool cull_backfaces)
+    : Slicer(mesh, ScanPlane(sensor_from_mesh), Eigen::Isometry3d::Identity(), sensor_from_mesh,
+             fan, tmin, tmax, cull_backfaces) {}
 
-Slicer::Slicer(const Mesh& mesh, const ScanPlane& plane,
-                         const Eigen::Isometry3d& frame_from_mesh,
-                         const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
-                         double tmin, double tmax, bool cull_backfaces)
+Slicer::Slicer(const Mesh& mesh, const ScanPlane& plane, const Eigen::Isometry3d& frame_from_mesh,
+               const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan, double tmin,
+               double tmax, bool cull_backfaces)
     : mesh_(mesh),
       fan_(fan),
       rot_(sensor_from_mesh.linear()),
       trans_(sensor_from_mesh.translation()),
       plane_(plane),
       frame_from_mesh_(frame_from_mesh),
+      cut_(plane, frame_from_mesh),
       sensor_in_mesh_(-(rot_.transpose() * trans_)),
       tmin_(tmin),
       tmax_(tmax),

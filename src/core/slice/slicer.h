@@ -24,7 +24,7 @@ namespace core {
 // written in a basis (u, v) of it that depends on n alone, so that the same plane, met again from
 // another sensor pose in it (a robot driving on a floor), gives the same plane coordinates bit for
 // bit (kept_slice.h keeps them); toSensor() maps them to the sensor's x, y. Every planar test goes
-// through these steps, from vertices moved into the frame.
+// through these steps, a mesh's vertices by MeshCut.
 struct ScanPlane {
   explicit ScanPlane(const Eigen::Isometry3d& sensor_from_frame);
 
@@ -33,9 +33,6 @@ struct ScanPlane {
   Eigen::Vector2d toSensor(const Eigen::Vector2d& w) const {
     return {a * w.x() + b * w.y() + tx, c * w.x() + d * w.y() + ty};
   }
-  // Where a triangle (frame coordinates) crosses the plane, in plane coordinates: false if it does
-  // not (a vertex exactly on the plane counts as just below it, see Slicer).
-  bool crossing(const Eigen::Vector3d (&v)[3], Eigen::Vector2d* p, Eigen::Vector2d* q) const;
   // False if no point of box (a mesh's frame, placed in this frame by frame_from_mesh) can be cut:
   // the box moved into the frame, against side() with a slack for the rounding of moving a
   // vertex there and of side() (relative to the magnitudes involved).
@@ -45,6 +42,31 @@ struct ScanPlane {
   double offset;      // the frame origin's sensor z
   Eigen::Vector3d u, v;
   double a, b, c, d, tx, ty;  // sensor x = a pu + b pv + tx, y = c pu + d pv + ty
+};
+
+// The plane seen from a mesh placed in its frame (frame_from_mesh): a mesh point's side() and plane
+// coordinates by one affine map, the plane's n, u and v turned into the mesh's frame, so a vertex
+// is not moved into the frame first. Every planar test cuts a mesh's triangles through this
+// (Slicer, KeptSlice), so neighbouring triangles share their crossings bit for bit, and the same
+// plane met again in the frame (a robot driving on a floor) gives the same bits: the map depends on
+// the plane's n and offset and the mesh's placement alone.
+class MeshCut {
+ public:
+  MeshCut(const ScanPlane& plane, const Eigen::Isometry3d& frame_from_mesh);
+
+  // Where a triangle (mesh coordinates) crosses the plane, in plane coordinates: false if it does
+  // not (a vertex exactly on the plane counts as just below it, see Slicer).
+  bool crossing(const std::array<Eigen::Vector3d, 3>& v, Eigen::Vector2d* p,
+                Eigen::Vector2d* q) const;
+
+ private:
+  // Row r's value at mesh point x.
+  double map(int r, const Eigen::Vector3d& x) const {
+    return rows_[r][0] * x.x() + rows_[r][1] * x.y() + rows_[r][2] * x.z() + offsets_[r];
+  }
+  // Row 0 gives side(), rows 1 and 2 the plane coordinates along u and v.
+  double rows_[3][3];
+  double offsets_[3];
 };
 
 // A box given in a mesh's frame as a box in the frame that places the mesh (frame_from_mesh):
@@ -73,18 +95,13 @@ class Slicer {
   // A mesh placed in a frame (frame_from_mesh) cut by that frame's plane (plane): how the walk
   // slices a body, so that it gets the bits a kept slice of the frame holds.
   Slicer(const Mesh& mesh, const ScanPlane& plane, const Eigen::Isometry3d& frame_from_mesh,
-              const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan, double tmin,
-              double tmax, bool cull_backfaces);
+         const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan, double tmin,
+         double tmax, bool cull_backfaces);
   // A mesh in its own frame.
   Slicer(const Mesh& mesh, const Eigen::Isometry3d& sensor_from_mesh, const ScanPattern& fan,
-              double tmin, double tmax, bool cull_backfaces);
+         double tmin, double tmax, bool cull_backfaces);
 
   const ScanPlane& plane() const { return plane_; }
-  // The triangle in slot moved into the frame.
-  void frameTriangle(std::uint32_t slot, Eigen::Vector3d (&out)[3]) const {
-    const auto& v = mesh_.bvh().triangleVertices()[slot];
-    for (int k = 0; k < 3; ++k) out[k] = frame_from_mesh_ * v[k];
-  }
 
   // False if the box (mesh frame) certainly neither crosses the plane nor comes within tmax.
   bool mayCross(const Aabb& box) const;
@@ -120,12 +137,10 @@ class Slicer {
   }
 
  private:
-  // Where the triangle in `slot`, moved into the frame, crosses the plane (plane coordinates);
+  // Where the triangle in `slot` crosses the plane (plane coordinates, by MeshCut);
   // false if it does not.
   bool cut(std::uint32_t slot, Eigen::Vector2d* p, Eigen::Vector2d* q) const {
-    Eigen::Vector3d v[3];
-    frameTriangle(slot, v);
-    return plane_.crossing(v, p, q);
+    return cut_.crossing(mesh_.bvh().triangleVertices()[slot], p, q);
   }
   // The triangle's front normal's sensor x, y into *front, which is returned, where back faces are
   // culled; else null.
@@ -141,6 +156,7 @@ class Slicer {
   Eigen::Vector3d trans_;
   ScanPlane plane_;
   Eigen::Isometry3d frame_from_mesh_;
+  MeshCut cut_;
   Eigen::Vector3d sensor_in_mesh_;
   double tmin_, tmax_, tmax2_, gamma_;
   bool cull_backfaces_;
@@ -203,8 +219,8 @@ void forSegmentColumns(const ScanPattern& fan, const Eigen::Vector2d& p, const E
                                     : std::sqrt(std::min(p.squaredNorm(), q.squaredNorm()))) *
           (1 - 16 * std::numeric_limits<double>::epsilon()) -
       16 * std::numeric_limits<double>::epsilon() * (p.norm() + q.norm());
-  const double near = shift > 0 ? std::max(0.0, reference_near - shift * (1 + 1e-9))
-                                : reference_near;
+  const double near =
+      shift > 0 ? std::max(0.0, reference_near - shift * (1 + 1e-9)) : reference_near;
   auto clipped = [&](int lo, int hi) {
     lo = std::max(lo, first);
     hi = std::min(hi, last);
@@ -251,8 +267,7 @@ void testSegmentInFan(const ScanPattern& fan, const Eigen::Vector2d& p, const Ei
 
 template <class Hit, class Open>
 void Slicer::testSegment(const Eigen::Vector2d& plane_p, const Eigen::Vector2d& plane_q,
-                              std::uint32_t slot, int first, int last, Hit&& hit,
-                              Open&& open) const {
+                         std::uint32_t slot, int first, int last, Hit&& hit, Open&& open) const {
   Eigen::Vector2d front;
   testSegmentInFan(fan_, plane_.toSensor(plane_p), plane_.toSensor(plane_q), tmin_, tmax_,
                    frontOf(slot, &front), first, last, std::forward<Hit>(hit),
@@ -265,8 +280,8 @@ inline bool Slicer::sliceBeam(std::uint32_t slot, int beam, double* t) const {
   if (!cut(slot, &p, &q) || p == q) return false;
   Eigen::Vector2d front;
   const Eigen::Vector3d& dir = fan_.directions()[beam];
-  return beamCrossesSegment(dir.x(), dir.y(), plane_.toSensor(p), plane_.toSensor(q), tmin_,
-                            tmax_, frontOf(slot, &front), t);
+  return beamCrossesSegment(dir.x(), dir.y(), plane_.toSensor(p), plane_.toSensor(q), tmin_, tmax_,
+                            frontOf(slot, &front), t);
 }
 
 }  // namespace core
