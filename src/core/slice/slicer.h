@@ -165,7 +165,7 @@ class Slicer {
 // Whether the beam with direction (dx, dy) (sensor frame) crosses the segment with ends p != q
 // (sensor x, y) with t in [tmin, tmax], and where. With front (the triangle's front normal's
 // sensor x, y), a beam meeting its back does not.
-inline bool beamCrossesSegment(double dx, double dy, const Eigen::Vector2d& p,
+LASER_RAYCAST_HOT_INLINE bool beamCrossesSegment(double dx, double dy, const Eigen::Vector2d& p,
                                const Eigen::Vector2d& q, double tmin, double tmax,
                                const Eigen::Vector2d* front, double* t) {
   // Which side of the beam's line each endpoint is on; a shared endpoint gives the same value to
