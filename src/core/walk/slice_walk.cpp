@@ -313,7 +313,7 @@ class SliceWalk {
   }
 
   // A sweep's beam (direction dx, dy) for the box tests: from its column's origin, in plane
-  // coordinates. A beam is traced in every node whose window holds it (2.4 times a scan, on the
+  // coordinates. A beam is traced in every node whose window holds it (2.2 times a scan, on the
   // benchmark's rotating LDS-01 through the warehouse), so each column's ray is made once a walk.
   // The last ones are kept by column (a node's window is at most kTraceBeams columns, and its
   // neighbours' overlap it): a walk that traces few beams sets up no more than it uses.
