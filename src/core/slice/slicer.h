@@ -35,7 +35,8 @@ struct ScanPlane {
   }
   // False if no point of box (a mesh's frame, placed in this frame by frame_from_mesh) can be cut:
   // the box moved into the frame, against side() with a slack for the rounding of moving a
-  // vertex there and of side() (relative to the magnitudes involved).
+  // vertex there and of side() (relative to the magnitudes involved), which also bounds the
+  // rounding of MeshCut's heights (its rows are n turned into the mesh's frame).
   bool mayMeet(const Eigen::Isometry3d& frame_from_mesh, const Aabb& box) const;
 
   Eigen::Vector3d n;  // the sensor's z axis in the frame
@@ -166,8 +167,8 @@ class Slicer {
 // (sensor x, y) with t in [tmin, tmax], and where. With front (the triangle's front normal's
 // sensor x, y), a beam meeting its back does not.
 LASER_RAYCAST_HOT_INLINE bool beamCrossesSegment(double dx, double dy, const Eigen::Vector2d& p,
-                               const Eigen::Vector2d& q, double tmin, double tmax,
-                               const Eigen::Vector2d* front, double* t) {
+                                                 const Eigen::Vector2d& q, double tmin, double tmax,
+                                                 const Eigen::Vector2d* front, double* t) {
   // Which side of the beam's line each endpoint is on; a shared endpoint gives the same value to
   // both of its segments.
   const double side_p = dx * p.y() - dy * p.x();
