@@ -6,15 +6,15 @@
 #include <cstdint>
 #include <optional>
 
+#include "accel/wide_bvh.h"
 #include "beams/column_motion.h"
 #include "beams/column_raster.h"
-#include "geometry/hit_order.h"
 #include "beams/edge_filter.h"
+#include "geometry/hit_order.h"
 #include "slice/slicer.h"
 #include "util/walk_stack.h"
 #include "walk/slot_cache.h"
 #include "walk/sub_ray_filter.h"
-#include "accel/wide_bvh.h"
 
 namespace laser_raycast {
 namespace core {
@@ -43,8 +43,7 @@ constexpr double kPlainSliceBeamsPerTriangle = 0.5;
 template <TriangleMethod M>
 class MeshWalk {
  public:
-  MeshWalk(BeamSet& beams, const Mesh& mesh, const PlacedBody& active,
-           const CastConfig& config)
+  MeshWalk(BeamSet& beams, const Mesh& mesh, const PlacedBody& active, const CastConfig& config)
       : beams_(beams),
         mesh_(mesh),
         wide_(mesh.wideBvh()),
@@ -72,8 +71,8 @@ class MeshWalk {
         slicer_.emplace(mesh, *active.plane, active.frame_from_body, active.sensor_from_body,
                         beams.grid().pattern(), config.tmin, config.tmax, config.cull_backfaces);
       } else {
-        slicer_.emplace(mesh, active.sensor_from_body, beams.grid().pattern(), config.tmin, config.tmax,
-                        config.cull_backfaces);
+        slicer_.emplace(mesh, active.sensor_from_body, beams.grid().pattern(), config.tmin,
+                        config.tmax, config.cull_backfaces);
       }
     }
   }
@@ -110,9 +109,7 @@ class MeshWalk {
     std::uint32_t triangles;  // below ref
   };
 
-  void push(const Entry& e) {
-    stack_.push(e);
-  }
+  void push(const Entry& e) { stack_.push(e); }
 
   void visit(const Entry& e) {
     const long long beams = e.rect.beams();
@@ -249,7 +246,7 @@ class MeshWalk {
   // The beam at (row, col) along sensor-frame direction d for the triangle tests: from the
   // sensor, or for a sweep's block from the beam's pose, in the reference sensor frame.
   LASER_RAYCAST_HOT_INLINE PreparedRay<double, M> rayAlong(int row, int col,
-                                                            const Eigen::Vector3d& d) const {
+                                                           const Eigen::Vector3d& d) const {
     Ray ray{Eigen::Vector3d::Zero(), d, config_.tmin};
     if (motion_) ray = motion_->ray(row, col, d, config_.tmin);
     return PreparedRay<double, M>(ray, config_.cull_backfaces);
@@ -364,11 +361,10 @@ class MeshWalk {
   bool hidden(std::uint32_t slot) { return closed_ && hiddenClosed(slot); }
   // Out of line: the tests that ask stay small inline.
   __attribute__((noinline)) bool hiddenClosed(std::uint32_t slot) {
-    return hidden_.get(
-        slot, [&] {
-          // A sweep's block: hidden from every column's origin, all within the shift.
-          return hiddenBackFace(mesh_, slot, active_.sensor_in_body, config_.tmin, spread_.shift);
-        });
+    return hidden_.get(slot, [&] {
+      // A sweep's block: hidden from every column's origin, all within the shift.
+      return hiddenBackFace(mesh_, slot, active_.sensor_in_body, config_.tmin, spread_.shift);
+    });
   }
 
   // The slot's segment in the scan plane against one beam, as slicing tests it.
@@ -436,11 +432,11 @@ class MeshWalk {
         if (bundle_) {
           for (int j = beams_.subBegin(row, col), end = beams_.subEnd(row, col); j < end; ++j) {
             if (filter && filter->misses(beams_.subDirection(j))) continue;
-            const auto hit = subRay(j, row, col).intersect(
-                s.a, s.b, s.c, std::min(config_.tmax, beams_.subRange(j)));
+            const auto hit =
+                subRay(j, row, col)
+                    .intersect(s.a, s.b, s.c, std::min(config_.tmax, beams_.subRange(j)));
             if (!hit) continue;
-            beams_.keepNearestSubHit(j, row, col, hit->t, active_.index,
-                                     static_cast<int>(triangle),
+            beams_.keepNearestSubHit(j, row, col, hit->t, active_.index, static_cast<int>(triangle),
                                      [&] { return beamNormal(row, col, triangle); });
           }
           return;
@@ -470,11 +466,12 @@ class MeshWalk {
   // the sweep block's spread): f(row, col) for each.
   template <class F>
   void forEachInWindow(const SensorTriangle& s, const BeamRect& rect, F&& f) const {
-    const Eigen::Vector3d lo = s.a.cwiseMin(s.b).cwiseMin(s.c), hi = s.a.cwiseMax(s.b).cwiseMax(s.c);
+    const Eigen::Vector3d lo = s.a.cwiseMin(s.b).cwiseMin(s.c),
+                          hi = s.a.cwiseMax(s.b).cwiseMax(s.c);
     const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
-    const View view = boxView((lo + hi) * 0.5, (hi - lo) * 0.5, identity, identity,
-                              Eigen::Vector3d::Zero(), beams_.grid().pattern().angleMin(),
-                              !planar_, spread_);
+    const View view =
+        boxView((lo + hi) * 0.5, (hi - lo) * 0.5, identity, identity, Eigen::Vector3d::Zero(),
+                beams_.grid().pattern().angleMin(), !planar_, spread_);
     if (!(view.near <= config_.tmax) || (planar_ && !view.crosses)) return;
     beams_.grid().forEachRect(view, rect, [&](const BeamRect& r) {
       for (int row = r.row_lo; row <= r.row_hi; ++row) {
@@ -510,7 +507,7 @@ class MeshWalk {
           slot, rect.col_lo, rect.col_hi,
           [&](int col, double t) {
             beams_.keepNearestHit(0, col, t, active_.index, static_cast<int>(ids_[slot]),
-                         [&] { return slicer_->sensorNormal(slot); });
+                                  [&] { return slicer_->sensorNormal(slot); });
           },
           [&](int col, double segment_near) {
             return beams_.range(0, col) >= std::max(near, segment_near);
@@ -527,7 +524,7 @@ class MeshWalk {
   const CastConfig& config_;
   const Eigen::Matrix3d rot_, abs_rot_;
   const Eigen::Vector3d trans_;
-  const ColumnMotion* motion_;  // a sweep's block, or null
+  const ColumnMotion* motion_;                       // a sweep's block, or null
   const BeamSet::Bundle* bundle_ = beams_.bundle();  // a bundle's sub-rays, or null
   const Spread spread_;
   const bool planar_, slicing_, tracing_only_;
