@@ -19,21 +19,8 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
       ref_from_column_(std::move(ref_from_column)),
       class_of_row_(std::move(class_of_row)),
       ref_from_class_(std::move(ref_from_class)) {
-  double shift2 = 0, frobenius2 = 0, z_move2 = 0;
-  std::vector<const Eigen::Isometry3d*> poses;
-  for (const Eigen::Isometry3d& m : ref_from_column_) poses.push_back(&m);
-  for (const auto& poses_of_class : ref_from_class_) {
-    for (std::size_t c = 0; c < poses_of_class.size(); ++c) {
-      poses.push_back(&poses_of_class[c]);
-      deviation_ = std::max(
-          deviation_,
-          (poses_of_class[c].translation() - ref_from_column_[c].translation()).norm());
-    }
-  }
-  // Widened for the rounding of the norm.
-  deviation_ = deviation_ > 0 ? deviation_ * (1 + 1e-9) : 0;
-  for (const Eigen::Isometry3d* pose : poses) {
-    const Eigen::Isometry3d& m = *pose;
+  double shift2 = 0, frobenius2 = 0, z_move2 = 0, deviation2 = 0;
+  auto add = [&](const Eigen::Isometry3d& m) {
     shift2 = std::max(shift2, m.translation().squaredNorm());
     frobenius2 = std::max(frobenius2, (m.linear() - Eigen::Matrix3d::Identity()).squaredNorm());
     z_move2 = std::max(z_move2, (m.linear().col(2) - Eigen::Vector3d::UnitZ()).squaredNorm());
@@ -41,7 +28,19 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
     translations_only_ = translations_only_ && r == Eigen::Matrix3d::Identity();
     in_plane_ = in_plane_ && r(0, 2) == 0 && r(1, 2) == 0 && r(2, 0) == 0 && r(2, 1) == 0 &&
                 r(2, 2) == 1 && m.translation().z() == 0;
+  };
+  for (const Eigen::Isometry3d& m : ref_from_column_) add(m);
+  for (const auto& poses_of_class : ref_from_class_) {
+    for (std::size_t c = 0; c < poses_of_class.size(); ++c) {
+      add(poses_of_class[c]);
+      deviation2 = std::max(
+          deviation2,
+          (poses_of_class[c].translation() - ref_from_column_[c].translation()).squaredNorm());
+    }
   }
+  // The largest norm (a square root is monotonic and correctly rounded: the root of the largest
+  // square is the largest root), widened for its rounding.
+  deviation_ = deviation2 > 0 ? std::sqrt(deviation2) * (1 + 1e-9) : 0;
   padded_lo_ = col_lo_ & ~3;
   const int padded_hi = colHi() | 3;
   for (std::vector<float>& axis : origin_) axis.resize(padded_hi - padded_lo_ + 1);
