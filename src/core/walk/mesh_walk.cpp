@@ -258,9 +258,11 @@ class MeshWalk {
     return rayAlong(row, col, beams_.grid().rebuiltDirection(row, col));
   }
 
-  // A beam traced on its own through a subtree: its rays, its far limit and its nearest hit.
+  // A beam (or a bundle's sub-ray) traced on its own through a subtree: its rays, its far limit
+  // and its nearest hit.
   struct Traced {
     int row, col;
+    int sub;  // the sub-ray, or -1 for the grid's beam
     double tmax;
     Best best;
     WideBoxRay box_ray;
@@ -281,8 +283,8 @@ class MeshWalk {
   }
 
   // Each open beam of the rect through the node's subtree, two at a time (their walks side by
-  // side, traceWidePair: the same visits and tests as one at a time); a bundle's sub-rays one at a
-  // time.
+  // side, traceWidePair: the same visits and tests as one at a time); a bundle's sub-rays by
+  // traceSubRays.
   void traceRect(const Entry& e) {
     if (bundle_) {
       traceSubRays(e);
@@ -297,32 +299,56 @@ class MeshWalk {
         Traced& b = pair[n++];
         b.row = row;
         b.col = col;
+        b.sub = -1;
         b.tmax = std::min(config_.tmax, range);
         b.best = Best{};
         b.box_ray = boxRay(row, col);
         if (!slicing_) b.ray.emplace(beamRay(row, col));
-        if (n == 2) {
-          traceWidePair(wide_, e.ref, pair[0].box_ray, &pair[0].tmax, leafOf(&pair[0]),
-                        pair[1].box_ray, &pair[1].tmax, leafOf(&pair[1]));
-          finish(pair[0]);
-          finish(pair[1]);
-          n = 0;
-        }
+        if (n == 2) tracePair(e, pair, [this](Traced* t) { return leafOf(t); });
+        n %= 2;
       }
     }
-    if (n == 1) {
-      traceWide(wide_, e.ref, pair[0].box_ray, &pair[0].tmax, leafOf(&pair[0]));
-      finish(pair[0]);
-    }
+    if (n == 1) traceOne(e, pair, [this](Traced* t) { return leafOf(t); });
+  }
+
+  // The two queued traces walked side by side (traceWidePair: the same visits and tests as one at
+  // a time), or the last one alone; leaf_of(t) gives what trace t does at each slot of a leaf.
+  template <class LeafOf>
+  LASER_RAYCAST_HOT_INLINE void tracePair(const Entry& e, Traced* pair, LeafOf&& leaf_of) {
+    traceWidePair(wide_, e.ref, pair[0].box_ray, &pair[0].tmax, leaf_of(&pair[0]), pair[1].box_ray,
+                  &pair[1].tmax, leaf_of(&pair[1]));
+    finish(pair[0]);
+    finish(pair[1]);
+  }
+  template <class LeafOf>
+  LASER_RAYCAST_HOT_INLINE void traceOne(const Entry& e, Traced* pair, LeafOf&& leaf_of) {
+    traceWide(wide_, e.ref, pair[0].box_ray, &pair[0].tmax, leaf_of(&pair[0]));
+    finish(pair[0]);
   }
 
   void finish(const Traced& b) {
-    if (b.best.found()) offer(b.row, b.col, b.best);
+    if (!b.best.found()) return;
+    if (b.sub >= 0) {
+      offerSub(b.sub, b.row, b.col, b.best);
+    } else {
+      offer(b.row, b.col, b.best);
+    }
   }
 
-  // Each open beam's sub-rays (a bundle's) through the node's subtree, one ray at a time: the
-  // boxes each enters are its own.
+  // Each open beam's sub-rays (a bundle's) through the node's subtree, each on its own ray (the
+  // boxes each enters are its own): two at a time as traceRect traces beams where a beam's
+  // sub-rays lie close together (a divergent beam's, a calibrated lidar's one), one at a time for
+  // a cell's list of beams (beams/beam_cells.h), which side by side went no faster. A sub-ray's
+  // walk reads and lowers only its own far limit, so pairing them changes no test.
   void traceSubRays(const Entry& e) {
+    if (bundle_->first) {
+      traceEachSubRay(e);
+    } else {
+      traceSubRayPairs(e);
+    }
+  }
+
+  void traceEachSubRay(const Entry& e) {
     for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
@@ -339,6 +365,39 @@ class MeshWalk {
         }
       }
     }
+  }
+
+  void traceSubRayPairs(const Entry& e) {
+    Traced pair[2];
+    int n = 0;
+    for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
+      for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
+        const double range = beams_.range(row, col);
+        if (!(range >= e.near)) continue;
+        for (int s = beams_.subBegin(row, col), end = beams_.subEnd(row, col); s < end; ++s) {
+          const double tmax = std::min(config_.tmax, beams_.subRange(s));
+          if (!(tmax >= e.near)) continue;
+          Traced& b = pair[n++];
+          b.row = row;
+          b.col = col;
+          b.sub = s;
+          b.tmax = tmax;
+          b.best = Best{};
+          b.box_ray = subBoxRay(s, row, col);
+          b.ray.emplace(subRay(s, row, col));
+          if (n == 2) tracePair(e, pair, [this](Traced* t) { return subLeafOf(t); });
+          n %= 2;
+        }
+      }
+    }
+    if (n == 1) traceOne(e, pair, [this](Traced* t) { return subLeafOf(t); });
+  }
+
+  // What a traced sub-ray does with each triangle slot of a leaf it enters: the exact 3D test.
+  auto subLeafOf(Traced* b) {
+    return [ this, b ](std::uint32_t slot) __attribute__((always_inline)) {
+      if (!hidden(slot)) testSlot(*b->ray, slot, &b->tmax, &b->best);
+    };
   }
 
   // A traced beam against a slot's triangle: a nearer hit (or as near on a lower triangle) becomes
