@@ -33,10 +33,13 @@
 // Triangle tests, box tests and the edge functions sit in the innermost loops of the BVH walks;
 // GCC and Clang would otherwise keep the larger ones out of line there (a 3D traced beam called
 // WideSlabRay::enter for every node).
+// LASER_RAYCAST_HOT_LAMBDA: the same for a lambda, after its parameter list.
 #if defined(__GNUC__)
 #define LASER_RAYCAST_HOT_INLINE __attribute__((always_inline)) inline
+#define LASER_RAYCAST_HOT_LAMBDA __attribute__((always_inline))
 #else
 #define LASER_RAYCAST_HOT_INLINE inline
+#define LASER_RAYCAST_HOT_LAMBDA
 #endif
 
 namespace laser_raycast {

@@ -396,7 +396,7 @@ class MeshWalk {
 
   // What a traced sub-ray does with each triangle slot of a leaf it enters: the exact 3D test.
   auto subLeafOf(Traced* b) {
-    return [ this, b ](std::uint32_t slot) __attribute__((always_inline)) {
+    return [this, b](std::uint32_t slot) LASER_RAYCAST_HOT_LAMBDA {
       if (!hidden(slot)) testSlot(*b->ray, slot, &b->tmax, &b->best);
     };
   }
