@@ -164,17 +164,12 @@ class BlockPlanner {
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
     ClassPoses ref_from = classPoses(lo, hi);
     const Eigen::Isometry3d world_from_ref = beamsFrom(0, ref);
-    // relativePose(world_from_ref, beamsFrom(k, c)), the same expressions, with the reference's
-    // transpose taken once (a calibrated Velodyne's block has 16 poses a column).
+    // The reference's transpose taken once (a calibrated Velodyne's block has 16 poses a column).
     const Eigen::Matrix3d ref_rot_t = world_from_ref.linear().transpose();
     for (int k = 0; k < beams_.classes; ++k) {
       for (int c = lo; c <= hi; ++c) {
-        const Eigen::Isometry3d world_from_beams = beamsFrom(k, c);
-        Eigen::Isometry3d& m = ref_from[k][c - lo];
-        m.linear() = ref_rot_t * world_from_beams.linear();
-        m.translation() =
-            ref_rot_t * (world_from_beams.translation() - world_from_ref.translation());
-        m.makeAffine();
+        ref_from[k][c - lo] =
+            relativePose(ref_rot_t, world_from_ref.translation(), beamsFrom(k, c));
       }
     }
     return motion(lo, std::move(ref_from));
