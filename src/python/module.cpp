@@ -82,30 +82,102 @@ void bindPattern(py::module_& m) {
       .def_static("preset", &Pattern::fromPreset, py::arg("name"),
                   "The pattern and range limits of a real sensor ('VLP-16', 'HDL-32E', 'OS1-64',\n"
                   "'UTM-30LX', 'TiM571', 'LDS-01'), from its datasheet (docs/sensors.md).")
+      .def_static("from_calibration", &Pattern::fromCalibration, py::arg("path"),
+                  py::arg("scan_time") = Pattern::kCalibratedScanTime,
+                  "A Velodyne head from its calibration YAML (velodyne_pointcloud's, as the\n"
+                  "node's calibration_file and cast_scan --calibration read it): each laser's\n"
+                  "beam and origin over one turn of scan_time s (in (0, 1]), each laser at the\n"
+                  "azimuth its firing time gives. Beams off any grid: the same every scan.")
+      .def_static("from_ouster_metadata", &Pattern::fromOusterMetadata, py::arg("path"),
+                  py::arg("scan_time") = py::none(),
+                  "An Ouster head from its sensor metadata JSON (legacy or nested, as the node's\n"
+                  "ouster_metadata and cast_scan --ouster-metadata read it): each column's beams\n"
+                  "and origins over one turn of scan_time s (the file's lidar mode's if None).")
+      .def_static("from_pattern_file", &Pattern::fromPatternFile, py::arg("path"),
+                  py::arg("point_rate"), py::arg("points_per_scan") = py::none(),
+                  "A scan pattern CSV 'Time/s,Azimuth/deg,Zenith/deg[,Line]' (Livox's simulation\n"
+                  "files; the node's pattern_file, cast_scan --pattern-file) read as a loop: scan\n"
+                  "k of a cast takes points_per_scan rows (all if None) from row k *\n"
+                  "points_per_scan on, as cast_scan --poses does; point_rate (Hz) times them.")
       .def_property_readonly(
-          "size", [](const Pattern& p) { return p.pattern.size(); }, "Beams in one scan.")
-      .def_property_readonly("azimuth_count",
-                             [](const Pattern& p) { return p.pattern.azimuthCount(); })
+          "size", [](const Pattern& p) { return p.size(); }, "Beams in one scan.")
+      .def_property_readonly(
+          "off_grid", [](const Pattern& p) { return p.offGrid(); },
+          "True for beams off any grid (a calibration, metadata or pattern file).")
+      .def_property_readonly(
+          "azimuth_count",
+          [](const Pattern& p) -> py::object {
+            return p.offGrid() ? py::none() : py::cast(p.pattern.azimuthCount());
+          },
+          "Azimuths in each ring, or None off a grid.")
       .def_property_readonly(
           "azimuths",
-          [](const Pattern& p) {
+          [](const Pattern& p) -> py::object {
+            if (p.offGrid()) return py::none();
             std::vector<double> a(p.pattern.azimuthCount());
             for (int i = 0; i < p.pattern.azimuthCount(); ++i) a[i] = p.pattern.azimuth(i);
-            return a;
+            return py::cast(a);
           },
-          "The azimuths (rad), the same in every ring.")
+          "The azimuths (rad), the same in every ring; None off a grid.")
       .def_property_readonly(
-          "elevations", [](const Pattern& p) { return p.elevations; },
-          "The rings' elevations (rad), ascending.")
+          "elevations",
+          [](const Pattern& p) -> py::object {
+            return p.offGrid() ? py::none() : py::cast(p.elevations);
+          },
+          "The rings' elevations (rad), ascending; None off a grid.")
       .def_property_readonly(
           "directions",
           [](const Pattern& p) {
-            const auto& d = p.pattern.directions();
+            core::BeamList scratch;
+            const auto& d =
+                p.offGrid() ? p.beamsOf(0, &scratch).directions : p.pattern.directions();
             Eigen::MatrixXd m(d.size(), 3);
             for (std::size_t i = 0; i < d.size(); ++i) m.row(i) = d[i].transpose();
             return matrixArray(m);
           },
-          "Unit beam directions in the sensor frame, shape (size, 3), ring-major.")
+          "Unit beam directions in the sensor frame, shape (size, 3): ring-major on a grid;\n"
+          "off a grid in firing order (a pattern file's first scan).")
+      .def_property_readonly(
+          "origins",
+          [](const Pattern& p) {
+            core::BeamList scratch;
+            Eigen::MatrixXd m = Eigen::MatrixXd::Zero(p.size(), 3);
+            if (p.offGrid()) {
+              const core::BeamList& b = p.beamsOf(0, &scratch);
+              for (int i = 0; i < b.size(); ++i) m.row(i) = b.origin(i).transpose();
+            }
+            return matrixArray(m);
+          },
+          "Where each beam leaves from in the sensor frame (m), shape (size, 3): zeros but for\n"
+          "a calibrated head's offsets. Ranges are measured from there; points are\n"
+          "origin + range * direction.")
+      .def_property_readonly(
+          "times",
+          [](const Pattern& p) {
+            core::BeamList scratch;
+            std::vector<double> t(p.size(), 0.0);
+            if (p.offGrid()) {
+              const core::BeamList& b = p.beamsOf(0, &scratch);
+              for (int i = 0; i < b.size(); ++i) t[i] = b.time(i);
+            }
+            return t;
+          },
+          "Each beam's firing time (s after the scan's stamp) off a grid; zeros on a grid.\n"
+          "Caster.cast casts every beam at once, from the scan's pose.")
+      .def_property_readonly(
+          "lines",
+          [](const Pattern& p) {
+            core::BeamList scratch;
+            std::vector<int> l(p.size());
+            const int azimuths = p.offGrid() ? 1 : p.pattern.azimuthCount();
+            for (int i = 0; i < p.size(); ++i) l[i] = p.offGrid() ? 0 : i / azimuths;
+            if (p.offGrid()) {
+              const core::BeamList& b = p.beamsOf(0, &scratch);
+              for (int i = 0; i < b.size(); ++i) l[i] = b.line(i);
+            }
+            return l;
+          },
+          "Each beam's ring (numbered by ascending elevation) or a pattern file's line.")
       .def_property_readonly(
           "range_min",
           [](const Pattern& p) -> py::object {
@@ -125,6 +197,10 @@ void bindPattern(py::module_& m) {
           },
           "A preset's scan rate (Hz), or None.")
       .def("__repr__", [](const Pattern& p) {
+        if (p.offGrid()) {
+          return "<laser_raycast.Pattern: " + std::to_string(p.size()) +
+                 " beams off any grid, from '" + p.source + "'>";
+        }
         return "<laser_raycast.Pattern: " + std::to_string(p.pattern.ringCount()) + " ring(s) x " +
                std::to_string(p.pattern.azimuthCount()) + " azimuths>";
       });

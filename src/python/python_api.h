@@ -23,12 +23,16 @@
 #include <utility>
 #include <vector>
 
+#include "laser_raycast/core/beam_list.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/measurement_model.h"
+#include "laser_raycast/core/pattern_file.h"
 #include "laser_raycast/core/scan_spec.h"
 #include "laser_raycast/core/sensor_model.h"
 #include "laser_raycast/loader/kinematics.h"
+#include "laser_raycast/loader/ouster_metadata.h"
 #include "laser_raycast/loader/scene_loader.h"
+#include "laser_raycast/loader/velodyne_calibration.h"
 
 namespace py = pybind11;
 
@@ -182,12 +186,34 @@ class Scene {
   std::vector<LoadedModel> models_;
 };
 
-// The beams of a scan, and a preset's range limits if it came from one.
+// The beams of a scan, and a preset's range limits if it came from one: a grid (a fan of azimuths
+// at each elevation), or beams off any grid, each its own direction and origin (a calibrated
+// head's turn, the same every scan; or a pattern file read as a loop, scan k of a cast taking its
+// rows from k * points_per_scan on, as cast_scan --poses takes them).
 struct Pattern {
+  // A turn of a calibrated head cast at once unless scan_time says otherwise: 10 Hz, as cast_scan.
+  static constexpr double kCalibratedScanTime = 0.1;  // s
+
   core::FanSpec fan;
   std::vector<double> elevations{0.0};
   std::optional<core::SensorModel> preset;
   core::ScanPattern pattern{core::FanSpec{-M_PI, M_PI, 0, 2}};
+  std::shared_ptr<const core::BeamList> turn;     // a calibrated head's beams, or null
+  std::shared_ptr<const core::PatternFile> file;  // a pattern file, or null
+  int points_per_scan = 0;                        // with file: rows a scan takes
+  double point_rate = 0;                          // with file: Hz
+  std::string source;                             // the file off-grid beams came from
+
+  bool offGrid() const { return turn || file; }
+  int size() const {
+    return turn ? turn->size() : file ? points_per_scan : static_cast<int>(pattern.size());
+  }
+  // Scan k's beams, off any grid (*scratch holds a pattern file's).
+  const core::BeamList& beamsOf(std::int64_t k, core::BeamList* scratch) const {
+    if (turn) return *turn;
+    *scratch = file->scan(k * points_per_scan, points_per_scan, point_rate);
+    return *scratch;
+  }
 
   static Pattern make(double angle_min, double angle_max, std::optional<int> samples,
                       std::optional<double> angle_increment, std::vector<double> elevations) {
@@ -221,6 +247,48 @@ struct Pattern {
     return p;
   }
 
+  // A Velodyne calibration YAML (as cast_scan --calibration reads it): one turn of scan_time s.
+  static Pattern fromCalibration(const std::string& path, double scan_time) {
+    checkScanTime(scan_time);
+    return offGridTurn(path, [&] { return loadVelodyneCalibration(path).scan(scan_time); });
+  }
+
+  // An Ouster metadata JSON (as cast_scan --ouster-metadata reads it): one turn of scan_time s,
+  // the file's lidar mode's if not given.
+  static Pattern fromOusterMetadata(const std::string& path, std::optional<double> scan_time) {
+    if (scan_time) checkScanTime(*scan_time);
+    return offGridTurn(path, [&] {
+      const core::OusterHead head = loadOusterMetadata(path);
+      return head.scan(scan_time.value_or(1 / head.fps));
+    });
+  }
+
+  // A scan pattern CSV (as cast_scan --pattern-file reads it): points_per_scan rows a scan (all
+  // of them if not given), point k of a scan at k / point_rate s.
+  static Pattern fromPatternFile(const std::string& path, double point_rate,
+                                 std::optional<int> points_per_scan) {
+    if (!(std::isfinite(point_rate) && point_rate > 0)) {
+      throw py::value_error("point_rate must be > 0 Hz, got " + std::to_string(point_rate));
+    }
+    Pattern p;
+    try {
+      p.file = std::make_shared<const core::PatternFile>(core::PatternFile::load(path));
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(std::string("path: ") + e.what());
+    }
+    const int count = points_per_scan.value_or(p.file->size());
+    if (count < 1 || count > core::FanSpec::kMaxBeams) {
+      throw py::value_error("points_per_scan must be in [1, " +
+                            std::to_string(core::FanSpec::kMaxBeams) + "], got " +
+                            std::to_string(count));
+    }
+    p.points_per_scan = count;
+    p.point_rate = point_rate;
+    p.source = path;
+    p.offGridSpec();
+    return p;
+  }
+
   // Validates as the node and cast_scan do (ScanSpec), with the rings in ascending order.
   void build() {
     core::ScanSpec spec;
@@ -232,6 +300,33 @@ struct Pattern {
       throw py::value_error(e.what());
     }
     elevations = spec.ringElevations();
+  }
+
+ private:
+  static void checkScanTime(double scan_time) {
+    if (!(std::isfinite(scan_time) && scan_time > 0 && scan_time <= 1)) {
+      throw py::value_error("scan_time must be in (0, 1] s, got " + std::to_string(scan_time));
+    }
+  }
+  template <typename Read>
+  static Pattern offGridTurn(const std::string& path, Read&& read) {
+    Pattern p;
+    try {
+      core::BeamList beams = read();
+      beams.validate();
+      p.turn = std::make_shared<const core::BeamList>(std::move(beams));
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(std::string("path: ") + e.what());
+    }
+    p.source = path;
+    p.offGridSpec();
+    return p;
+  }
+  // Off a grid the fan is not cast; the scan's settings are checked with cast_scan's default.
+  void offGridSpec() {
+    fan = core::FanSpec{};
+    fan.samples = core::FanSpec::kDefaultSamples;
+    elevations = {0.0};
   }
 };
 
@@ -292,7 +387,7 @@ class Caster {
         measurement ? measurement->reflectivityByLabel(scene.scene()) : std::vector<double>{};
 
     const py::ssize_t n = static_cast<py::ssize_t>(sensors.size());
-    const py::ssize_t beams = pattern.pattern.size();
+    const py::ssize_t beams = pattern.size();
     Scans out;
     out.ranges = py::array_t<double>({n, beams});
     out.links = py::array_t<std::int32_t>({n, beams});
@@ -308,12 +403,22 @@ class Caster {
       py::gil_scoped_release release;
       std::optional<core::MeasurementModel> model;
       if (measurement) model.emplace(spec.output);
+      core::BeamList scratch;
       for (py::ssize_t k = 0; k < n; ++k) {
         caster_.forget();  // every pose cast anew, as cast_scan casts a path
-        const core::ScanResult& result = caster_.cast(
-            scene.scene(), frames[frames.size() == 1 ? 0 : k], sensors[k], pattern.pattern, config);
-        writeScan(scene.scene(), result, spec.output, pattern.pattern, reflectivity,
-                  model ? &*model : nullptr, rows.at(k * beams));
+        const core::FramePoses& at = frames[frames.size() == 1 ? 0 : k];
+        if (pattern.offGrid()) {
+          const core::BeamList& list = pattern.beamsOf(k, &scratch);
+          const core::ScanResult& result =
+              caster_.castBeams(scene.scene(), at, sensors[k], list, config);
+          writeScan(scene.scene(), result, spec.output, list.directions, &list.origins,
+                    reflectivity, model ? &*model : nullptr, rows.at(k * beams));
+        } else {
+          const core::ScanResult& result =
+              caster_.cast(scene.scene(), at, sensors[k], pattern.pattern, config);
+          writeScan(scene.scene(), result, spec.output, pattern.pattern.directions(), nullptr,
+                    reflectivity, model ? &*model : nullptr, rows.at(k * beams));
+        }
       }
     }
     if (points) out.points = xyz;
@@ -359,8 +464,10 @@ class Caster {
 
   // One scan's beams into its rows: measured by model (as the node publishes them) or, without
   // one, the exact ranges classified as cast_scan prints them.
+  // The points leave from origins (beam by beam; null or empty: the sensor's origin) along dirs.
   void writeScan(const core::Scene& scene, const core::ScanResult& result,
-                 const core::MeasurementConfig& output, const core::ScanPattern& pattern,
+                 const core::MeasurementConfig& output, const std::vector<Eigen::Vector3d>& dirs,
+                 const std::vector<Eigen::Vector3d>* origins,
                  const std::vector<double>& reflectivity, core::MeasurementModel* model,
                  const Rows& rows) {
     const std::size_t beams = result.range.size();
@@ -383,12 +490,15 @@ class Caster {
       }
     }
     if (!rows.xyz) return;
-    const auto& dirs = pattern.directions();
+    const bool offset = origins && !origins->empty();
     for (std::size_t b = 0; b < beams; ++b) {
       const double r = rows.range[b];
       const bool valid = std::isfinite(r);
       for (int a = 0; a < 3; ++a) {
-        rows.xyz[b * 3 + a] = valid ? r * dirs[b][a] : std::numeric_limits<double>::quiet_NaN();
+        const double along = r * dirs[b][a];
+        rows.xyz[b * 3 + a] = !valid   ? std::numeric_limits<double>::quiet_NaN()
+                              : offset ? (*origins)[b][a] + along
+                                       : along;
       }
     }
   }

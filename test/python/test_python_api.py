@@ -251,6 +251,100 @@ def test_the_gil_is_released_while_casting():
 
 def test_help_describes_the_module():
     text = pydoc.render_doc(lr, renderer=pydoc.plaintext)
-    for words in ["class Scene", "from_urdf", "class Pattern", "preset", "class Caster",
+    for words in ["class Scene", "from_urdf", "class Pattern", "preset", "from_calibration",
+                  "from_ouster_metadata", "from_pattern_file", "class Caster",
                   "sensor_poses", "REP 117", "class Measurement", "noise_stddev"]:
         assert words in text, words
+
+
+def cast_scan_rows(args):
+    """cast_scan's CSV rows (after the header) as lists of fields, and the header."""
+    out = subprocess.run([cast_scan_binary()] + args, check=True, capture_output=True,
+                         text=True).stdout.splitlines()
+    return out[0], [line.split(",") for line in out[1:]]
+
+
+def test_a_pattern_file_casts_each_scan_from_its_rows_at_the_ranges_worked_out_by_hand(
+        walls, tmp_path):
+    # Five rows, two a scan: scan k takes rows 2k, 2k + 1, round the file's end (a loop).
+    rows = [(0.0, 0.0, 90.0, 0), (1e-5, 20.0, 80.0, 1), (2e-5, -30.0, 100.0, 2),
+            (3e-5, 10.0, 60.0, 3), (4e-5, -5.0, 95.0, 0)]
+    path = tmp_path / "pattern.csv"
+    path.write_text("Time/s,Azimuth/deg,Zenith/deg,Line\n" +
+                    "".join(f"{t},{a},{z},{line}\n" for t, a, z, line in rows))
+    pattern = lr.Pattern.from_pattern_file(str(path), point_rate=1000.0, points_per_scan=2)
+    assert pattern.off_grid and pattern.size == 2 and pattern.azimuths is None
+    assert pattern.lines == [0, 1] and pattern.times == [0.0, 0.001]
+    xs = [0.0, 1.0, 2.0]
+    poses = np.stack([pose(x, -4.0) for x in xs])
+    scans = lr.Caster().cast(walls, poses, pattern, range_max=50, points=True)
+    assert scans.ranges.shape == (3, 2)
+    for k, x in enumerate(xs):
+        for j in range(2):
+            _, a, z, _ = rows[(2 * k + j) % len(rows)]
+            a, z = math.radians(a), math.radians(z)
+            # The wall's face x = 5 along (sin z cos a, sin z sin a, cos z) from (x, -4, 0).
+            assert scans.ranges[k, j] == pytest.approx((5.0 - x) / (math.sin(z) * math.cos(a)),
+                                                       abs=1e-9), (k, j)
+            assert scans.points[k, j, 0] == pytest.approx(5.0 - x, abs=1e-9)
+
+
+@pytest.mark.parametrize("flag,make", [
+    ("--calibration", lambda path: lr.Pattern.from_calibration(path)),
+    ("--ouster-metadata", lambda path: lr.Pattern.from_ouster_metadata(path)),
+    ("--pattern-file", lambda path: lr.Pattern.from_pattern_file(path, 100000.0, 3000)),
+])
+def test_beams_off_a_grid_give_the_ranges_cast_scan_prints(flag, make, tmp_path):
+    here = os.path.dirname(os.path.abspath(__file__))
+    files = {"--calibration": os.path.join(here, "..", "data", "vlp16_calibration.yaml"),
+             "--ouster-metadata": os.path.join(here, "..", "..", "config", "ouster",
+                                               "os1_64_nominal.json"),
+             "--pattern-file": os.path.join(here, "..", "..", "config", "patterns",
+                                            "rosette_4line.csv")}
+    scene = lr.Scene.from_urdf(DEMO_ROOM)
+    pattern = make(files[flag])
+    sensors = [(0.0, 0.0, 0.4, 0.0), (1.0, -0.5, 0.3, 0.7), (-1.2, 0.8, 0.6, -2.0)]
+    poses = np.stack([pose(x, y, z, yaw) for x, y, z, yaw in sensors])
+    scans = lr.Caster().cast(scene, poses, pattern, range_min=0.2, range_max=12, points=True)
+    path = tmp_path / "poses.txt"
+    path.write_text("".join(f"{x!r},{y!r},{z!r},0,0,{yaw!r}\n" for x, y, z, yaw in sensors))
+    extra = ["--point-rate", "100000", "--points-per-scan", "3000"] if flag == "--pattern-file" \
+        else []
+    header, rows = cast_scan_rows(["--urdf", DEMO_ROOM, "--poses", str(path), flag, files[flag],
+                                   "--range-min", "0.2", "--range-max", "12"] + extra)
+    assert header == "pose,index,line,azimuth,elevation,time,range,link"
+    assert len(rows) == scans.ranges.size
+    lines = np.array(pattern.lines)
+    for k, i, line, _, _, _, text, link in rows:
+        k, i = int(k), int(i)
+        assert "%.9g" % scans.ranges[k, i] == text, (k, i)
+        name = scene.link_names[scans.links[k, i]] if scans.links[k, i] >= 0 else ""
+        assert name == link, (k, i)
+        if flag != "--pattern-file" or k == 0:
+            assert int(line) == lines[i], (k, i)
+    assert np.isfinite(scans.ranges).mean() > 0.5  # a closed room: most beams hit
+    # Points leave from each beam's origin (a calibrated head's offsets) along its direction.
+    first = scans.ranges[0]
+    hit = np.isfinite(first)
+    expected = pattern.origins + first[:, None] * pattern.directions
+    np.testing.assert_allclose(scans.points[0][hit], expected[hit], atol=1e-12)
+    assert np.all(np.isnan(scans.points[0][~hit]))
+
+
+def test_off_grid_readers_raise_errors_that_name_the_argument():
+    here = os.path.dirname(os.path.abspath(__file__))
+    calibration = os.path.join(here, "..", "data", "vlp16_calibration.yaml")
+    cases = [
+        (lambda: lr.Pattern.from_calibration("/no/such/calibration.yaml"), ValueError,
+         "/no/such/calibration.yaml"),
+        (lambda: lr.Pattern.from_calibration(calibration, scan_time=0.0), ValueError, "scan_time"),
+        (lambda: lr.Pattern.from_ouster_metadata(calibration), ValueError,
+         "beam_altitude_angles"),
+        (lambda: lr.Pattern.from_pattern_file(calibration, 1000.0), ValueError, calibration),
+        (lambda: lr.Pattern.from_pattern_file(calibration, 0.0), ValueError, "point_rate"),
+        (lambda: lr.Pattern.from_calibration(42), TypeError, "from_calibration"),
+    ]
+    for call, error, words in cases:
+        with pytest.raises(error) as raised:
+            call()
+        assert words in str(raised.value), (words, str(raised.value))
