@@ -97,8 +97,8 @@ bool RaycastNode::init() {
     const std::string beams =
         s.pattern
             ? std::to_string(s.points_per_scan) + " points a scan from '" + s.pattern_file + "'"
-        : s.calibrated ? std::to_string(s.calibrated->size()) + " beams a turn from '" +
-                             s.calibratedFrom() + "'"
+        : s.calibrated ? std::to_string(s.calibrated->size()) + " beams a turn from " +
+                             (s.preset_head ? s.calibratedFrom() : "'" + s.calibratedFrom() + "'")
                        : std::to_string(s.scan.pattern().size()) + " beams (" +
                              std::to_string(s.scan.elevations.size()) + " rings)";
     ROS_INFO(

@@ -210,6 +210,29 @@ void readOusterMetadata(ParamReader* r, SensorParams* s, std::vector<std::string
   }
 }
 
+// A Velodyne preset's lasers as the sensor fires them (core::SensorModel::head), one turn of
+// scanTime(), unless a file gives the beams or the fan, the elevations or divergent beams are set
+// (a note says so: the preset is then the grid of its elevations, every ring at the same
+// azimuths).
+void readPresetHead(ParamReader* r, SensorParams* s) {
+  s->preset_head = false;
+  if (s->sensor_model.empty() || s->calibrated || s->pattern) return;
+  const std::optional<core::SensorModel> model = core::findSensorModel(s->sensor_model);
+  if (!model || !model->head) return;
+  const char* grid_by = nullptr;
+  for (const char* name : {"elevations", "samples", "angle_increment", "angle_min", "angle_max"}) {
+    if (!grid_by && r->has(name)) grid_by = name;
+  }
+  if (!grid_by && s->returns.beam_samples > 1) grid_by = "beam_samples";
+  if (grid_by) {
+    r->note(r->prefix() + grid_by + " is set: " + s->sensor_model +
+            "'s lasers as a grid (every ring at the same azimuths, a column at once)");
+    return;
+  }
+  s->calibrated = std::make_shared<const core::BeamList>(model->beams(s->scanTime()));
+  s->preset_head = true;
+}
+
 // ~pattern_file, ~points_per_scan, ~point_rate: beams from a scan pattern file instead of the fan.
 void readPatternFile(ParamReader* r, SensorParams* s) {
   s->pattern_file = r->text("pattern_file", s->pattern_file);
@@ -288,6 +311,7 @@ void readSensor(ParamReader* r, SensorParams* s, bool entry, std::vector<std::st
   readPatternFile(r, s);
   readCalibration(r, s);
   readOusterMetadata(r, s, warnings);
+  readPresetHead(r, s);
   if (s->returns.beam_samples > 1 && (s->pattern || s->calibrated)) {
     const char* file = s->pattern                      ? "pattern_file"
                        : !s->calibration_file.empty() ? "calibration_file"

@@ -244,6 +244,12 @@ struct Pattern {
     p.elevations = model->elevations;
     p.preset = model;
     p.build();
+    if (model->head) {
+      // The lasers as the sensor fires them, one turn at the preset's rate (as the node's preset).
+      p.turn = std::make_shared<const core::BeamList>(model->beams(1 / model->rate));
+      p.source = name + " preset";
+      p.offGridSpec();
+    }
     return p;
   }
 

@@ -140,6 +140,13 @@ def test_presets_bring_their_range_limits():
     finite = scans.ranges[np.isfinite(scans.ranges)]
     assert finite.min() >= 0.1 and finite.max() <= 30.0
     assert lr.Pattern.fan(-1, 1, samples=3).range_max is None
+    # A Velodyne preset fires its lasers as the user manual says (the node's preset): 1808
+    # sequences of 16 in its 0.1 s turn, laser i of sequence q at q * 55.296 + i * 2.304 us.
+    vlp = lr.Pattern.preset("VLP-16")
+    assert vlp.off_grid and vlp.size == 16 * 1808 and vlp.elevations is None
+    assert (vlp.range_min, vlp.range_max, vlp.rate) == (0.4, 100.0, 10.0)
+    np.testing.assert_allclose(vlp.times[16 * 5 + 3], 5 * 55.296e-6 + 3 * 2.304e-6, rtol=1e-12)
+    assert vlp.lines[:4] == [0, 8, 1, 9]  # laser ids 0..3 at -15, 1, -13, 3 deg
 
 
 def test_rep117_and_the_min_range_policy(walls):

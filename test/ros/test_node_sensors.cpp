@@ -39,15 +39,19 @@ TEST(NodeSensors, APlanarSensorMatchesHandComputedRanges) {
   for (int i = 0; i < 8; ++i) EXPECT_NEAR(rangeOf(*scan, i), expected[i], kTolerance) << i;
 }
 
-// The VLP-16 preset: 16 rings from -15 to +15 deg, 1800 azimuths. In the closed room every beam
-// returns, and every point must lie where its beam meets the room's faces.
-TEST(NodeSensors, AVlp16CloudMatchesTheGeometry) {
+// The VLP-16 preset: its lasers as the user manual fires them, 16 a firing sequence 2.304 us apart,
+// a sequence every 55.296 us, 1808 sequences in the 0.1 s turn; ring r at -15 + 2r deg is laser id
+// 2r below the horizon and 2(r - 8) + 1 above it. Cast at once (sweep instant), each point keeps
+// its firing time and lies at the head's azimuth then (pi at the stamp, turning clockwise). In the
+// closed room every beam returns, and every point must lie where its beam meets the room's faces.
+TEST(NodeSensors, AVlp16CloudMatchesTheGeometryAndTheFiringTimes) {
   const auto cloud = rig->waitFor<sensor_msgs::PointCloud2>(
       &rig->clouds, [](const sensor_msgs::PointCloud2&) { return true; }, 30.0);
   ASSERT_TRUE(cloud) << "no cloud from sensor vlp";
   EXPECT_EQ(cloud->header.frame_id, "vlp");
+  const int sequences = 1808;
   ASSERT_EQ(cloud->height, 1u);
-  ASSERT_EQ(cloud->width, 16u * 1800u);
+  ASSERT_EQ(cloud->width, 16u * sequences);
   std::vector<std::string> fields;
   for (const auto& f : cloud->fields) fields.push_back(f.name);
   EXPECT_EQ(fields, (std::vector<std::string>{"x", "y", "z", "intensity", "ring", "time"}));
@@ -59,6 +63,7 @@ TEST(NodeSensors, AVlp16CloudMatchesTheGeometry) {
   sensor_msgs::PointCloud2ConstIterator<std::uint16_t> ring(*cloud, "ring");
   int bad = 0;
   std::vector<int> per_ring(16, 0);
+  std::set<std::pair<int, int>> fired;  // (sequence, laser id): each once
   for (; x != x.end(); ++x, ++y, ++z, ++time, ++ring) {
     const Eigen::Vector3d p(*x, *y, *z);
     const double r = p.norm();
@@ -67,16 +72,25 @@ TEST(NodeSensors, AVlp16CloudMatchesTheGeometry) {
     const double elevation = std::asin(dir.z()) * 180 / M_PI;
     ASSERT_LT(*ring, 16);
     ++per_ring[*ring];
+    const int id = *ring < 8 ? 2 * *ring : 2 * (*ring - 8) + 1;
+    const int sequence = static_cast<int>(std::lround((*time - id * 2.304e-6) / 55.296e-6));
+    fired.insert({sequence, id});
+    const double t = sequence * 55.296e-6 + id * 2.304e-6;
+    const double head = M_PI - 2 * M_PI * t / 0.1;
+    const double azimuth_off = std::remainder(std::atan2(dir.y(), dir.x()) - head, 2 * M_PI);
     const bool ok = std::abs(r - expected) < kTolerance &&
-                    std::abs(elevation - (-15.0 + 2.0 * *ring)) < 1e-3 && *time == 0.0f;
+                    std::abs(elevation - (-15.0 + 2.0 * *ring)) < 1e-3 && sequence >= 0 &&
+                    sequence < sequences && std::abs(*time - t) < 1e-8 &&
+                    std::abs(azimuth_off) < 2e-6;
     if (!ok && ++bad <= 5) {
       ADD_FAILURE() << "point " << p.transpose() << " (ring " << *ring << ", elevation "
-                    << elevation << " deg, time " << *time << "): range " << r << ", the room at "
-                    << expected;
+                    << elevation << " deg, time " << *time << ", " << azimuth_off
+                    << " rad from the head's azimuth): range " << r << ", the room at " << expected;
     }
   }
   EXPECT_EQ(bad, 0);
-  for (int r = 0; r < 16; ++r) EXPECT_EQ(per_ring[r], 1800) << "ring " << r;
+  EXPECT_EQ(fired.size(), 16u * sequences);
+  for (int r = 0; r < 16; ++r) EXPECT_EQ(per_ring[r], sequences) << "ring " << r;
 }
 
 // "spinner": 721 beams over the full turn, the head turning once in 0.1 s, beam i at stamp +

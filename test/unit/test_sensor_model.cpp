@@ -3,10 +3,12 @@
 // counts, and apply() sets only what a preset owns.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "laser_raycast/core/measurement_model.h"
 #include "laser_raycast/core/sensor_model.h"
@@ -40,8 +42,8 @@ TEST(SensorModel, EveryNameFindsItsPreset) {
     EXPECT_FALSE(findSensorModel(bad)) << bad;
   }
   const std::string message = sensorModelProblem("VLP16");
-  for (const char* name : {"'VLP16'", "VLP-16", "HDL-32E", "OS1-64", "UTM-30LX", "TiM571",
-                           "LDS-01", "OS1-64-realistic"}) {
+  for (const char* name : {"'VLP16'", "VLP-16", "HDL-32E", "OS1-64", "UTM-30LX", "TiM571", "LDS-01",
+                           "OS1-64-realistic"}) {
     EXPECT_NE(message.find(name), std::string::npos) << message;
   }
 }
@@ -199,6 +201,38 @@ TEST(SensorModel, ApplySetsOnlyWhatAPresetOwns) {
   EXPECT_EQ(p.ringCount(), 16);
   // A preset's sensor model with a bad id (a cast from a bad integer) is refused.
   EXPECT_THROW(sensorModel(static_cast<SensorModelId>(42)), std::invalid_argument);
+}
+
+// The Velodyne presets' heads are the lasers of their grids, by laser id as the manuals list them:
+// sorted by elevation, the VLP-16's are its rings exactly, the HDL-32E's its rings as the table
+// rounds them (to 0.01 deg). The other presets publish no firing table.
+TEST(SensorModel, TheVelodyneHeadsAreTheGridsLasers) {
+  for (SensorModelId id : {SensorModelId::kVlp16, SensorModelId::kHdl32e}) {
+    const SensorModel model = sensorModel(id);
+    ASSERT_TRUE(model.head) << toString(id);
+    std::vector<double> by_elevation;
+    for (const VelodyneLaser& l : model.head->lasers) by_elevation.push_back(l.elevation);
+    std::sort(by_elevation.begin(), by_elevation.end());
+    const ScanPattern grid = patternOf(model);
+    ASSERT_EQ(by_elevation.size(), grid.elevations().size()) << toString(id);
+    const double tolerance = id == SensorModelId::kVlp16 ? 1e-15 : 0.005 * kDeg;
+    for (std::size_t r = 0; r < by_elevation.size(); ++r) {
+      EXPECT_NEAR(by_elevation[r], grid.elevations()[r], tolerance) << toString(id) << " " << r;
+    }
+    const BeamList turn = model.beams(1 / model.rate);
+    EXPECT_NO_THROW(turn.validate());
+    // As many firing sequences as fit in a turn: about the grid's azimuths (1808 against 1800 for
+    // the VLP-16, whose grid is the datasheet's 0.2 deg; 2170 for the HDL-32E).
+    const int sequences = turn.size() / static_cast<int>(by_elevation.size());
+    EXPECT_EQ(sequences, static_cast<int>(1 / model.rate / model.head->timing.sequence_period));
+    EXPECT_NEAR(sequences, grid.azimuthCount(), 8) << toString(id);
+  }
+  EXPECT_EQ(sensorModel(SensorModelId::kVlp16).head->timing.laser_period, 2.304e-6);
+  EXPECT_EQ(sensorModel(SensorModelId::kHdl32e).head->timing.laser_period, 1.152e-6);
+  for (SensorModelId id : {SensorModelId::kOs1_64, SensorModelId::kUtm30lx, SensorModelId::kTim571,
+                           SensorModelId::kLds01}) {
+    EXPECT_FALSE(sensorModel(id).head) << toString(id);
+  }
 }
 
 }  // namespace

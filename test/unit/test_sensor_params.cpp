@@ -4,6 +4,7 @@
 // (or the entry) and the value.
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -109,10 +110,97 @@ TEST(SensorParams, APresetSetsThePatternRangesAndRateAndExplicitValuesWin) {
   EXPECT_EQ(parsed.params.sensors.at(0).scan.output.range_max, 3.5);
 }
 
+// The Velodyne presets fire their lasers as the user manuals say: one turn of firing sequences at
+// the sensor's rate (VLP-16: a sequence of 16 every 55.296 us, 2.304 us apart; HDL-32E: 32 every
+// 46.08 us, 1.152 us apart), rings by ascending elevation. Setting the fan, the elevations or
+// divergent beams makes the preset the grid of its elevations, and says so; a calibration file
+// gives its own lasers.
+TEST(SensorParams, TheVelodynePresetsFireTheirLasersAsTheManualsSay) {
+  Parsed parsed = parse(values({{"sensor_model", "VLP-16"}}));
+  ASSERT_EQ(parsed.error, "");
+  const laser_raycast::SensorParams& s = parsed.params.sensors.at(0);
+  ASSERT_TRUE(s.calibrated);
+  EXPECT_TRUE(s.preset_head);
+  EXPECT_EQ(s.calibratedFrom(), "the VLP-16 preset's lasers");
+  const int sequences = static_cast<int>(0.1 / 55.296e-6);  // 1808
+  ASSERT_EQ(s.calibrated->size(), 16 * sequences);
+  // Laser id i of sequence q: its elevation from the manual's table, its ring by elevation, its
+  // time q * 55.296 + i * 2.304 us, its azimuth the head's then (pi at 0, clockwise, a turn in
+  // 0.1 s).
+  const int table[16] = {-15, 1, -13, 3, -11, 5, -9, 7, -7, 9, -5, 11, -3, 13, -1, 15};
+  for (int q : {0, 1, 903, sequences - 1}) {
+    for (int i = 0; i < 16; ++i) {
+      const int b = q * 16 + i;
+      const Eigen::Vector3d& d = s.calibrated->directions[b];
+      const double t = q * 55.296e-6 + i * 2.304e-6;
+      EXPECT_NEAR(std::asin(d.z()), table[i] * M_PI / 180, 1e-12) << b;
+      EXPECT_EQ(s.calibrated->line(b), (table[i] + 15) / 2) << b;
+      EXPECT_NEAR(s.calibrated->time(b), t, 1e-15) << b;
+      EXPECT_NEAR(std::remainder(std::atan2(d.y(), d.x()) - (M_PI - 2 * M_PI * t / 0.1), 2 * M_PI),
+                  0.0, 1e-12)
+          << b;
+      EXPECT_EQ(s.calibrated->origin(b), Eigen::Vector3d::Zero()) << b;
+    }
+  }
+  EXPECT_NEAR(s.sweepDuration(), 0.0, 0.0);  // instant: every beam cast at the stamp
+
+  // A rotating VLP-16 at 20 Hz turns in 0.05 s: half the sequences.
+  parsed = parse(values({{"sensor_model", "VLP-16"}, {"rate", 20}, {"sweep", "rotating"}}));
+  ASSERT_EQ(parsed.error, "");
+  const laser_raycast::SensorParams& fast = parsed.params.sensors.at(0);
+  ASSERT_TRUE(fast.calibrated);
+  EXPECT_EQ(fast.calibrated->size(), 16 * static_cast<int>(0.05 / 55.296e-6));
+  EXPECT_NEAR(fast.sweepDuration(), fast.calibrated->times.back(), 0.0);
+
+  parsed = parse(values({{"sensor_model", "HDL-32E"}}));
+  ASSERT_EQ(parsed.error, "");
+  const laser_raycast::SensorParams& hdl = parsed.params.sensors.at(0);
+  ASSERT_TRUE(hdl.calibrated);
+  EXPECT_EQ(hdl.calibrated->size(), 32 * static_cast<int>(0.1 / 46.08e-6));
+  EXPECT_NEAR(hdl.calibrated->time(1), 1.152e-6, 1e-15);
+  EXPECT_NEAR(std::asin(hdl.calibrated->directions[0].z()), -30.67 * M_PI / 180, 1e-12);
+  EXPECT_EQ(hdl.calibrated->line(0), 0);    // the lowest laser
+  EXPECT_EQ(hdl.calibrated->line(31), 31);  // the highest, +10.67 deg
+
+  // Set explicitly, the fan, elevations or divergent beams give the grid, with a note.
+  for (const auto& [name, value] :
+       std::vector<std::pair<std::string, XmlRpcValue>>{{"samples", XmlRpcValue(900)},
+                                                        {"angle_min", XmlRpcValue(-1.0)},
+                                                        {"elevations", list({-0.1, 0.1})},
+                                                        {"beam_samples", XmlRpcValue(7)}}) {
+    XmlRpcValue v = values({{"sensor_model", "VLP-16"}});
+    v[name] = value;
+    if (name == "beam_samples") v["beam_divergence"] = 0.003;
+    parsed = parse(v);
+    ASSERT_EQ(parsed.error, "") << name;
+    const laser_raycast::SensorParams& grid = parsed.params.sensors.at(0);
+    EXPECT_FALSE(grid.calibrated) << name;
+    EXPECT_FALSE(grid.preset_head) << name;
+    const auto& log = parsed.report.values;
+    EXPECT_NE(std::find(log.begin(), log.end(),
+                        "~" + name + " is set: VLP-16's lasers as a grid (every ring at the same " +
+                            "azimuths, a column at once)"),
+              log.end())
+        << name;
+  }
+  // A calibration file's lasers, not the preset's.
+  parsed = parse(
+      values({{"sensor_model", "VLP-16"},
+              {"calibration_file", LASER_RAYCAST_SOURCE_DIR "/test/data/vlp16_calibration.yaml"}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_TRUE(parsed.params.sensors.at(0).calibrated);
+  EXPECT_FALSE(parsed.params.sensors.at(0).preset_head);
+  // Presets without a published firing table stay grids.
+  for (const char* name : {"OS1-64", "UTM-30LX", "LDS-01"}) {
+    parsed = parse(values({{"sensor_model", name}}));
+    ASSERT_EQ(parsed.error, "") << name;
+    EXPECT_FALSE(parsed.params.sensors.at(0).calibrated) << name;
+  }
+}
+
 TEST(SensorParams, AnUnknownPresetNamesTheChoices) {
-  expectRefused(values({{"sensor_model", "VLP-15"}}),
-                {"~sensor_model", "'VLP-15' is not one of", "VLP-16", "LDS-01",
-                 "OS1-64-realistic"});
+  expectRefused(values({{"sensor_model", "VLP-15"}}), {"~sensor_model", "'VLP-15' is not one of",
+                                                       "VLP-16", "LDS-01", "OS1-64-realistic"});
   expectRefused(values({{"sensor_model", "LDS-01-realistic"}}),
                 {"~sensor_model", "'LDS-01-realistic'", "no realistic variant"});
 }

@@ -1,6 +1,7 @@
 // Presets of real sensors: the beam pattern, range limits and scan rate of a named lidar, taken
-// from its datasheet (src/core/measurement/sensor_model.cpp says where each value comes from;
-// docs/sensors.md lists them). A preset fills a ScanSpec; explicit settings then override single fields of it.
+// from its datasheet and user manual (src/core/measurement/sensor_model.cpp says where each value
+// comes from; docs/sensors.md lists them). A preset fills a ScanSpec; explicit settings then
+// override single fields of it.
 #pragma once
 
 #include <optional>
@@ -11,6 +12,7 @@
 #include "laser_raycast/core/returns.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scan_spec.h"
+#include "laser_raycast/core/velodyne_beams.h"
 
 namespace laser_raycast {
 namespace core {
@@ -57,6 +59,12 @@ struct SensorModel {
   };
   std::optional<Realism> realism;
   bool realistic = false;  // this is the "-realistic" variant (realism is set)
+  // The lasers as the sensor fires them, where the user manual publishes them (the Velodyne
+  // presets: each laser's elevation by laser id and its firing time, velodyne_beams.h): the
+  // preset's beams are then the head's turn (beams()), each laser at the azimuth its firing time
+  // gives, and elevations x fan is the same lasers as a grid (every ring at the same azimuths, a
+  // column at once), what a preset gives when its fan or elevations are set explicitly.
+  std::optional<VelodyneHead> head;
 
   // "VLP-16", or "OS1-64-realistic" for the variant.
   std::string name() const;
@@ -70,6 +78,8 @@ struct SensorModel {
   // For the realistic variant, sets the beam divergence, sub-rays, return mode and separation;
   // otherwise leaves returns as it was.
   void applyReturns(ReturnsConfig* returns) const;
+  // The head's beams over one turn taking scan_time s (VelodyneHead::scan); head must be set.
+  BeamList beams(double scan_time) const { return head->scan(scan_time); }
 };
 
 // The preset of that sensor.

@@ -108,10 +108,13 @@ struct SensorParams {
   // ~ouster_metadata: an Ouster sensor metadata JSON; its W columns over one turn of scanTime(),
   // the same every scan (core::OusterHead::scan).
   std::string ouster_metadata;
-  // The beams of calibration_file or ouster_metadata (one turn).
+  // The beams of calibration_file or ouster_metadata, or of sensor_model's head (one turn).
   std::shared_ptr<const core::BeamList> calibrated;
-  // The file calibrated was read from.
-  const std::string& calibratedFrom() const {
+  // calibrated is the preset's head (core::SensorModel::head), not a file's.
+  bool preset_head = false;
+  // Where calibrated came from: the file, or "the <sensor_model> preset's lasers".
+  std::string calibratedFrom() const {
+    if (preset_head) return "the " + sensor_model + " preset's lasers";
     return calibration_file.empty() ? ouster_metadata : calibration_file;
   }
   // Beams off any grid (a pattern file's or a calibrated head's): a PointCloud2 of one row.

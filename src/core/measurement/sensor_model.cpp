@@ -37,7 +37,7 @@ FanSpec sector(double first_deg, double last_deg, double increment_deg) {
 }
 
 SensorModel vlp16() {
-  SensorModel m{SensorModelId::kVlp16, {}, {}, 0, 0, 0, std::nullopt, false};
+  SensorModel m{SensorModelId::kVlp16, {}, {}, 0, 0, 0, std::nullopt, false, std::nullopt};
   // Per the Velodyne VLP-16 user manual and datasheet: 16 channels, vertical field of view +15 to
   // -15 deg at 2.0 deg vertical resolution (the lasers' elevation table: -15, -13, ..., 13, 15).
   m.elevations = uniformRings(-15.0, 15.0, 16);
@@ -50,11 +50,14 @@ SensorModel vlp16() {
   // min_range default of velodyne_pointcloud's launch files (a driver setting, not a sensor spec).
   m.range_max = 100.0;
   m.range_min = 0.4;
+  // Per the user manual: the lasers by id (-15, 1, -13, 3, ... deg) fired 2.304 us apart, a
+  // sequence every 55.296 us: the same 16 elevations as above, each at its own azimuth and time.
+  m.head = nominalVlp16();
   return m;
 }
 
 SensorModel hdl32e() {
-  SensorModel m{SensorModelId::kHdl32e, {}, {}, 0, 0, 0, std::nullopt, false};
+  SensorModel m{SensorModelId::kHdl32e, {}, {}, 0, 0, 0, std::nullopt, false, std::nullopt};
   // Per the Velodyne HDL-32E user manual and datasheet: 32 lasers, vertical field of view +10.67
   // to -30.67 deg at 1.33 deg vertical resolution. The published table is spaced by exactly 4/3
   // deg with 0 deg as the 24th laser from the bottom: -92/3 (-30.67) to 32/3 (10.67) deg.
@@ -67,11 +70,14 @@ SensorModel hdl32e() {
   // pointcloud's min_range launch default, as for the VLP-16.
   m.range_max = 100.0;
   m.range_min = 0.4;
+  // Per the user manual: the lasers by id (-30.67, -9.33, -29.33, ... deg) fired 1.152 us apart,
+  // a cycle every 46.08 us: the elevations above, rounded as the manual's table gives them.
+  m.head = nominalHdl32e();
   return m;
 }
 
 SensorModel os1_64() {
-  SensorModel m{SensorModelId::kOs1_64, {}, {}, 0, 0, 0, std::nullopt, false};
+  SensorModel m{SensorModelId::kOs1_64, {}, {}, 0, 0, 0, std::nullopt, false, std::nullopt};
   // Per the Ouster OS1 datasheet (first generation, 64 channels): vertical field of view +16.6 to
   // -16.6 deg (33.2 deg), beams spaced uniformly (0.527 deg). Later OS1 revisions (45 deg, and
   // gradient or below-horizon spacing) are other sensors; give their elevations explicitly.
@@ -94,7 +100,7 @@ SensorModel os1_64() {
 }
 
 SensorModel utm30lx() {
-  SensorModel m{SensorModelId::kUtm30lx, {0.0}, {}, 0, 0, 0, std::nullopt, false};
+  SensorModel m{SensorModelId::kUtm30lx, {0.0}, {}, 0, 0, 0, std::nullopt, false, std::nullopt};
   // Per the Hokuyo UTM-30LX specification and its SCIP 2.0 protocol: 270 deg scan, 1440 steps a
   // turn (0.25 deg), steps 0..1080 with the front at step 540: -135 to +135 deg, 1081 beams.
   m.fan = sector(-135.0, 135.0, 0.25);
@@ -108,7 +114,7 @@ SensorModel utm30lx() {
 }
 
 SensorModel tim571() {
-  SensorModel m{SensorModelId::kTim571, {0.0}, {}, 0, 0, 0, std::nullopt, false};
+  SensorModel m{SensorModelId::kTim571, {0.0}, {}, 0, 0, 0, std::nullopt, false, std::nullopt};
   // Per the SICK TiM571 product data sheet: aperture angle 270 deg, angular resolution 0.33 deg
   // (a third of a degree: 811 beams from -135 to +135 deg, as the sick_tim driver publishes).
   m.fan = sector(-135.0, 135.0, 1.0 / 3.0);
@@ -121,7 +127,7 @@ SensorModel tim571() {
 }
 
 SensorModel lds01() {
-  SensorModel m{SensorModelId::kLds01, {0.0}, {}, 0, 0, 0, std::nullopt, false};
+  SensorModel m{SensorModelId::kLds01, {0.0}, {}, 0, 0, 0, std::nullopt, false, std::nullopt};
   // Per the ROBOTIS LDS-01 (HLS-LFCD2) specification: angular range 360 deg, angular resolution
   // 1 deg. Its driver (hls_lfcd_lds_driver) publishes 360 beams from 0 to 359 deg.
   m.fan = sector(0.0, 359.0, 1.0);
