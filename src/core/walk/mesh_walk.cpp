@@ -338,8 +338,9 @@ class MeshWalk {
   // Each open beam's sub-rays (a bundle's) through the node's subtree, each on its own ray (the
   // boxes each enters are its own): two at a time as traceRect traces beams where a beam's
   // sub-rays lie close together (a divergent beam's, a calibrated lidar's one), one at a time for
-  // a cell's list of beams (beams/beam_cells.h), which side by side went slower (the rosette
-  // through the warehouse, bench --quick: 0.47-0.49 of Embree's speed against 0.50-0.51). A
+  // a cell's list of beams (beams/beam_cells.h), where side by side gained nothing (the rosette's
+  // still poses, bench --quick: warehouse 0.47-0.49 of Embree's speed against 0.50-0.51, forest
+  // and million the same either way). A
   // sub-ray's walk reads and lowers only its own far limit, so pairing them changes no test.
   void traceSubRays(const Entry& e) {
     if (bundle_->first) {
