@@ -10,6 +10,7 @@
 
 #include "laser_raycast/core/sensor_model.h"
 #include "laser_raycast/loader/ouster_metadata.h"
+#include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/velodyne_calibration.h"
 
 namespace laser_raycast {
@@ -210,26 +211,45 @@ void readOusterMetadata(ParamReader* r, SensorParams* s, std::vector<std::string
   }
 }
 
-// A Velodyne preset's lasers as the sensor fires them (core::SensorModel::head), one turn of
-// scanTime(), unless a file gives the beams or the fan, the elevations or divergent beams are set
-// (a note says so: the preset is then the grid of its elevations, every ring at the same
-// azimuths).
+// A preset's beams as the sensor fires them (core::SensorModel::head, or head_file's Ouster head),
+// one turn of scanTime(), unless a file gives the beams or the fan, the elevations or divergent
+// beams are set (a note says so: the preset is then the grid of its elevations, every ring at the
+// same azimuths, a column at once).
 void readPresetHead(ParamReader* r, SensorParams* s) {
   s->preset_head = false;
   if (s->sensor_model.empty() || s->calibrated || s->pattern) return;
   const std::optional<core::SensorModel> model = core::findSensorModel(s->sensor_model);
-  if (!model || !model->head) return;
+  if (!model || !(model->head || !model->head_file.empty())) return;
   const char* grid_by = nullptr;
   for (const char* name : {"elevations", "samples", "angle_increment", "angle_min", "angle_max"}) {
     if (!grid_by && r->has(name)) grid_by = name;
   }
-  if (!grid_by && s->returns.beam_samples > 1) grid_by = "beam_samples";
+  const std::string as_grid = s->sensor_model +
+                              "'s lasers as a grid (every ring at the same azimuths, a column at once)";
   if (grid_by) {
-    r->note(r->prefix() + grid_by + " is set: " + s->sensor_model +
-            "'s lasers as a grid (every ring at the same azimuths, a column at once)");
+    r->note(r->prefix() + grid_by + " is set: " + as_grid);
     return;
   }
-  s->calibrated = std::make_shared<const core::BeamList>(model->beams(s->scanTime()));
+  if (s->returns.beam_samples > 1) {
+    // Divergent beams are cast for grids only (set here, or by a realistic variant).
+    r->note(r->prefix() + "beam_samples is " + std::to_string(s->returns.beam_samples) + ": " +
+            as_grid);
+    return;
+  }
+  if (model->head) {
+    s->calibrated = std::make_shared<const core::BeamList>(model->beams(s->scanTime()));
+  } else {
+    try {
+      const core::OusterHead head =
+          loadOusterMetadata(resolvePackageUri(model->head_file, rosPackagePath));
+      s->calibrated = std::make_shared<const core::BeamList>(head.scan(s->scanTime()));
+    } catch (const std::exception& e) {
+      // The package's own file: missing or unreadable only in a broken installation.
+      r->fail("sensor_model", "'" + s->sensor_model + "': its beams' file " + model->head_file +
+                                  " (part of this package): " + e.what());
+      return;
+    }
+  }
   s->preset_head = true;
 }
 

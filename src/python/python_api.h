@@ -31,6 +31,7 @@
 #include "laser_raycast/core/sensor_model.h"
 #include "laser_raycast/loader/kinematics.h"
 #include "laser_raycast/loader/ouster_metadata.h"
+#include "laser_raycast/loader/package_resolver.h"
 #include "laser_raycast/loader/scene_loader.h"
 #include "laser_raycast/loader/velodyne_calibration.h"
 
@@ -244,9 +245,20 @@ struct Pattern {
     p.elevations = model->elevations;
     p.preset = model;
     p.build();
+    // The beams as the sensor fires them, one turn at the preset's rate (as the node's preset).
     if (model->head) {
-      // The lasers as the sensor fires them, one turn at the preset's rate (as the node's preset).
       p.turn = std::make_shared<const core::BeamList>(model->beams(1 / model->rate));
+    } else if (!model->head_file.empty()) {
+      try {
+        const core::OusterHead head =
+            loadOusterMetadata(resolvePackageUri(model->head_file, rosPackagePath));
+        p.turn = std::make_shared<const core::BeamList>(head.scan(1 / model->rate));
+      } catch (const std::exception& e) {
+        throw py::value_error("name: '" + name + "': its beams' file " + model->head_file +
+                              " (part of the package): " + e.what());
+      }
+    }
+    if (p.turn) {
       p.source = name + " preset";
       p.offGridSpec();
     }

@@ -147,6 +147,11 @@ def test_presets_bring_their_range_limits():
     assert (vlp.range_min, vlp.range_max, vlp.rate) == (0.4, 100.0, 10.0)
     np.testing.assert_allclose(vlp.times[16 * 5 + 3], 5 * 55.296e-6 + 3 * 2.304e-6, rtol=1e-12)
     assert vlp.lines[:4] == [0, 8, 1, 9]  # laser ids 0..3 at -15, 1, -13, 3 deg
+    # The OS1-64 as its nominal metadata file in the package places its beams: 1024 columns of 64,
+    # each from its beam origin off the axis.
+    os1 = lr.Pattern.preset("OS1-64")
+    assert os1.off_grid and os1.size == 64 * 1024
+    assert np.all(np.linalg.norm(os1.origins, axis=1) > 0.01)
 
 
 def test_rep117_and_the_min_range_policy(walls):

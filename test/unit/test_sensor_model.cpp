@@ -205,7 +205,7 @@ TEST(SensorModel, ApplySetsOnlyWhatAPresetOwns) {
 
 // The Velodyne presets' heads are the lasers of their grids, by laser id as the manuals list them:
 // sorted by elevation, the VLP-16's are its rings exactly, the HDL-32E's its rings as the table
-// rounds them (to 0.01 deg). The other presets publish no firing table.
+// rounds them (to 0.01 deg). The OS1-64's comes from a metadata file; the planar ones have none.
 TEST(SensorModel, TheVelodyneHeadsAreTheGridsLasers) {
   for (SensorModelId id : {SensorModelId::kVlp16, SensorModelId::kHdl32e}) {
     const SensorModel model = sensorModel(id);
@@ -232,6 +232,13 @@ TEST(SensorModel, TheVelodyneHeadsAreTheGridsLasers) {
   for (SensorModelId id : {SensorModelId::kOs1_64, SensorModelId::kUtm30lx, SensorModelId::kTim571,
                            SensorModelId::kLds01}) {
     EXPECT_FALSE(sensorModel(id).head) << toString(id);
+  }
+  // The OS1-64's beams come from the nominal metadata file in the package (the loader reads it).
+  EXPECT_EQ(sensorModel(SensorModelId::kOs1_64).head_file,
+            "package://laser_raycast/config/ouster/os1_64_nominal.json");
+  for (SensorModelId id : {SensorModelId::kVlp16, SensorModelId::kHdl32e, SensorModelId::kUtm30lx,
+                           SensorModelId::kTim571, SensorModelId::kLds01}) {
+    EXPECT_EQ(sensorModel(id).head_file, "") << toString(id);
   }
 }
 

@@ -114,8 +114,8 @@ TEST(SensorParams, APresetSetsThePatternRangesAndRateAndExplicitValuesWin) {
 // the sensor's rate (VLP-16: a sequence of 16 every 55.296 us, 2.304 us apart; HDL-32E: 32 every
 // 46.08 us, 1.152 us apart), rings by ascending elevation. Setting the fan, the elevations or
 // divergent beams makes the preset the grid of its elevations, and says so; a calibration file
-// gives its own lasers.
-TEST(SensorParams, TheVelodynePresetsFireTheirLasersAsTheManualsSay) {
+// gives its own lasers. The OS1-64 fires as its nominal metadata file in the package says.
+TEST(SensorParams, TheLidarPresetsFireTheirLasersAsTheirMakersSay) {
   Parsed parsed = parse(values({{"sensor_model", "VLP-16"}}));
   ASSERT_EQ(parsed.error, "");
   const laser_raycast::SensorParams& s = parsed.params.sensors.at(0);
@@ -177,9 +177,10 @@ TEST(SensorParams, TheVelodynePresetsFireTheirLasersAsTheManualsSay) {
     EXPECT_FALSE(grid.calibrated) << name;
     EXPECT_FALSE(grid.preset_head) << name;
     const auto& log = parsed.report.values;
+    const std::string why = name == "beam_samples" ? "~beam_samples is 7" : "~" + name + " is set";
     EXPECT_NE(std::find(log.begin(), log.end(),
-                        "~" + name + " is set: VLP-16's lasers as a grid (every ring at the same " +
-                            "azimuths, a column at once)"),
+                        why + ": VLP-16's lasers as a grid (every ring at the same azimuths, a " +
+                            "column at once)"),
               log.end())
         << name;
   }
@@ -190,11 +191,30 @@ TEST(SensorParams, TheVelodynePresetsFireTheirLasersAsTheManualsSay) {
   ASSERT_EQ(parsed.error, "");
   EXPECT_TRUE(parsed.params.sensors.at(0).calibrated);
   EXPECT_FALSE(parsed.params.sensors.at(0).preset_head);
-  // Presets without a published firing table stay grids.
-  for (const char* name : {"OS1-64", "UTM-30LX", "LDS-01"}) {
+  // The OS1-64's from the nominal metadata file in the package: 1024 columns of 64 rows, each
+  // column at its own time; its realistic variant's seven sub-rays a beam make it the grid.
+  parsed = parse(values({{"sensor_model", "OS1-64"}}));
+  ASSERT_EQ(parsed.error, "");
+  const laser_raycast::SensorParams& os1 = parsed.params.sensors.at(0);
+  ASSERT_TRUE(os1.calibrated);
+  EXPECT_TRUE(os1.preset_head);
+  EXPECT_EQ(os1.calibrated->size(), 64 * 1024);
+  EXPECT_NEAR(os1.calibrated->time(64), 0.1 / 1024, 1e-15);  // column 1's first row
+  EXPECT_EQ(os1.calibrated->line(0), 0);
+  parsed = parse(values({{"sensor_model", "OS1-64-realistic"}}));
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_FALSE(parsed.params.sensors.at(0).calibrated);
+  const auto& log = parsed.report.values;
+  EXPECT_NE(std::find(log.begin(), log.end(),
+                      "~beam_samples is 7: OS1-64-realistic's lasers as a grid (every ring at the "
+                      "same azimuths, a column at once)"),
+            log.end());
+  // Planar presets stay fans.
+  for (const char* name : {"UTM-30LX", "TiM571", "LDS-01"}) {
     parsed = parse(values({{"sensor_model", name}}));
     ASSERT_EQ(parsed.error, "") << name;
     EXPECT_FALSE(parsed.params.sensors.at(0).calibrated) << name;
+    EXPECT_TRUE(parsed.params.sensors.at(0).planar()) << name;
   }
 }
 

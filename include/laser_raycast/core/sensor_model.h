@@ -65,6 +65,9 @@ struct SensorModel {
   // gives, and elevations x fan is the same lasers as a grid (every ring at the same azimuths, a
   // column at once), what a preset gives when its fan or elevations are set explicitly.
   std::optional<VelodyneHead> head;
+  // Or an Ouster metadata file of this package (a package:// URI) whose head (OusterHead::scan)
+  // the preset's beams are in the same way, for the loader to read ("" for none).
+  std::string head_file;
 
   // "VLP-16", or "OS1-64-realistic" for the variant.
   std::string name() const;
