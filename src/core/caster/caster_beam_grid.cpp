@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -27,6 +28,13 @@ namespace laser_raycast {
 namespace core {
 
 namespace {
+
+// Whether two lists of vectors hold the same bits (so the same values; a list the node casts every
+// scan is compared with the fitted one as memory, not value by value).
+bool sameBits(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Eigen::Vector3d)) == 0);
+}
 
 // The bodies cast against in any of a list's walks, for its CastStats::bodies_culled.
 class CastBodies {
@@ -115,8 +123,8 @@ TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list, bo
 
 const BeamListGrid* CasterState::gridOf(const BeamList& beams) {
   const std::vector<Eigen::Vector3d>& origins = beams.origins;
-  if (!fitted || fitted->directions != beams.directions || fitted->origins != origins ||
-      fitted->lines != beams.lines) {
+  if (!fitted || !sameBits(fitted->directions, beams.directions) ||
+      !sameBits(fitted->origins, origins) || fitted->lines != beams.lines) {
     fitted.reset();
     beams.validate();
     fitted = FittedList{beams.directions, origins, beams.lines, fitBeamGrid(beams), {}};

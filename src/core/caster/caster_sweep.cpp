@@ -128,7 +128,7 @@ class BlockPlanner {
           if (!poses_.frameAt(column(k, c), f, &world_from_frame)) return false;  // not throughout
           const Eigen::Isometry3d column_from_frame =
               relativePose(beamsFrom(k, c), world_from_frame);
-          ref_from[k][c - lo] = block->key.sensor_from_frame[f] * column_from_frame.inverse();
+          ref_from[k].push_back(block->key.sensor_from_frame[f] * column_from_frame.inverse());
         }
       }
       block->motion[f] = motion(lo, std::move(ref_from));
@@ -168,18 +168,22 @@ class BlockPlanner {
     const Eigen::Matrix3d ref_rot_t = world_from_ref.linear().transpose();
     for (int k = 0; k < beams_.classes; ++k) {
       for (int c = lo; c <= hi; ++c) {
-        ref_from[k][c - lo] =
-            relativePose(ref_rot_t, world_from_ref.translation(), beamsFrom(k, c));
+        ref_from[k].push_back(
+            relativePose(ref_rot_t, world_from_ref.translation(), beamsFrom(k, c)));
       }
     }
     return motion(lo, std::move(ref_from));
   }
 
-  // Each row class's poses at columns lo..hi relative to the reference (class 0's are the
-  // columns'), to be filled.
+  // Room for each row class's poses at columns lo..hi relative to the reference (class 0's are
+  // the columns'), appended column by column: each written once (a calibrated Velodyne's block
+  // has 16 poses a column; constructed first and then written, they would pass through memory
+  // twice).
   using ClassPoses = std::vector<std::vector<Eigen::Isometry3d>>;
   ClassPoses classPoses(int lo, int hi) const {
-    return ClassPoses(beams_.classes, std::vector<Eigen::Isometry3d>(hi - lo + 1));
+    ClassPoses out(beams_.classes);
+    for (auto& poses : out) poses.reserve(hi - lo + 1);
+    return out;
   }
   // The block's motion from them.
   std::shared_ptr<const ColumnMotion> motion(int lo, ClassPoses ref_from) const {

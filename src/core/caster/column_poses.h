@@ -37,13 +37,16 @@ class ColumnPoses {
     }
     findBrackets(columns);
     sample_rotation_.set(samples.world_from_sensor, arcs_used_);
-    sensor_.resize(columns);
+    // Each pose written once as it is made (a calibrated Velodyne's turn has 28,928: constructed
+    // first and then written, they would pass through memory twice).
+    sensor_.reserve(columns);
     sensor_valid_.resize(columns);
     for (int c = 0; c < columns; ++c) {
       const Bracket& b = brackets_[c];
       sensor_valid_[c] = sample_sensor_ok_[b.i] && sample_sensor_ok_[b.j];
+      sensor_.emplace_back();
       if (sensor_valid_[c]) {
-        interpolate(samples.world_from_sensor, sample_rotation_, b, &sensor_[c]);
+        interpolate(samples.world_from_sensor, sample_rotation_, b, &sensor_.back());
       }
     }
     prepareFrames(scene, index);
