@@ -104,7 +104,6 @@ TEST(CastSweep, RefusesBadInput) {
                  {"no samples"});
 }
 
-
 // A sensor moving and turning through a random scene (a moving frame among them), sampled at
 // `steps` + 1 times across `duration` s: position p0 + v t, orientation turning at w (world axes)
 // from rpy; the cart moves at its own speed. With tilt 0 the sensor stays level and at one height
@@ -112,10 +111,10 @@ TEST(CastSweep, RefusesBadInput) {
 core::PoseSamples randomMotion(Rng& rng, const RandomScene& rs, double duration, double speed,
                                double turn_rate, double tilt) {
   core::PoseSamples s;
-  const Eigen::Vector3d p0 = uniformInBox(rng, Eigen::Vector3d(-6, -6, -0.3),
-                                          Eigen::Vector3d(6, 6, 0.3));
-  const Eigen::Vector3d v = speed * randomUnitVector(rng).cwiseProduct(
-                                        Eigen::Vector3d(1, 1, tilt > 0 ? 0.2 : 0.0));
+  const Eigen::Vector3d p0 =
+      uniformInBox(rng, Eigen::Vector3d(-6, -6, -0.3), Eigen::Vector3d(6, 6, 0.3));
+  const Eigen::Vector3d v =
+      speed * randomUnitVector(rng).cwiseProduct(Eigen::Vector3d(1, 1, tilt > 0 ? 0.2 : 0.0));
   const Eigen::Vector3d w(tilt * uniform(rng, -1, 1), tilt * uniform(rng, -1, 1),
                           turn_rate * uniform(rng, -1, 1));
   const Eigen::Matrix3d r0 =
@@ -149,8 +148,7 @@ struct Agreement {
   }
 };
 
-Agreement compare(const core::ScanResult& sweep, const core::ScanResult& columns,
-                  bool incidence) {
+Agreement compare(const core::ScanResult& sweep, const core::ScanResult& columns, bool incidence) {
   Agreement a;
   for (std::size_t i = 0; i < sweep.range.size(); ++i) {
     ++a.beams;
@@ -189,8 +187,8 @@ TEST(CastSweep, BlocksAgreeWithEachColumnCastOnItsOwn) {
     const core::ScanPattern pattern =
         planar ? core::ScanPattern(fanBySamples(-3.0, 3.0, 1441))
                : core::ScanPattern(fanBySamples(-M_PI, M_PI - 2 * M_PI / 720, 720),
-                                   {-0.26, -0.2, -0.13, -0.09, -0.05, -0.02, 0.0, 0.02, 0.04,
-                                    0.07, 0.11, 0.15, 0.2, 0.23, 0.26, 0.3});
+                                   {-0.26, -0.2, -0.13, -0.09, -0.05, -0.02, 0.0, 0.02, 0.04, 0.07,
+                                    0.11, 0.15, 0.2, 0.23, 0.26, 0.3});
     core::CastConfig cfg = config(trial % 3 != 2);
     cfg.threads = trial % 2 ? 2 : 1;
     cfg.compute_incidence = trial % 2 == 0;
@@ -210,9 +208,10 @@ TEST(CastSweep, BlocksAgreeWithEachColumnCastOnItsOwn) {
   EXPECT_LE(all.range_off, all.beams / 50000) << "of " << all.beams;
   EXPECT_LE(all.body_off, all.beams / 50000);
   EXPECT_LE(all.triangle_off, all.beams / 10000);
-  std::printf("sweep blocks vs columns: %lld beams, %lld hits, %lld ranges off, %lld bodies off, "
-              "%lld triangles off, worst %.3g m\n",
-              all.beams, all.hits, all.range_off, all.body_off, all.triangle_off, all.worst);
+  std::printf(
+      "sweep blocks vs columns: %lld beams, %lld hits, %lld ranges off, %lld bodies off, "
+      "%lld triangles off, worst %.3g m\n",
+      all.beams, all.hits, all.range_off, all.body_off, all.triangle_off, all.worst);
 }
 
 // A caster keeps state between casts (its beams' arrays and occlusion tiles, kept slices, the
@@ -263,13 +262,14 @@ TEST(CastSweep, PrimitivesPreTestLetsThroughEveryBeamOfABlock) {
     const int cart = scene.addFrame("cart");
     for (const char* label : {"box", "can", "bead"}) scene.addLabel(label);
     for (int i = 0; i < 300; ++i) {
-      const Eigen::Vector3d at = randomUnitVector(rng).cwiseProduct(Eigen::Vector3d(1, 1, 0.15)) *
-                                 uniform(rng, 0.4, 4);
+      const Eigen::Vector3d at =
+          randomUnitVector(rng).cwiseProduct(Eigen::Vector3d(1, 1, 0.15)) * uniform(rng, 0.4, 4);
       const Eigen::Isometry3d where = pose(at, randomRotation(rng).toRotationMatrix());
       const int frame = i % 4 ? world : cart;
       if (i % 3 == 0) {
-        addBody(&scene, core::Box{uniformInBox(rng, Eigen::Vector3d::Constant(0.03),
-                                               Eigen::Vector3d::Constant(0.4))},
+        addBody(&scene,
+                core::Box{uniformInBox(rng, Eigen::Vector3d::Constant(0.03),
+                                       Eigen::Vector3d::Constant(0.4))},
                 frame, where, 0);
       } else if (i % 3 == 1) {
         addBody(&scene, core::Cylinder{uniform(rng, 0.02, 0.2), uniform(rng, 0.05, 0.6)}, frame,
@@ -298,9 +298,10 @@ TEST(CastSweep, PrimitivesPreTestLetsThroughEveryBeamOfABlock) {
   EXPECT_GT(all.hits, 5000);
   EXPECT_EQ(all.range_off, 0) << "of " << all.beams;
   EXPECT_EQ(all.body_off, 0);
-  std::printf("primitives, sweep blocks vs columns: %lld beams, %lld hits, %lld ranges off, "
-              "worst %.3g m\n",
-              all.beams, all.hits, all.range_off, all.worst);
+  std::printf(
+      "primitives, sweep blocks vs columns: %lld beams, %lld hits, %lld ranges off, "
+      "worst %.3g m\n",
+      all.beams, all.hits, all.range_off, all.worst);
 }
 
 }  // namespace
