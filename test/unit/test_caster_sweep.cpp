@@ -8,7 +8,9 @@
 #include "cast_reference.h"
 #include "expect_invalid.h"
 #include "fan_specs.h"
+#include "laser_raycast/core/ouster_beams.h"
 #include "laser_raycast/core/pose_samples.h"
+#include "laser_raycast/core/velodyne_beams.h"
 #include "random_scene.h"
 #include "sweep_by_columns.h"
 
@@ -302,6 +304,82 @@ TEST(CastSweep, PrimitivesPreTestLetsThroughEveryBeamOfABlock) {
       "primitives, sweep blocks vs columns: %lld beams, %lld hits, %lld ranges off, "
       "worst %.3g m\n",
       all.beams, all.hits, all.range_off, all.worst);
+}
+
+// A scene carried by the sensor's robot: every frame's pose is the sensor's at each sample times
+// its pose relative to the sensor (rs.poses), plus `drift` (m) along x a sample further on. With
+// no drift nothing moves relative to the sensor, so a sweep's every beam meets the scene where the
+// cast from one pose does: rings, a planar fan, a calibrated Velodyne's turn and an Ouster's from
+// its beam origins, the sensor driving and turning. With a drift of 0.1 um a sample the frames
+// move relative to it (past the 1 nm within which a frame rides with the sensor): each beam from
+// its own column's poses, as each column cast on its own gives, and some beams see it.
+core::PoseSamples carriedBy(const core::PoseSamples& sensor, const core::FramePoses& relative,
+                            double drift) {
+  core::PoseSamples s = sensor;
+  for (std::size_t k = 0; k < s.times.size(); ++k) {
+    for (std::size_t f = 0; f < relative.pose.size(); ++f) {
+      s.frames[k].pose[f] = s.world_from_sensor[k] * relative.pose[f] *
+                            Eigen::Translation3d(drift * static_cast<double>(k), 0, 0);
+    }
+  }
+  return s;
+}
+
+TEST(CastSweep, ASceneTheSensorCarriesIsSweptAsItsCastFromOnePose) {
+  Rng rng(5802);
+  Agreement carried, drifting;
+  long long moved = 0;
+  for (int trial = 0; trial < 8; ++trial) {
+    const RandomScene rs = randomScene(rng);
+    const double tilt = trial % 2 ? 0.3 : 0.0;
+    const core::PoseSamples sensor =
+        randomMotion(rng, rs, 0.1, uniform(rng, 0.5, 3), uniform(rng, 0.5, 4), tilt);
+    const core::CastConfig cfg = config(true);
+    const Eigen::Isometry3d at = Eigen::Isometry3d::Identity();
+    // Grid sweeps.
+    const core::ScanPattern pattern =
+        trial % 4 < 2 ? core::ScanPattern(fanBySamples(-3.0, 3.0, 1441))
+                      : core::ScanPattern(fanBySamples(-M_PI, M_PI - 2 * M_PI / 720, 720),
+                                          {-0.2, -0.1, -0.03, 0.0, 0.05, 0.1, 0.2});
+    const double dt = 0.1 / pattern.azimuthCount();
+    core::Caster caster;
+    const core::ScanResult still = cast(rs.scene, rs.poses, at, pattern, cfg);
+    carried.add(
+        compare(caster.castSweep(rs.scene, carriedBy(sensor, rs.poses, 0), pattern, cfg, dt), still,
+                false));
+    const core::PoseSamples drift = carriedBy(sensor, rs.poses, 1e-7);
+    const core::ScanResult swept = caster.castSweep(rs.scene, drift, pattern, cfg, dt);
+    drifting.add(compare(swept, sweepByColumns(rs.scene, drift, pattern, cfg, dt), false));
+    for (std::size_t i = 0; i < swept.range.size(); ++i) {
+      moved += std::isfinite(swept.range[i]) && std::abs(swept.range[i] - still.range[i]) > 1e-8;
+    }
+    // Beam lists swept through the grids: a Velodyne's lasers each at its own time, an Ouster's
+    // columns from their beam origins.
+    core::OusterHead ouster;
+    for (int r = 0; r < 16; ++r) {
+      ouster.altitudes_deg.push_back(15 - 2 * r);
+      ouster.azimuths_deg.push_back(r % 2 ? -1.5 : 1.5);
+    }
+    ouster.beam_origin_x_mm = 15.8;
+    ouster.columns = 512;
+    ouster.last_column = 511;
+    const core::BeamList list = trial % 2 ? core::nominalVlp16().scan(0.1) : ouster.scan(0.1);
+    core::Caster list_caster;
+    const core::ScanResult list_still = list_caster.castBeams(rs.scene, rs.poses, at, list, cfg);
+    carried.add(
+        compare(list_caster.castBeamsSweep(rs.scene, carriedBy(sensor, rs.poses, 0), list, cfg),
+                list_still, false));
+  }
+  EXPECT_GT(carried.hits, 30000);
+  EXPECT_EQ(carried.range_off, 0) << "of " << carried.beams << ", worst " << carried.worst;
+  EXPECT_LT(carried.worst, 1e-12);  // the rounding of one relative pose, not a turn's chord
+  EXPECT_EQ(carried.body_off, 0);
+  EXPECT_LE(drifting.range_off, drifting.beams / 50000) << "of " << drifting.beams;
+  EXPECT_GT(moved, 1000);
+  std::printf(
+      "carried scenes: %lld beams, %lld hits, worst %.3g m; drifting: %lld hits, %lld "
+      "ranges off, %lld beams moved past 1e-8 m\n",
+      carried.beams, carried.hits, carried.worst, drifting.hits, drifting.range_off, moved);
 }
 
 }  // namespace

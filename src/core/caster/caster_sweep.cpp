@@ -108,17 +108,31 @@ class BlockPlanner {
     frames.pose.assign(frame_count, Eigen::Isometry3d::Identity());
     frames.valid.assign(frame_count, 0);
     for (int f : poses_.framesWithBodies()) {
-      frames.valid[f] = poses_.frameAt(column(0, ref), f, &frames.pose[f]);
+      if (poses_.ridesWithSensor(f)) {
+        // Where the sensor carries it (its own poses, interpolated on their own, would stray from
+        // that by the chord of each turn between two samples).
+        frames.valid[f] = 1;
+        frames.pose[f] = poses_.sensor(column(0, ref)) * poses_.sensorFromRider(f);
+      } else {
+        frames.valid[f] = poses_.frameAt(column(0, ref), f, &frames.pose[f]);
+      }
     }
     block->key = relativeInputs(scene_, frames, beamsFrom(0, ref), pattern_, config_);
     block->motion.assign(scene_.frames().size(), nullptr);
-    std::shared_ptr<const ColumnMotion> static_motion;
+    std::shared_ptr<const ColumnMotion> static_motion, riding_motion;
     for (int f : poses_.framesWithBodies()) {
       if (!block->key.valid[f]) continue;
       if (poses_.isStatic(f)) {
         // A frame that stays put: each column's pose relative to the reference is the sensor's.
         if (!static_motion) static_motion = sensorMotion(lo, hi, ref);
         block->motion[f] = static_motion;
+        continue;
+      }
+      if (poses_.ridesWithSensor(f)) {
+        // A frame that rides with the sensor: every beam meets it where the reference's would, and
+        // the columns differ only by their origins.
+        if (!riding_motion) riding_motion = originsMotion(lo, hi, ref);
+        block->motion[f] = riding_motion;
         continue;
       }
       ClassPoses ref_from = classPoses(lo, hi);
@@ -145,6 +159,7 @@ class BlockPlanner {
       }
     }
     if (static_motion && !small(*static_motion, limits_)) return false;
+    if (riding_motion && !small(*riding_motion, limits_)) return false;
     // A planar fan's longer blocks are for the 2D walk of its kept slices: a block whose columns
     // leave the reference's plane (a tilted or climbing sensor) is walked in 3D, so it keeps within
     // the 3D limits.
@@ -173,6 +188,19 @@ class BlockPlanner {
       }
     }
     return motion(lo, std::move(ref_from));
+  }
+
+  // The columns' beams from a sensor that does not move relative to the frame: each from its own
+  // origin, relative to the reference's, with the sensor's axes (one class: the rows' times do not
+  // matter).
+  std::shared_ptr<const ColumnMotion> originsMotion(int lo, int hi, int ref) const {
+    std::vector<Eigen::Isometry3d> columns(hi - lo + 1, Eigen::Isometry3d::Identity());
+    if (beams_.origins) {
+      for (int c = lo; c <= hi; ++c) {
+        columns[c - lo].translation() = (*beams_.origins)[c] - (*beams_.origins)[ref];
+      }
+    }
+    return std::make_shared<ColumnMotion>(lo, std::move(columns), steepest_, beams_.turn);
   }
 
   // Room for each row class's poses at columns lo..hi relative to the reference (class 0's are

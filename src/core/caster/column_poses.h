@@ -57,6 +57,17 @@ class ColumnPoses {
   const Eigen::Isometry3d& sensor(int col) const { return sensor_[col]; }
   const std::vector<int>& framesWithBodies() const { return frames_; }
   bool isStatic(int frame) const { return frame_[frame].is_static; }
+  // True if the frame rides with the sensor: both have a pose at every sample, and the frame's pose
+  // relative to the sensor's is the same at each to within kRideTolerance (a link of the robot
+  // that carries the sensor, which TF moves with it). A beam then meets it where it would at any
+  // other time of the sweep, its own origin and direction in the sensor frame being the same.
+  bool ridesWithSensor(int frame) const { return frame_[frame].rides; }
+  // For a frame that rides with the sensor: its pose relative to the sensor's (at the first
+  // sample), where every beam meets it.
+  const Eigen::Isometry3d& sensorFromRider(int frame) const { return frame_[frame].sensor_from; }
+  // m, and in each entry of the rotation: far below a range's resolution, and far above the
+  // rounding of the poses' products at the distances of a scene (1e-13 at 1 km).
+  static constexpr double kRideTolerance = 1e-9;
   // The frame's pose at the column's time; false if it has none then.
   bool frameAt(int col, int frame, Eigen::Isometry3d* pose) const {
     const Frame& f = frame_[frame];
@@ -138,9 +149,11 @@ class ColumnPoses {
   };
   struct Frame {
     bool is_static = false;
-    std::vector<char> ok;                       // by sample
-    std::vector<Eigen::Isometry3d> pose;        // by sample
-    Rotations rotation;                         // by sample
+    bool rides = false;                   // ridesWithSensor
+    Eigen::Isometry3d sensor_from;        // sensorFromRider
+    std::vector<char> ok;                 // by sample
+    std::vector<Eigen::Isometry3d> pose;  // by sample
+    Rotations rotation;                   // by sample
   };
 
   // PoseSamples::bracket for each column's time: the last sample at or before it (the first if
@@ -202,7 +215,25 @@ class ColumnPoses {
         frame.pose[k] = sample.pose[f];
       }
       frame.rotation.set(frame.pose, arcs_used_);
+      frame.rides = ridesWith(&frame);
     }
+  }
+
+  // Sets frame->sensor_from to the frame's pose relative to the sensor's at the first sample, and
+  // returns whether it is that at every sample.
+  bool ridesWith(Frame* frame) const {
+    for (std::size_t k = 0; k < samples_.times.size(); ++k) {
+      if (!(frame->ok[k] && sample_sensor_ok_[k])) return false;
+      const Eigen::Isometry3d relative =
+          relativePose(samples_.world_from_sensor[k], frame->pose[k]);
+      if (k == 0) {
+        frame->sensor_from = relative;
+      } else if (!((relative.matrix() - frame->sensor_from.matrix()).cwiseAbs().maxCoeff() <=
+                   kRideTolerance)) {
+        return false;
+      }
+    }
+    return true;
   }
 
   // interpolatePose(a, b, s) of the bracket's samples, from their rotations as quaternions, into
