@@ -238,7 +238,7 @@ void CasterState::castBeamGridsSweep(const Scene& scene, const PoseSamples& samp
       times.insert(times.end(), t.begin(), t.end());
     }
   }
-  const ColumnPoses poses(scene, indexOf(scene), samples, std::move(times));
+  const ColumnPoses poses(scene, indexOf(scene), samples, std::move(times), &column_sensor);
   int base = 0;
   for (std::size_t p = 0; p < grid.parts.size(); ++p) {
     const BeamListGrid::Part& part = grid.parts[p];

@@ -129,6 +129,8 @@ struct CasterState {
     std::optional<BeamCells> cells;
   };
   std::optional<FittedList> fitted;
+  // ColumnPoses' sensor poses, kept from sweep to sweep (a calibrated Velodyne's turn has 28,928).
+  std::vector<Eigen::Isometry3d> column_sensor;
   ScanResult grid_culling, grid_own;  // castBeamGrids' results for one part, by its grid beams
 
   // The scene's index for this scene version.

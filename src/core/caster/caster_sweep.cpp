@@ -142,7 +142,7 @@ class BlockPlanner {
           if (!poses_.frameAt(column(k, c), f, &world_from_frame)) return false;  // not throughout
           const Eigen::Isometry3d column_from_frame =
               relativePose(beamsFrom(k, c), world_from_frame);
-          ref_from[k].push_back(block->key.sensor_from_frame[f] * column_from_frame.inverse());
+          ref_from[k][c - lo] = block->key.sensor_from_frame[f] * column_from_frame.inverse();
         }
       }
       block->motion[f] = motion(lo, std::move(ref_from));
@@ -183,8 +183,8 @@ class BlockPlanner {
     const Eigen::Matrix3d ref_rot_t = world_from_ref.linear().transpose();
     for (int k = 0; k < beams_.classes; ++k) {
       for (int c = lo; c <= hi; ++c) {
-        ref_from[k].push_back(
-            relativePose(ref_rot_t, world_from_ref.translation(), beamsFrom(k, c)));
+        ref_from[k][c - lo] =
+            relativePose(ref_rot_t, world_from_ref.translation(), beamsFrom(k, c));
       }
     }
     return motion(lo, std::move(ref_from));
@@ -203,14 +203,13 @@ class BlockPlanner {
     return std::make_shared<ColumnMotion>(lo, std::move(columns), steepest_, beams_.turn);
   }
 
-  // Room for each row class's poses at columns lo..hi relative to the reference (class 0's are
-  // the columns'), appended column by column: each written once (a calibrated Velodyne's block
-  // has 16 poses a column; constructed first and then written, they would pass through memory
-  // twice).
+  // Each row class's poses at columns lo..hi relative to the reference (class 0's are the
+  // columns'), to be filled (each class's made on its own: a copy of one made would write every
+  // pose twice, and a calibrated Velodyne's block has 16 a column).
   using ClassPoses = std::vector<std::vector<Eigen::Isometry3d>>;
   ClassPoses classPoses(int lo, int hi) const {
     ClassPoses out(beams_.classes);
-    for (auto& poses : out) poses.reserve(hi - lo + 1);
+    for (auto& poses : out) poses.resize(hi - lo + 1);
     return out;
   }
   // The block's motion from them.
@@ -290,7 +289,8 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
   for (int c = 0; c < azimuths; ++c) times[c] = c * time_increment;
   resetResult(pattern.size(), static_cast<int>(scene.bodies().size()), true,
               config.compute_incidence, &result_);
-  const ColumnPoses poses(scene, state_->indexOf(scene), samples, std::move(times));
+  const ColumnPoses poses(scene, state_->indexOf(scene), samples, std::move(times),
+                          &state_->column_sensor);
   std::vector<char> column_valid;
   state_->sweepColumns(scene, poses, 0, pattern, SweepBeams{}, config, &result_, &column_valid);
   if (config.compute_incidence) computeIncidence(pattern, &result_);

@@ -26,9 +26,11 @@ namespace core {
 // down in azimuth as their times go up).
 class ColumnPoses {
  public:
+  // sensor_storage holds the columns' sensor poses (the caller's, kept from sweep to sweep: a
+  // calibrated Velodyne's turn has 28,928, and storage of the right size is written, not made).
   ColumnPoses(const Scene& scene, const SceneIndex& index, const PoseSamples& samples,
-              std::vector<double> times)
-      : samples_(samples), times_(std::move(times)) {
+              std::vector<double> times, std::vector<Eigen::Isometry3d>* sensor_storage)
+      : samples_(samples), times_(std::move(times)), sensor_(*sensor_storage) {
     const int columns = static_cast<int>(times_.size());
     const std::size_t n = samples.times.size();
     sample_sensor_ok_.resize(n);
@@ -37,16 +39,13 @@ class ColumnPoses {
     }
     findBrackets(columns);
     sample_rotation_.set(samples.world_from_sensor, arcs_used_);
-    // Each pose written once as it is made (a calibrated Velodyne's turn has 28,928: constructed
-    // first and then written, they would pass through memory twice).
-    sensor_.reserve(columns);
+    sensor_.resize(columns);
     sensor_valid_.resize(columns);
     for (int c = 0; c < columns; ++c) {
       const Bracket& b = brackets_[c];
       sensor_valid_[c] = sample_sensor_ok_[b.i] && sample_sensor_ok_[b.j];
-      sensor_.emplace_back();
       if (sensor_valid_[c]) {
-        interpolate(samples.world_from_sensor, sample_rotation_, b, &sensor_.back());
+        interpolate(samples.world_from_sensor, sample_rotation_, b, &sensor_[c]);
       }
     }
     prepareFrames(scene, index);
@@ -277,7 +276,7 @@ class ColumnPoses {
   Rotations sample_rotation_;
   std::vector<Bracket> brackets_;
   std::vector<char> arcs_used_;  // by sample: some column lies strictly between it and the next
-  std::vector<Eigen::Isometry3d> sensor_;
+  std::vector<Eigen::Isometry3d>& sensor_;
   std::vector<char> sensor_valid_;
   std::vector<int> frames_;
   std::vector<Frame> frame_;  // by scene frame (only those with bodies are filled)
