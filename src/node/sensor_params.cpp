@@ -225,7 +225,8 @@ void readPresetHead(ParamReader* r, SensorParams* s) {
     if (!grid_by && r->has(name)) grid_by = name;
   }
   const std::string as_grid = s->sensor_model +
-                              "'s lasers as a grid (every ring at the same azimuths, a column at once)";
+                              "'s lasers as a grid (every ring at the same azimuths, a column at " +
+                              "once)";
   if (grid_by) {
     r->note(r->prefix() + grid_by + " is set: " + as_grid);
     return;

@@ -82,9 +82,9 @@ void bindPattern(py::module_& m) {
       .def_static("preset", &Pattern::fromPreset, py::arg("name"),
                   "The pattern and range limits of a real sensor ('VLP-16', 'HDL-32E', 'OS1-64',\n"
                   "'UTM-30LX', 'TiM571', 'LDS-01'), from its datasheet (docs/sensors.md). The\n"
-                  "lidars' beams are off any grid, as the node's presets fire them: the Velodynes'\n"
-                  "lasers by their manuals' tables and times, the OS1-64's from its nominal\n"
-                  "metadata file in the package; the planar scanners are fans.")
+                  "lidars' beams are off any grid, as the node's presets fire them: the\n"
+                  "Velodynes' lasers by their manuals' tables and times, the OS1-64's from its\n"
+                  "nominal metadata file in the package; the planar scanners are fans.")
       .def_static("from_calibration", &Pattern::fromCalibration, py::arg("path"),
                   py::arg("scan_time") = Pattern::kCalibratedScanTime,
                   "A Velodyne head from its calibration YAML (velodyne_pointcloud's, as the\n"
