@@ -108,16 +108,21 @@ class BlockPlanner {
     frames.pose.assign(frame_count, Eigen::Isometry3d::Identity());
     frames.valid.assign(frame_count, 0);
     for (int f : poses_.framesWithBodies()) {
-      if (poses_.ridesWithSensor(f)) {
-        // Where the sensor carries it (its own poses, interpolated on their own, would stray from
-        // that by the chord of each turn between two samples).
-        frames.valid[f] = 1;
-        frames.pose[f] = poses_.sensor(column(0, ref)) * poses_.sensorFromRider(f);
-      } else {
+      if (!poses_.ridesWithSensor(f)) {
         frames.valid[f] = poses_.frameAt(column(0, ref), f, &frames.pose[f]);
       }
     }
     block->key = relativeInputs(scene_, frames, beamsFrom(0, ref), pattern_, config_);
+    // A frame that rides with the sensor: where the sensor carries it, relative to the reference
+    // column's origin, with no world pose in between (its own poses, interpolated on their own,
+    // would stray from it by the chord of each turn between two samples).
+    for (int f : poses_.framesWithBodies()) {
+      if (!poses_.ridesWithSensor(f)) continue;
+      Eigen::Isometry3d from_ref = poses_.sensorFromRider(f);
+      if (beams_.origins) from_ref.translation() -= (*beams_.origins)[ref];
+      block->key.valid[f] = 1;
+      block->key.sensor_from_frame[f] = from_ref;
+    }
     block->motion.assign(scene_.frames().size(), nullptr);
     std::shared_ptr<const ColumnMotion> static_motion, riding_motion;
     for (int f : poses_.framesWithBodies()) {

@@ -340,8 +340,9 @@ class MeshWalk {
   // sub-rays lie close together (a divergent beam's, a calibrated lidar's one), one at a time for
   // a cell's list of beams (beams/beam_cells.h), where side by side gained nothing (the rosette's
   // still poses, bench --quick: warehouse 0.47-0.49 of Embree's speed against 0.50-0.51, forest
-  // and million the same either way). A
-  // sub-ray's walk reads and lowers only its own far limit, so pairing them changes no test.
+  // and million the same either way). A sub-ray's walk reads and lowers only its own far limit, so
+  // pairing them changes no test. (One loop for both, pairing or not, cost the rosette 6.6% more
+  // instructions and the divergent rings 1.7%.)
   void traceSubRays(const Entry& e) {
     if (bundle_->first) {
       traceEachSubRay(e);
