@@ -170,13 +170,13 @@ void bindPattern(py::module_& m) {
       .def_property_readonly(
           "lines",
           [](const Pattern& p) {
-            core::BeamList scratch;
             std::vector<int> l(p.size());
-            const int azimuths = p.offGrid() ? 1 : p.pattern.azimuthCount();
-            for (int i = 0; i < p.size(); ++i) l[i] = p.offGrid() ? 0 : i / azimuths;
             if (p.offGrid()) {
+              core::BeamList scratch;
               const core::BeamList& b = p.beamsOf(0, &scratch);
               for (int i = 0; i < b.size(); ++i) l[i] = b.line(i);
+            } else {
+              for (int i = 0; i < p.size(); ++i) l[i] = i / p.pattern.azimuthCount();
             }
             return l;
           },
