@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace laser_raycast {
 namespace core {
@@ -36,8 +37,13 @@ FanSpec sector(double first_deg, double last_deg, double increment_deg) {
   return fan;
 }
 
+// A preset of that id and those elevations, its other fields to be filled by its maker below.
+SensorModel blank(SensorModelId id, std::vector<double> elevations = {}) {
+  return SensorModel{id, std::move(elevations), {}, 0, 0, 0, std::nullopt, false, std::nullopt, ""};
+}
+
 SensorModel vlp16() {
-  SensorModel m{SensorModelId::kVlp16, {}, {}, 0, 0, 0, std::nullopt, false, std::nullopt, ""};
+  SensorModel m = blank(SensorModelId::kVlp16);
   // Per the Velodyne VLP-16 user manual and datasheet: 16 channels, vertical field of view +15 to
   // -15 deg at 2.0 deg vertical resolution (the lasers' elevation table: -15, -13, ..., 13, 15).
   m.elevations = uniformRings(-15.0, 15.0, 16);
@@ -57,7 +63,7 @@ SensorModel vlp16() {
 }
 
 SensorModel hdl32e() {
-  SensorModel m{SensorModelId::kHdl32e, {}, {}, 0, 0, 0, std::nullopt, false, std::nullopt, ""};
+  SensorModel m = blank(SensorModelId::kHdl32e);
   // Per the Velodyne HDL-32E user manual and datasheet: 32 lasers, vertical field of view +10.67
   // to -30.67 deg at 1.33 deg vertical resolution. The published table is spaced by exactly 4/3
   // deg with 0 deg as the 24th laser from the bottom: -92/3 (-30.67) to 32/3 (10.67) deg.
@@ -77,7 +83,7 @@ SensorModel hdl32e() {
 }
 
 SensorModel os1_64() {
-  SensorModel m{SensorModelId::kOs1_64, {}, {}, 0, 0, 0, std::nullopt, false, std::nullopt, ""};
+  SensorModel m = blank(SensorModelId::kOs1_64);
   // Per the Ouster OS1 datasheet (first generation, 64 channels): vertical field of view +16.6 to
   // -16.6 deg (33.2 deg), beams spaced uniformly (0.527 deg). Later OS1 revisions (45 deg, and
   // gradient or below-horizon spacing) are other sensors; give their elevations explicitly.
@@ -105,7 +111,7 @@ SensorModel os1_64() {
 }
 
 SensorModel utm30lx() {
-  SensorModel m{SensorModelId::kUtm30lx, {0.0}, {}, 0, 0, 0, std::nullopt, false, std::nullopt, ""};
+  SensorModel m = blank(SensorModelId::kUtm30lx, {0.0});
   // Per the Hokuyo UTM-30LX specification and its SCIP 2.0 protocol: 270 deg scan, 1440 steps a
   // turn (0.25 deg), steps 0..1080 with the front at step 540: -135 to +135 deg, 1081 beams.
   m.fan = sector(-135.0, 135.0, 0.25);
@@ -119,7 +125,7 @@ SensorModel utm30lx() {
 }
 
 SensorModel tim571() {
-  SensorModel m{SensorModelId::kTim571, {0.0}, {}, 0, 0, 0, std::nullopt, false, std::nullopt, ""};
+  SensorModel m = blank(SensorModelId::kTim571, {0.0});
   // Per the SICK TiM571 product data sheet: aperture angle 270 deg, angular resolution 0.33 deg
   // (a third of a degree: 811 beams from -135 to +135 deg, as the sick_tim driver publishes).
   m.fan = sector(-135.0, 135.0, 1.0 / 3.0);
@@ -132,7 +138,7 @@ SensorModel tim571() {
 }
 
 SensorModel lds01() {
-  SensorModel m{SensorModelId::kLds01, {0.0}, {}, 0, 0, 0, std::nullopt, false, std::nullopt, ""};
+  SensorModel m = blank(SensorModelId::kLds01, {0.0});
   // Per the ROBOTIS LDS-01 (HLS-LFCD2) specification: angular range 360 deg, angular resolution
   // 1 deg. Its driver (hls_lfcd_lds_driver) publishes 360 beams from 0 to 359 deg.
   m.fan = sector(0.0, 359.0, 1.0);
