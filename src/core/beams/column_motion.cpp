@@ -16,28 +16,44 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
                            double steepest, double extra_turn, std::vector<int> class_of_row,
                            std::vector<std::vector<Eigen::Isometry3d>> ref_from_class)
     : col_lo_(col_lo),
-      ref_from_column_(std::move(ref_from_column)),
-      class_of_row_(std::move(class_of_row)),
-      ref_from_class_(std::move(ref_from_class)) {
-  double shift2 = 0, frobenius2 = 0, z_move2 = 0, deviation2 = 0;
-  auto add = [&](const Eigen::Isometry3d& m) {
-    shift2 = std::max(shift2, m.translation().squaredNorm());
-    frobenius2 = std::max(frobenius2, (m.linear() - Eigen::Matrix3d::Identity()).squaredNorm());
-    z_move2 = std::max(z_move2, (m.linear().col(2) - Eigen::Vector3d::UnitZ()).squaredNorm());
-    const Eigen::Matrix3d& r = m.linear();
-    translations_only_ = translations_only_ && r == Eigen::Matrix3d::Identity();
-    in_plane_ = in_plane_ && r(0, 2) == 0 && r(1, 2) == 0 && r(2, 0) == 0 && r(2, 1) == 0 &&
-                r(2, 2) == 1 && m.translation().z() == 0;
-  };
-  for (const Eigen::Isometry3d& m : ref_from_column_) add(m);
-  for (const auto& poses_of_class : ref_from_class_) {
-    for (std::size_t c = 0; c < poses_of_class.size(); ++c) {
-      add(poses_of_class[c]);
-      deviation2 = std::max(
-          deviation2,
-          (poses_of_class[c].translation() - ref_from_column_[c].translation()).squaredNorm());
-    }
+      columns_(static_cast<int>(ref_from_column.size())),
+      own_(std::move(ref_from_column)),
+      stride_(columns_),
+      classes_(1 + static_cast<int>(ref_from_class.size())),
+      class_of_row_(std::move(class_of_row)) {
+  for (const auto& poses_of_class : ref_from_class) {
+    own_.insert(own_.end(), poses_of_class.begin(), poses_of_class.end());
   }
+  poses_ = own_.data();
+  measure(reachOf(), steepest, extra_turn);
+}
+
+ColumnMotion::ColumnMotion(int col_lo, int columns, const Eigen::Isometry3d* poses, int stride,
+                           int classes, const Reach& reach, double steepest, double extra_turn,
+                           std::vector<int> class_of_row)
+    : col_lo_(col_lo),
+      columns_(columns),
+      poses_(poses),
+      stride_(stride),
+      classes_(classes),
+      class_of_row_(std::move(class_of_row)) {
+  measure(reach, steepest, extra_turn);
+}
+
+ColumnMotion::Reach ColumnMotion::reachOf() const {
+  Reach reach;
+  for (int c = 0; c < columns_; ++c) reach.add(poses_[c]);
+  for (int k = 1; k < classes_; ++k) {
+    for (int c = 0; c < columns_; ++c) reach.add(poses_[k * stride_ + c], poses_[c].translation());
+  }
+  return reach;
+}
+
+void ColumnMotion::measure(const Reach& reach, double steepest, double extra_turn) {
+  const double frobenius2 = reach.frobenius2, z_move2 = reach.z_move2;
+  const double deviation2 = reach.deviation2;
+  translations_only_ = reach.translations_only;
+  in_plane_ = reach.in_plane;
   // The largest norm (a square root is monotonic and correctly rounded: the root of the largest
   // square is the largest root), widened for its rounding.
   deviation_ = deviation2 > 0 ? std::sqrt(deviation2) * (1 + 1e-9) : 0;
@@ -53,7 +69,7 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
   // the angle, so the largest gives the largest angle.
   const double turn = 2 * std::asin(std::min(1.0, std::sqrt(frobenius2) / (2 * std::sqrt(2.0))));
   const double tilt = 2 * std::asin(std::min(1.0, std::sqrt(z_move2) / 2));
-  spread_ = Spread::of(std::sqrt(shift2), turn + extra_turn, tilt, steepest);
+  spread_ = Spread::of(std::sqrt(reach.shift2), turn + extra_turn, tilt, steepest);
 }
 
 }  // namespace core

@@ -43,10 +43,42 @@ class ColumnMotion {
   ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column, double steepest,
                double extra_turn, std::vector<int> class_of_row,
                std::vector<std::vector<Eigen::Isometry3d>> ref_from_class);
+  // How far a block's poses reach from the reference, gathered pose by pose (as they are written,
+  // with their values at hand, rather than read back: a calibrated Velodyne's block has 2,048).
+  struct Reach {
+    double shift2 = 0, frobenius2 = 0, z_move2 = 0, deviation2 = 0;
+    bool translations_only = true, in_plane = true;
+    // A column's pose (class 0's).
+    void add(const Eigen::Isometry3d& m) {
+      const Eigen::Matrix3d& r = m.linear();
+      shift2 = std::max(shift2, m.translation().squaredNorm());
+      frobenius2 = std::max(frobenius2, (r - Eigen::Matrix3d::Identity()).squaredNorm());
+      z_move2 = std::max(z_move2, (r.col(2) - Eigen::Vector3d::UnitZ()).squaredNorm());
+      translations_only = translations_only && r == Eigen::Matrix3d::Identity();
+      in_plane = in_plane && r(0, 2) == 0 && r(1, 2) == 0 && r(2, 0) == 0 && r(2, 1) == 0 &&
+                 r(2, 2) == 1 && m.translation().z() == 0;
+    }
+    // Another class's pose at a column whose own starts at column_origin.
+    void add(const Eigen::Isometry3d& m, const Eigen::Vector3d& column_origin) {
+      add(m);
+      deviation2 = std::max(deviation2, (m.translation() - column_origin).squaredNorm());
+    }
+  };
+  // The same over poses the caller keeps while this lives (a sweep's, written in place block by
+  // block: CasterState::sweep_poses): class k's pose at column c is poses[k * stride + c - col_lo],
+  // for `columns` columns and `classes` classes (class_of_row empty if one); reach: every one of
+  // them added.
+  ColumnMotion(int col_lo, int columns, const Eigen::Isometry3d* poses, int stride, int classes,
+               const Reach& reach, double steepest, double extra_turn,
+               std::vector<int> class_of_row);
+  // Its poses may be its own: not copied (a move keeps them where they are).
+  ColumnMotion(const ColumnMotion&) = delete;
+  ColumnMotion& operator=(const ColumnMotion&) = delete;
+  ColumnMotion(ColumnMotion&&) = default;
 
   int colLo() const { return col_lo_; }
-  int colHi() const { return col_lo_ + static_cast<int>(ref_from_column_.size()) - 1; }
-  const Eigen::Isometry3d& refFromColumn(int col) const { return ref_from_column_[col - col_lo_]; }
+  int colHi() const { return col_lo_ + columns_ - 1; }
+  const Eigen::Isometry3d& refFromColumn(int col) const { return poses_[col - col_lo_]; }
   const Spread& spread() const { return spread_; }
   // True if every column's pose differs from the reference by a turn about the sensor's z axis and
   // a move in its xy plane, exactly (as a level sensor driving on a floor gives): every column scans
@@ -58,8 +90,8 @@ class ColumnMotion {
 
   // The pose the beam at (row, col) leaves from: its column's, or its row's class's.
   LASER_RAYCAST_HOT_INLINE const Eigen::Isometry3d& refFromBeam(int row, int col) const {
-    if (class_of_row_.empty() || class_of_row_[row] == 0) return refFromColumn(col);
-    return ref_from_class_[class_of_row_[row] - 1][col - col_lo_];
+    if (class_of_row_.empty()) return refFromColumn(col);
+    return poses_[class_of_row_[row] * stride_ + (col - col_lo_)];
   }
   // The most any beam's origin lies from its column's (0 without row classes).
   double deviation() const { return deviation_; }
@@ -98,8 +130,16 @@ class ColumnMotion {
   }
 
  private:
+  Reach reachOf() const;
+  // Sets the spread and the columns' origins from the poses' reach.
+  void measure(const Reach& reach, double steepest, double extra_turn);
+
   int col_lo_;
-  std::vector<Eigen::Isometry3d> ref_from_column_;
+  int columns_;
+  std::vector<Eigen::Isometry3d> own_;  // the poses, where they are this motion's own
+  const Eigen::Isometry3d* poses_;      // class k's column c at poses_[k * stride_ + c - col_lo_]
+  int stride_;
+  int classes_;
   Spread spread_;
   LASER_RAYCAST_HOT_INLINE Ray rayFrom(const Eigen::Isometry3d& m, const Eigen::Vector3d& d,
                                        double tmin) const {
@@ -114,7 +154,6 @@ class ColumnMotion {
   bool in_plane_ = true;
   bool translations_only_ = true;
   std::vector<int> class_of_row_;
-  std::vector<std::vector<Eigen::Isometry3d>> ref_from_class_;
   double deviation_ = 0;
   int padded_lo_;
   std::vector<float> origin_[3];

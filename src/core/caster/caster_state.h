@@ -129,8 +129,10 @@ struct CasterState {
     std::optional<BeamCells> cells;
   };
   std::optional<FittedList> fitted;
-  // ColumnPoses' sensor poses, kept from sweep to sweep (a calibrated Velodyne's turn has 28,928).
-  std::vector<Eigen::Isometry3d> column_sensor;
+  // A sweep's sensor poses at its columns (ColumnPoses' columns), each relative to its block's
+  // reference, kept from sweep to sweep (a calibrated Velodyne's turn has 28,928): the blocks'
+  // ColumnMotion of the frames that stay put are views of them.
+  std::vector<Eigen::Isometry3d> sweep_poses;
   ScanResult grid_culling, grid_own;  // castBeamGrids' results for one part, by its grid beams
 
   // The scene's index for this scene version.

@@ -64,10 +64,13 @@ class BlockPlanner {
   // turn: how far the beams may turn from the pattern's directions (a calibrated lidar's, cast as
   // a bundle: ColumnMotion's extra turn).
   // The pattern's column c is poses' column base + c (base + k * columns + c for row class k).
+  // sweep_poses: storage for the sensor's poses at poses' columns, as many.
   BlockPlanner(const Scene& scene, const ColumnPoses& poses, int base, const ScanPattern& pattern,
-               const CastConfig& config, const SweepBeams& beams)
+               const CastConfig& config, const SweepBeams& beams,
+               std::vector<Eigen::Isometry3d>* sweep_poses)
       : scene_(scene),
         poses_(poses),
+        sweep_poses_(sweep_poses),
         base_(base),
         pattern_(pattern),
         config_(config),
@@ -181,18 +184,31 @@ class BlockPlanner {
     return true;
   }
 
+  // The sensor's poses at each row class's columns lo..hi relative to the reference, written into
+  // the sweep's poses (their place there is their column's in poses_: blocks hold columns of their
+  // own, and a block that is halved is dropped before its halves write theirs).
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
-    ClassPoses ref_from = classPoses(lo, hi);
-    const Eigen::Isometry3d world_from_ref = beamsFrom(0, ref);
-    // The reference's transpose taken once (a calibrated Velodyne's block has 16 poses a column).
-    const Eigen::Matrix3d ref_rot_t = world_from_ref.linear().transpose();
-    for (int k = 0; k < beams_.classes; ++k) {
+    auto origin = [&](int c) { return beams_.origins ? &(*beams_.origins)[c] : nullptr; };
+    ColumnPoses::Relative relative(poses_, column(0, ref),
+                                   beams_.origins ? *origin(ref) : Eigen::Vector3d::Zero());
+    std::vector<Eigen::Isometry3d>& out = *sweep_poses_;
+    ColumnMotion::Reach reach;
+    for (int c = lo; c <= hi; ++c) {
+      Eigen::Isometry3d& pose = out[column(0, c)];
+      relative.at(column(0, c), origin(c), &pose);
+      reach.add(pose);
+    }
+    // Class by class, each one's poses written in a row.
+    for (int k = 1; k < beams_.classes; ++k) {
       for (int c = lo; c <= hi; ++c) {
-        ref_from[k][c - lo] =
-            relativePose(ref_rot_t, world_from_ref.translation(), beamsFrom(k, c));
+        Eigen::Isometry3d& pose = out[column(k, c)];
+        relative.at(column(k, c), origin(c), &pose);
+        reach.add(pose, out[column(0, c)].translation());
       }
     }
-    return motion(lo, std::move(ref_from));
+    return std::make_shared<ColumnMotion>(
+        lo, hi - lo + 1, &out[column(0, lo)], pattern_.azimuthCount(), beams_.classes, reach,
+        steepest_, beams_.turn, beams_.classes > 1 ? beams_.class_of_row : std::vector<int>());
   }
 
   // The columns' beams from a sensor that does not move relative to the frame: each from its own
@@ -248,6 +264,7 @@ class BlockPlanner {
 
   const Scene& scene_;
   const ColumnPoses& poses_;
+  std::vector<Eigen::Isometry3d>* sweep_poses_;
   int base_;
   const ScanPattern& pattern_;
   const CastConfig& config_;
@@ -294,8 +311,7 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
   for (int c = 0; c < azimuths; ++c) times[c] = c * time_increment;
   resetResult(pattern.size(), static_cast<int>(scene.bodies().size()), true,
               config.compute_incidence, &result_);
-  const ColumnPoses poses(scene, state_->indexOf(scene), samples, std::move(times),
-                          &state_->column_sensor);
+  const ColumnPoses poses(scene, state_->indexOf(scene), samples, std::move(times));
   std::vector<char> column_valid;
   state_->sweepColumns(scene, poses, 0, pattern, SweepBeams{}, config, &result_, &column_valid);
   if (config.compute_incidence) computeIncidence(pattern, &result_);
@@ -315,7 +331,8 @@ void CasterState::sweepColumns(const Scene& scene, const ColumnPoses& poses, int
     return true;
   };
   // Blocks over each run of columns with a sensor pose; the others' beams are NaN.
-  BlockPlanner planner(scene, poses, base, pattern, config, sweep_beams);
+  sweep_poses.resize(poses.columns());
+  BlockPlanner planner(scene, poses, base, pattern, config, sweep_beams, &sweep_poses);
   std::vector<SweepBlock> blocks;
   column_valid->assign(azimuths, 0);
   for (int c = 0; c < azimuths;) {

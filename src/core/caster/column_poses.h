@@ -26,11 +26,9 @@ namespace core {
 // down in azimuth as their times go up).
 class ColumnPoses {
  public:
-  // sensor_storage holds the columns' sensor poses (the caller's, kept from sweep to sweep: a
-  // calibrated Velodyne's turn has 28,928, and storage of the right size is written, not made).
   ColumnPoses(const Scene& scene, const SceneIndex& index, const PoseSamples& samples,
-              std::vector<double> times, std::vector<Eigen::Isometry3d>* sensor_storage)
-      : samples_(samples), times_(std::move(times)), sensor_(*sensor_storage) {
+              std::vector<double> times)
+      : samples_(samples), times_(std::move(times)) {
     const int columns = static_cast<int>(times_.size());
     const std::size_t n = samples.times.size();
     sample_sensor_ok_.resize(n);
@@ -39,21 +37,85 @@ class ColumnPoses {
     }
     findBrackets(columns);
     sample_rotation_.set(samples.world_from_sensor, arcs_used_);
-    sensor_.resize(columns);
     sensor_valid_.resize(columns);
     for (int c = 0; c < columns; ++c) {
       const Bracket& b = brackets_[c];
       sensor_valid_[c] = sample_sensor_ok_[b.i] && sample_sensor_ok_[b.j];
-      if (sensor_valid_[c]) {
-        interpolate(samples.world_from_sensor, sample_rotation_, b, &sensor_[c]);
-      }
     }
     prepareFrames(scene, index);
   }
 
+  int columns() const { return static_cast<int>(times_.size()); }
   double time(int col) const { return times_[col]; }
   bool sensorValid(int col) const { return sensor_valid_[col]; }
-  const Eigen::Isometry3d& sensor(int col) const { return sensor_[col]; }
+  // The sensor's pose at the column's time (sensorValid(col)).
+  Eigen::Isometry3d sensor(int col) const {
+    Eigen::Isometry3d pose;
+    interpolate(samples_.world_from_sensor, sample_rotation_, brackets_[col], &pose);
+    return pose;
+  }
+
+  // The sensor's poses at columns' times relative to one of them, each moved to an origin in its
+  // own sensor frame (a calibrated lidar's column's): what relativePose(sensor(ref) moved to
+  // ref_origin, sensor(col) moved to origin) gives, to the rounding of double, without the
+  // columns' world poses. Between two samples, a column's rotation is the slerp a q_a + b q_b of
+  // theirs, so relative to the reference's q_r it is a conj(q_r) q_a + b conj(q_r) q_b, and its
+  // translation r^T (t_a - t_r) + s r^T (t_b - t_a): both products are made once for the pair,
+  // and a column costs its slerp's weights and one rotation matrix.
+  class Relative {
+   public:
+    Relative(const ColumnPoses& poses, int ref, const Eigen::Vector3d& ref_origin) : poses_(poses) {
+      const Bracket& b = poses.brackets_[ref];
+      world_from_ref_ = poses.sensor(ref);
+      q_ref_conj_ = b.j == b.i ? Eigen::Quaterniond(world_from_ref_.linear()).conjugate()
+                               : poses.sample_rotation_.slerp(b).conjugate();
+      world_from_ref_.translation() += world_from_ref_.linear() * ref_origin;
+      ref_rot_t_ = world_from_ref_.linear().transpose();
+    }
+    // The reference column's sensor pose moved to ref_origin.
+    const Eigen::Isometry3d& worldFromRef() const { return world_from_ref_; }
+    // The column's sensor pose moved to origin (its sensor frame; null: none), relative to the
+    // reference.
+    void at(int col, const Eigen::Vector3d* origin, Eigen::Isometry3d* out) {
+      const Bracket& b = poses_.brackets_[col];
+      const std::vector<Eigen::Isometry3d>& pose = poses_.samples_.world_from_sensor;
+      if (b.j == b.i) {
+        // At a sample: its pose, taken relative as it is.
+        *out = relativePose(ref_rot_t_, world_from_ref_.translation(), pose[b.i]);
+        if (origin) out->translation() += out->linear() * *origin;
+      } else {
+        if (b.i != pair_) {
+          pair_ = b.i;
+          const Rotations& rotation = poses_.sample_rotation_;
+          p_ = q_ref_conj_ * rotation.sample(b.i);
+          q_ = q_ref_conj_ * rotation.sample(b.j);
+          const Eigen::Vector3d& ta = pose[b.i].translation();
+          alpha_ = ref_rot_t_ * (ta - world_from_ref_.translation());
+          beta_ = ref_rot_t_ * (pose[b.j].translation() - ta);
+        }
+        double scale0, scale1;
+        poses_.sample_rotation_.weights(b, &scale0, &scale1);
+        const Eigen::Quaterniond q(scale0 * p_.coeffs() + scale1 * q_.coeffs());
+        // The translation from the rotation's values, not read back from *out (their stores could
+        // not be forwarded to its loads, and each column waited for them: a third of its time).
+        Eigen::Vector3d t = alpha_ + b.s * beta_;
+        const Eigen::Matrix3d r = rotationOf(q);
+        if (origin) t += r * *origin;
+        out->linear() = r;
+        out->translation() = t;
+        out->makeAffine();
+      }
+    }
+
+   private:
+    const ColumnPoses& poses_;
+    Eigen::Isometry3d world_from_ref_;
+    Eigen::Matrix3d ref_rot_t_;
+    Eigen::Quaterniond q_ref_conj_;
+    std::size_t pair_ = std::numeric_limits<std::size_t>::max();  // the sample pair p_.. are of
+    Eigen::Quaterniond p_, q_;
+    Eigen::Vector3d alpha_, beta_;
+  };
   const std::vector<int>& framesWithBodies() const { return frames_; }
   bool isStatic(int frame) const { return frame_[frame].is_static; }
   // True if the frame rides with the sensor: both have a pose at every sample, and the frame's pose
@@ -104,19 +166,25 @@ class ColumnPoses {
     }
     // The bracket's samples must be consecutive, with their arc used.
     Eigen::Quaterniond slerp(const Bracket& b) const {
-      const Arc& arc = arc_[b.i];
-      const double t = b.s;
       double scale0, scale1;
-      if (arc.linear) {
-        scale0 = 1 - t;
-        scale1 = t;
-      } else {
-        scale0 = smallSin((1 - t) * arc.theta) / arc.sin_theta;
-        scale1 = smallSin(t * arc.theta) / arc.sin_theta;
-      }
-      if (arc.flip) scale1 = -scale1;
+      weights(b, &scale0, &scale1);
       return Eigen::Quaterniond(scale0 * q_[b.i].coeffs() + scale1 * q_[b.j].coeffs());
     }
+    // The slerp's weights of the bracket's two samples' quaternions.
+    void weights(const Bracket& b, double* scale0, double* scale1) const {
+      const Arc& arc = arc_[b.i];
+      const double t = b.s;
+      if (arc.linear) {
+        *scale0 = 1 - t;
+        *scale1 = t;
+      } else {
+        *scale0 = smallSin((1 - t) * arc.theta) / arc.sin_theta;
+        *scale1 = smallSin(t * arc.theta) / arc.sin_theta;
+      }
+      if (arc.flip) *scale1 = -*scale1;
+    }
+    // Sample k's quaternion (k or k - 1 must have its arc used).
+    const Eigen::Quaterniond& sample(std::size_t k) const { return q_[k]; }
 
    private:
     // sin x: for |x| <= 1/4 (two samples of a sweep a few degrees apart at most) its Taylor series
@@ -236,10 +304,7 @@ class ColumnPoses {
   }
 
   // interpolatePose(a, b, s) of the bracket's samples, from their rotations as quaternions, into
-  // *out; a column exactly at a sample has its pose. The rotation matrix is Eigen's
-  // QuaternionBase::toRotationMatrix's expression, written entry by entry straight into *out:
-  // through a temporary matrix, its entries stored one at a time and read back two at a time could
-  // not be forwarded from the pending stores, and every column waited for them.
+  // *out; a column exactly at a sample has its pose.
   static void interpolate(const std::vector<Eigen::Isometry3d>& pose, const Rotations& rotation,
                           const Bracket& b, Eigen::Isometry3d* out) {
     if (b.j == b.i) {
@@ -248,26 +313,22 @@ class ColumnPoses {
     }
     const Eigen::Vector3d& ta = pose[b.i].translation();
     const Eigen::Vector3d t = ta + b.s * (pose[b.j].translation() - ta);
-    const Eigen::Quaterniond q = rotation.slerp(b);
+    out->linear() = rotationOf(rotation.slerp(b));
+    out->translation() = t;
+    out->makeAffine();
+  }
+
+  // QuaternionBase::toRotationMatrix's expression.
+  static Eigen::Matrix3d rotationOf(const Eigen::Quaterniond& q) {
     const double tx = 2 * q.x(), ty = 2 * q.y(), tz = 2 * q.z();
     const double twx = tx * q.w(), twy = ty * q.w(), twz = tz * q.w();
     const double txx = tx * q.x(), txy = ty * q.x(), txz = tz * q.x();
     const double tyy = ty * q.y(), tyz = tz * q.y(), tzz = tz * q.z();
-    Eigen::Matrix4d& m = out->matrix();
-    m(0, 0) = 1 - (tyy + tzz);
-    m(0, 1) = txy - twz;
-    m(0, 2) = txz + twy;
-    m(1, 0) = txy + twz;
-    m(1, 1) = 1 - (txx + tzz);
-    m(1, 2) = tyz - twx;
-    m(2, 0) = txz - twy;
-    m(2, 1) = tyz + twx;
-    m(2, 2) = 1 - (txx + tyy);
-    m(0, 3) = t.x();
-    m(1, 3) = t.y();
-    m(2, 3) = t.z();
-    m(3, 0) = m(3, 1) = m(3, 2) = 0;
-    m(3, 3) = 1;
+    Eigen::Matrix3d m;
+    m << 1 - (tyy + tzz), txy - twz, txz + twy,  //
+        txy + twz, 1 - (txx + tzz), tyz - twx,   //
+        txz - twy, tyz + twx, 1 - (txx + tyy);
+    return m;
   }
 
   const PoseSamples& samples_;
@@ -276,7 +337,6 @@ class ColumnPoses {
   Rotations sample_rotation_;
   std::vector<Bracket> brackets_;
   std::vector<char> arcs_used_;  // by sample: some column lies strictly between it and the next
-  std::vector<Eigen::Isometry3d>& sensor_;
   std::vector<char> sensor_valid_;
   std::vector<int> frames_;
   std::vector<Frame> frame_;  // by scene frame (only those with bodies are filled)
