@@ -555,5 +555,37 @@ TEST(BeamSet, AWindowWithAnOpenBeamIsNeverClosed) {
   EXPECT_GT(closed, 1000);
 }
 
+// A pose's reach taken from its quaternion (a sweep's poses, ColumnPoses::Relative) bounds the
+// turn of the matrix it gives at least as far as the matrix's own reach does, for turns from 1e-12
+// rad to a half turn and quaternions off unit length by their rounding, and says "translations
+// only" or "in the plane" only where the matrix is so.
+TEST(ColumnMotion, AQuaternionsReachCoversItsRotationMatrix) {
+  Rng rng(57);
+  for (int i = 0; i < 20000; ++i) {
+    const double angle = i % 7 == 0 ? 0.0 : logUniform(rng, -12, 0.5);
+    const Eigen::Vector3d axis = i % 3 == 0 ? Eigen::Vector3d::UnitZ() : randomUnitVector(rng);
+    Eigen::Quaterniond q(Eigen::AngleAxisd(angle, axis));
+    // Off unit length by a few ulp, as a slerp's weighted sum is.
+    q.coeffs() *= 1 + uniform(rng, -4, 4) * std::numeric_limits<double>::epsilon();
+    const Eigen::Matrix3d r = q.toRotationMatrix();
+    const Eigen::Vector3d t = i % 5 == 0 ? Eigen::Vector3d(uniform(rng, -1, 1), 0.2, 0)
+                                         : uniformInCube(rng, 0.01);
+    Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+    m.linear() = r;
+    m.translation() = t;
+    core::ColumnMotion::Reach from_q, from_m;
+    from_q.add(q, r, t);
+    from_m.add(m);
+    EXPECT_GE(from_q.frobenius2, from_m.frobenius2) << "angle " << angle;
+    EXPECT_LE(from_q.frobenius2, from_m.frobenius2 * (1 + 1e-8) + 1e-20) << "angle " << angle;
+    EXPECT_EQ(from_q.shift2, from_m.shift2);
+    EXPECT_NEAR(from_q.z_move2, from_m.z_move2, 1e-15 * from_m.z_move2);
+    if (from_q.translations_only) EXPECT_TRUE(from_m.translations_only);
+    if (from_q.in_plane) EXPECT_TRUE(from_m.in_plane);
+    if (angle == 0) EXPECT_TRUE(from_q.translations_only);
+    if (axis == Eigen::Vector3d::UnitZ() && t.z() == 0) EXPECT_TRUE(from_q.in_plane);
+  }
+}
+
 }  // namespace
 }  // namespace laser_raycast_test

@@ -44,7 +44,11 @@ ColumnMotion::Reach ColumnMotion::reachOf() const {
   Reach reach;
   for (int c = 0; c < columns_; ++c) reach.add(poses_[c]);
   for (int k = 1; k < classes_; ++k) {
-    for (int c = 0; c < columns_; ++c) reach.add(poses_[k * stride_ + c], poses_[c].translation());
+    for (int c = 0; c < columns_; ++c) {
+      const Eigen::Isometry3d& m = poses_[k * stride_ + c];
+      reach.add(m);
+      reach.addDeviation(m.translation(), poses_[c].translation());
+    }
   }
   return reach;
 }

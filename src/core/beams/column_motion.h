@@ -58,10 +58,24 @@ class ColumnMotion {
       in_plane = in_plane && r(0, 2) == 0 && r(1, 2) == 0 && r(2, 0) == 0 && r(2, 1) == 0 &&
                  r(2, 2) == 1 && m.translation().z() == 0;
     }
-    // Another class's pose at a column whose own starts at column_origin.
-    void add(const Eigen::Isometry3d& m, const Eigen::Vector3d& column_origin) {
-      add(m);
-      deviation2 = std::max(deviation2, (m.translation() - column_origin).squaredNorm());
+    // The same for a pose of rotation r and translation t, r being QuaternionBase's
+    // toRotationMatrix of q, taken from q where that costs less: r - I is 2 w [v]x + 2 [v]x^2 (v
+    // q's vector part), whose |.|_F^2 is 8 |v|^2 |q|^2 (raised by a relative 2e-9 and 1e-21 to
+    // cover the rounding of r's entries, which moves |r - I|_F by a few 1e-16: a turn of 1e-11
+    // rad at most); r is exactly I where v = 0, and turns about z alone exactly where v has no x
+    // and y (where it has, r is taken as turning, which only costs speed).
+    void add(const Eigen::Quaterniond& q, const Eigen::Matrix3d& r, const Eigen::Vector3d& t) {
+      const double v2 = q.vec().squaredNorm();
+      shift2 = std::max(shift2, t.squaredNorm());
+      frobenius2 = std::max(frobenius2, 8 * v2 * (q.w() * q.w() + v2) * (1 + 2e-9) + 1e-21);
+      z_move2 =
+          std::max(z_move2, r(0, 2) * r(0, 2) + r(1, 2) * r(1, 2) + (r(2, 2) - 1) * (r(2, 2) - 1));
+      translations_only = translations_only && v2 == 0;
+      in_plane = in_plane && q.x() == 0 && q.y() == 0 && t.z() == 0;
+    }
+    // Where a class's pose lies from its column's, whose own starts at column_origin.
+    void addDeviation(const Eigen::Vector3d& t, const Eigen::Vector3d& column_origin) {
+      deviation2 = std::max(deviation2, (t - column_origin).squaredNorm());
     }
   };
   // The same over poses the caller keeps while this lives (a sweep's, written in place block by

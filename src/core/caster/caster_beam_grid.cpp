@@ -53,8 +53,9 @@ class CastBodies {
 
 // Sub-ray k's result (own's k-th) as the list's beam i: its range, body, triangle and, with
 // compute_incidence, normal and incidence.
-void scatterBeam(const ScanResult& own, std::size_t k, int i, const BeamList& list,
-                 const CastConfig& config, ScanResult* result) {
+LASER_RAYCAST_HOT_INLINE void scatterBeam(const ScanResult& own, std::size_t k, int i,
+                                          const BeamList& list, const CastConfig& config,
+                                          ScanResult* result) {
   result->range[i] = own.range[k];
   result->body[i] = own.body[k];
   result->triangle[i] = own.triangle[k];
@@ -83,15 +84,16 @@ void scatter(const BeamListGrid::Part& part, const ScanResult& own, const BeamLi
 
 // A part's lines grouped by when they fire: lines of one class fire at one time in every column
 // (an Ouster's part is one class, each Velodyne laser its own, at its place in the firing
-// sequence). class_of_row by the rows of the part's grid (ascending elevation); time[k][col].
+// sequence). class_of_row by the rows of the part's grid (ascending elevation).
 struct TimeClasses {
   int count = 0;
   std::vector<int> class_of_row;
-  std::vector<std::vector<double>> time;
 };
 
-// at_once: every beam at time 0 (a cast from one pose).
-TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list, bool at_once) {
+// Appends each class's times at the part's columns to *times (class by class); at_once: every
+// beam at time 0 (a cast from one pose).
+TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list, bool at_once,
+                        std::vector<double>* times) {
   const int rings = part.culling.ringCount(), cols = part.culling.azimuthCount();
   auto time = [&](int ring, int col) {
     return at_once ? 0.0 : list.time(part.beam[ring * cols + col]);
@@ -110,8 +112,7 @@ TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list, bo
     if (k == out.count) {
       ++out.count;
       first_ring.push_back(ring);
-      out.time.emplace_back();
-      for (int col = 0; col < cols; ++col) out.time.back().push_back(time(ring, col));
+      for (int col = 0; col < cols; ++col) times->push_back(time(ring, col));
     }
     class_of_ring[ring] = k;
   }
@@ -233,14 +234,12 @@ void CasterState::castBeamGridsSweep(const Scene& scene, const PoseSamples& samp
   std::vector<char> column_valid;
   // Every part's columns' poses at once (the samples are prepared once for all of them).
   std::vector<TimeClasses> classes;
-  std::vector<double> times;
+  std::vector<double>& times = sweep_columns.times;
+  times.clear();
   for (const BeamListGrid::Part& part : grid.parts) {
-    classes.push_back(timeClasses(part, list, at_once));
-    for (const std::vector<double>& t : classes.back().time) {
-      times.insert(times.end(), t.begin(), t.end());
-    }
+    classes.push_back(timeClasses(part, list, at_once, &times));
   }
-  const ColumnPoses poses(scene, indexOf(scene), samples, std::move(times));
+  const ColumnPoses poses(scene, indexOf(scene), samples, &sweep_columns);
   int base = 0;
   for (std::size_t p = 0; p < grid.parts.size(); ++p) {
     const BeamListGrid::Part& part = grid.parts[p];

@@ -13,6 +13,7 @@
 #include "beams/beam_list_grid.h"
 #include "beams/beam_set.h"
 #include "beams/column_motion.h"
+#include "caster/column_poses.h"
 #include "laser_raycast/core/cast_config.h"
 #include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/core/scan_pattern.h"
@@ -50,8 +51,6 @@ struct ReuseKey {
     return true;
   }
 };
-
-class ColumnPoses;  // caster/column_poses.h
 
 // A scene frame with bodies this scan, with its pose in the sensor frame.
 struct PlacedGroup {
@@ -133,6 +132,7 @@ struct CasterState {
   // reference, kept from sweep to sweep (a calibrated Velodyne's turn has 28,928): the blocks'
   // ColumnMotion of the frames that stay put are views of them.
   std::vector<Eigen::Isometry3d> sweep_poses;
+  ColumnPoses::Storage sweep_columns;  // the ColumnPoses' of a sweep
   ScanResult grid_culling, grid_own;  // castBeamGrids' results for one part, by its grid beams
 
   // The scene's index for this scene version.

@@ -193,17 +193,12 @@ class BlockPlanner {
                                    beams_.origins ? *origin(ref) : Eigen::Vector3d::Zero());
     std::vector<Eigen::Isometry3d>& out = *sweep_poses_;
     ColumnMotion::Reach reach;
-    for (int c = lo; c <= hi; ++c) {
-      Eigen::Isometry3d& pose = out[column(0, c)];
-      relative.at(column(0, c), origin(c), &pose);
-      reach.add(pose);
-    }
+    for (int c = lo; c <= hi; ++c) relative.at(column(0, c), origin(c), &out[column(0, c)], &reach);
     // Class by class, each one's poses written in a row.
     for (int k = 1; k < beams_.classes; ++k) {
       for (int c = lo; c <= hi; ++c) {
-        Eigen::Isometry3d& pose = out[column(k, c)];
-        relative.at(column(k, c), origin(c), &pose);
-        reach.add(pose, out[column(0, c)].translation());
+        const Eigen::Vector3d t = relative.at(column(k, c), origin(c), &out[column(k, c)], &reach);
+        reach.addDeviation(t, out[column(0, c)].translation());
       }
     }
     return std::make_shared<ColumnMotion>(
@@ -307,11 +302,12 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
   }
   forget();  // a sweep is never reused, and the last single cast is not this one
   const int azimuths = pattern.azimuthCount();
-  std::vector<double> times(azimuths);
+  std::vector<double>& times = state_->sweep_columns.times;
+  times.resize(azimuths);
   for (int c = 0; c < azimuths; ++c) times[c] = c * time_increment;
   resetResult(pattern.size(), static_cast<int>(scene.bodies().size()), true,
               config.compute_incidence, &result_);
-  const ColumnPoses poses(scene, state_->indexOf(scene), samples, std::move(times));
+  const ColumnPoses poses(scene, state_->indexOf(scene), samples, &state_->sweep_columns);
   std::vector<char> column_valid;
   state_->sweepColumns(scene, poses, 0, pattern, SweepBeams{}, config, &result_, &column_valid);
   if (config.compute_incidence) computeIncidence(pattern, &result_);

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "beams/column_motion.h"
 #include "laser_raycast/core/pose.h"
 #include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/core/scene.h"
@@ -26,9 +27,24 @@ namespace core {
 // down in azimuth as their times go up).
 class ColumnPoses {
  public:
+  struct Bracket {
+    std::size_t i, j;
+    double s;
+  };
+  // Its columns' times and what it finds of them, in storage the caller keeps from sweep to sweep
+  // (a calibrated Velodyne's turn has 28,928 columns: written, not made and zeroed anew).
+  struct Storage {
+    std::vector<double> times;  // by column: set by the caller
+    std::vector<Bracket> brackets;
+    std::vector<char> sensor_valid;
+  };
+  // Column c at storage->times[c].
   ColumnPoses(const Scene& scene, const SceneIndex& index, const PoseSamples& samples,
-              std::vector<double> times)
-      : samples_(samples), times_(std::move(times)) {
+              Storage* storage)
+      : samples_(samples),
+        times_(storage->times),
+        brackets_(storage->brackets),
+        sensor_valid_(storage->sensor_valid) {
     const int columns = static_cast<int>(times_.size());
     const std::size_t n = samples.times.size();
     sample_sensor_ok_.resize(n);
@@ -75,36 +91,41 @@ class ColumnPoses {
     // The reference column's sensor pose moved to ref_origin.
     const Eigen::Isometry3d& worldFromRef() const { return world_from_ref_; }
     // The column's sensor pose moved to origin (its sensor frame; null: none), relative to the
-    // reference.
-    void at(int col, const Eigen::Vector3d* origin, Eigen::Isometry3d* out) {
+    // reference, added to *reach; returns its translation (as out has it, without reading back
+    // what was just stored).
+    Eigen::Vector3d at(int col, const Eigen::Vector3d* origin, Eigen::Isometry3d* out,
+                       ColumnMotion::Reach* reach) {
       const Bracket& b = poses_.brackets_[col];
       const std::vector<Eigen::Isometry3d>& pose = poses_.samples_.world_from_sensor;
       if (b.j == b.i) {
         // At a sample: its pose, taken relative as it is.
         *out = relativePose(ref_rot_t_, world_from_ref_.translation(), pose[b.i]);
         if (origin) out->translation() += out->linear() * *origin;
-      } else {
-        if (b.i != pair_) {
-          pair_ = b.i;
-          const Rotations& rotation = poses_.sample_rotation_;
-          p_ = q_ref_conj_ * rotation.sample(b.i);
-          q_ = q_ref_conj_ * rotation.sample(b.j);
-          const Eigen::Vector3d& ta = pose[b.i].translation();
-          alpha_ = ref_rot_t_ * (ta - world_from_ref_.translation());
-          beta_ = ref_rot_t_ * (pose[b.j].translation() - ta);
-        }
-        double scale0, scale1;
-        poses_.sample_rotation_.weights(b, &scale0, &scale1);
-        const Eigen::Quaterniond q(scale0 * p_.coeffs() + scale1 * q_.coeffs());
-        // The translation from the rotation's values, not read back from *out (their stores could
-        // not be forwarded to its loads, and each column waited for them: a third of its time).
-        Eigen::Vector3d t = alpha_ + b.s * beta_;
-        const Eigen::Matrix3d r = rotationOf(q);
-        if (origin) t += r * *origin;
-        out->linear() = r;
-        out->translation() = t;
-        out->makeAffine();
+        reach->add(*out);
+        return out->translation();
       }
+      if (b.i != pair_) {
+        pair_ = b.i;
+        const Rotations& rotation = poses_.sample_rotation_;
+        p_ = q_ref_conj_ * rotation.sample(b.i);
+        q_ = q_ref_conj_ * rotation.sample(b.j);
+        const Eigen::Vector3d& ta = pose[b.i].translation();
+        alpha_ = ref_rot_t_ * (ta - world_from_ref_.translation());
+        beta_ = ref_rot_t_ * (pose[b.j].translation() - ta);
+      }
+      double scale0, scale1;
+      poses_.sample_rotation_.weights(b, &scale0, &scale1);
+      const Eigen::Quaterniond q(scale0 * p_.coeffs() + scale1 * q_.coeffs());
+      // The translation from the rotation's values, not read back from *out (their stores could
+      // not be forwarded to its loads, and each column waited for them: a third of its time).
+      Eigen::Vector3d t = alpha_ + b.s * beta_;
+      const Eigen::Matrix3d r = rotationOf(q);
+      if (origin) t += r * *origin;
+      out->linear() = r;
+      out->translation() = t;
+      out->makeAffine();
+      reach->add(q, r, t);
+      return t;
     }
 
    private:
@@ -143,10 +164,6 @@ class ColumnPoses {
   }
 
  private:
-  struct Bracket {
-    std::size_t i, j;
-    double s;
-  };
   // The samples' rotations as quaternions, and the slerp between two of them as Eigen's
   // QuaternionBase::slerp computes it, with the angle between each sample and the next and its
   // sine worked out once rather than at every column, and the sines of its fractions by smallSin.
@@ -332,12 +349,12 @@ class ColumnPoses {
   }
 
   const PoseSamples& samples_;
-  std::vector<double> times_;  // by column
+  const std::vector<double>& times_;  // by column
   std::vector<char> sample_sensor_ok_;
   Rotations sample_rotation_;
-  std::vector<Bracket> brackets_;
+  std::vector<Bracket>& brackets_;
   std::vector<char> arcs_used_;  // by sample: some column lies strictly between it and the next
-  std::vector<char> sensor_valid_;
+  std::vector<char>& sensor_valid_;
   std::vector<int> frames_;
   std::vector<Frame> frame_;  // by scene frame (only those with bodies are filled)
 };
