@@ -1,6 +1,7 @@
 #include "live_params.h"
 
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "param_reader.h"
@@ -38,8 +39,19 @@ std::string applyLiveParams(const LiveParams& live, SensorParams* params) {
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
+  // A head's beams (a preset's lasers, a calibration file's) are one turn of scanTime(): a turn
+  // that follows the rate is fired again at the new one.
+  if (next.calibrated && next.head_turn && next.scanTime() != params->scanTime()) {
+    try {
+      next.calibrated = std::make_shared<const core::BeamList>(next.head_turn(next.scanTime()));
+    } catch (const std::invalid_argument& e) {
+      return "rate " + formatNumber(live.rate) + " Hz: " + params->calibratedFrom() +
+             " over one turn of " + formatNumber(next.scanTime()) + " s: " + e.what();
+    }
+  }
   params->scan.output = live.output;
   params->rate = live.rate;
+  params->calibrated = next.calibrated;
   return "";
 }
 

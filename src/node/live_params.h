@@ -22,7 +22,9 @@ LiveParams liveParams(const SensorParams& params);
 // value) and leaves *params as it was: a rate outside (0, kMaxRate], a rate too fast for a
 // rotating sensor's scan_time (one turn per scan; scan_time itself needs a restart), one so slow
 // that a sweep following it outlasts the times point_layout can hold, or output settings
-// core::MeasurementConfig::validate refuses (e.g. range_min >= range_max).
+// core::MeasurementConfig::validate refuses (e.g. range_min >= range_max). A head's beams
+// (SensorParams::calibrated, head_turn) whose turn follows the rate are fired again over the new
+// turn.
 std::string applyLiveParams(const LiveParams& live, SensorParams* params);
 
 }  // namespace laser_raycast

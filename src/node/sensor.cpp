@@ -177,8 +177,9 @@ const core::ScanResult* Sensor::castPattern(const core::Scene& scene,
     const core::PatternFile& file = *cast_params_.pattern;
     beams_ = file.scan(next_row_, cast_params_.points_per_scan, cast_params_.point_rate);
     next_row_ = (next_row_ + cast_params_.points_per_scan) % file.size();
-  } else if (beams_.size() != cast_params_.calibrated->size()) {
-    beams_ = *cast_params_.calibrated;  // the same every scan
+  } else if (beams_of_ != cast_params_.calibrated) {
+    beams_ = *cast_params_.calibrated;  // the same every scan, until a live rate change
+    beams_of_ = cast_params_.calibrated;
   }
   // An instant scan casts every point from the stamp's poses; the points keep their times.
   if (cast_params_.sweep != Sweep::kRotating) {

@@ -170,6 +170,7 @@ void readCalibration(ParamReader* r, SensorParams* s) {
   s->calibration_file = r->text("calibration_file", s->calibration_file);
   if (s->calibration_file.empty()) {
     s->calibrated.reset();
+    s->head_turn = nullptr;
     return;
   }
   if (!s->pattern_file.empty()) {
@@ -178,7 +179,8 @@ void readCalibration(ParamReader* r, SensorParams* s) {
   }
   try {
     const core::VelodyneHead head = loadVelodyneCalibration(s->calibration_file);
-    s->calibrated = std::make_shared<const core::BeamList>(head.scan(s->scanTime()));
+    s->head_turn = [head](double scan_time) { return head.scan(scan_time); };
+    s->calibrated = std::make_shared<const core::BeamList>(s->head_turn(s->scanTime()));
   } catch (const std::invalid_argument& e) {
     r->fail("calibration_file", e.what());
   }
@@ -198,7 +200,8 @@ void readOusterMetadata(ParamReader* r, SensorParams* s, std::vector<std::string
   }
   try {
     const core::OusterHead head = loadOusterMetadata(s->ouster_metadata);
-    s->calibrated = std::make_shared<const core::BeamList>(head.scan(s->scanTime()));
+    s->head_turn = [head](double scan_time) { return head.scan(scan_time); };
+    s->calibrated = std::make_shared<const core::BeamList>(s->head_turn(s->scanTime()));
     if (std::abs(head.fps * s->scanTime() - 1) > 1e-6) {
       warnings->push_back(r->prefix() + "ouster_metadata: the file's lidar mode turns at " +
                           formatNumber(head.fps) + " Hz, the sensor once in " +
@@ -238,18 +241,27 @@ void readPresetHead(ParamReader* r, SensorParams* s) {
     return;
   }
   if (model->head) {
-    s->calibrated = std::make_shared<const core::BeamList>(model->beams(s->scanTime()));
+    s->head_turn = [model = *model](double scan_time) { return model.beams(scan_time); };
   } else {
     try {
       const core::OusterHead head =
           loadOusterMetadata(resolvePackageUri(model->head_file, rosPackagePath));
-      s->calibrated = std::make_shared<const core::BeamList>(head.scan(s->scanTime()));
+      s->head_turn = [head](double scan_time) { return head.scan(scan_time); };
     } catch (const std::exception& e) {
       // The package's own file: missing or unreadable only in a broken installation.
       r->fail("sensor_model", "'" + s->sensor_model + "': its beams' file " + model->head_file +
                                   " (part of this package): " + e.what());
       return;
     }
+  }
+  try {
+    s->calibrated = std::make_shared<const core::BeamList>(s->head_turn(s->scanTime()));
+  } catch (const std::invalid_argument& e) {
+    // A turn too slow for a list (a VLP-16's over 34.56 s: 10M beams).
+    r->fail("sensor_model", "'" + s->sensor_model + "' over one turn of " +
+                                formatNumber(s->scanTime()) + " s: " + e.what());
+    s->head_turn = nullptr;
+    return;
   }
   s->preset_head = true;
 }

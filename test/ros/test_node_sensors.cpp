@@ -336,24 +336,26 @@ TEST(NodeSensors, LinkPosesAreLookedUpOncePerScanTime) {
   EXPECT_LE(lookups / seconds, 1.05 * frames * kStaticLookUpsMax);
 }
 
-// Sets one of front's live parameters through dynamic_reconfigure; returns the configuration the
-// node replied with.
-dynamic_reconfigure::Config reconfigureFront(const dynamic_reconfigure::Config& change) {
+// Sets live parameters of a sensor (front unless named) through dynamic_reconfigure; returns the
+// configuration the node replied with.
+dynamic_reconfigure::Config reconfigureFront(const dynamic_reconfigure::Config& change,
+                                             const std::string& sensor = "front") {
   dynamic_reconfigure::Reconfigure srv;
   srv.request.config = change;
-  EXPECT_TRUE(ros::service::call("/laser_raycast/front/set_parameters", srv));
+  EXPECT_TRUE(ros::service::call("/laser_raycast/" + sensor + "/set_parameters", srv));
   return srv.response.config;
 }
 
-// A double parameter of front; returns the doubles the node replied with.
-std::map<std::string, double> setFront(const std::string& name, double value) {
+// A double parameter of front (or the sensor named); returns the doubles the node replied with.
+std::map<std::string, double> setFront(const std::string& name, double value,
+                                       const std::string& sensor = "front") {
   dynamic_reconfigure::Config change;
   dynamic_reconfigure::DoubleParameter p;
   p.name = name;
   p.value = value;
   change.doubles.push_back(p);
   std::map<std::string, double> out;
-  for (const auto& d : reconfigureFront(change).doubles) out[d.name] = d.value;
+  for (const auto& d : reconfigureFront(change, sensor).doubles) out[d.name] = d.value;
   return out;
 }
 
@@ -452,6 +454,47 @@ TEST(NodeSensors, ALiveIntensityToggle) {
       10.0);
   ASSERT_TRUE(scan) << "no scan after switching intensity off";
   EXPECT_TRUE(scan->intensities.empty());
+}
+
+// The VLP-16 preset's turn follows its rate: set live to 20 Hz, the next clouds fire 904
+// sequences in the 0.05 s turn, each point at the head's azimuth at its firing time in that
+// turn; back at 10 Hz, 1808 again.
+TEST(NodeSensors, ALiveRateTurnsTheVlp16sHeadAtTheNewRate) {
+  ASSERT_TRUE(ros::service::waitForService("/laser_raycast/vlp/set_parameters", 30000));
+  for (const double rate : {20.0, 10.0}) {
+    EXPECT_EQ(setFront("rate", rate, "vlp")["rate"], rate);
+    const double turn = 1 / rate;
+    const int sequences = static_cast<int>(turn / 55.296e-6);
+    // Clouds cast before the change may still arrive: the first of the new turn's size after it.
+    const ros::Time after = ros::Time::now() + ros::Duration(0.1);
+    const auto cloud = rig->waitFor<sensor_msgs::PointCloud2>(
+        &rig->clouds,
+        [&](const sensor_msgs::PointCloud2& c) {
+          return c.header.stamp >= after && c.width == 16u * sequences;
+        },
+        10.0);
+    ASSERT_TRUE(cloud) << "no cloud of " << sequences << " sequences at " << rate << " Hz";
+    sensor_msgs::PointCloud2ConstIterator<float> x(*cloud, "x"), y(*cloud, "y");
+    sensor_msgs::PointCloud2ConstIterator<float> time(*cloud, "time");
+    sensor_msgs::PointCloud2ConstIterator<std::uint16_t> ring(*cloud, "ring");
+    int bad = 0;
+    double last = 0;
+    for (; x != x.end(); ++x, ++y, ++time, ++ring) {
+      const int id = *ring < 8 ? 2 * *ring : 2 * (*ring - 8) + 1;
+      const long sequence = std::lround((*time - id * 2.304e-6) / 55.296e-6);
+      const double t = sequence * 55.296e-6 + id * 2.304e-6;
+      const double head = M_PI - 2 * M_PI * t / turn;
+      const double off = std::remainder(std::atan2(*y, *x) - head, 2 * M_PI);
+      last = std::max(last, static_cast<double>(*time));
+      if (!(std::abs(off) < 2e-6 && std::abs(*time - t) < 1e-8) && ++bad <= 5) {
+        ADD_FAILURE() << "at " << rate << " Hz: a point of time " << *time << " lies " << off
+                      << " rad from the head's azimuth";
+      }
+    }
+    EXPECT_EQ(bad, 0);
+    EXPECT_LT(last, turn);
+    EXPECT_GT(last, turn - 2 * 55.296e-6);
+  }
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "expect_invalid.h"
 #include "live_params.h"
+#include "node_params_inputs.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -92,6 +93,52 @@ TEST(LiveParams, ASweepTooLongForThePointLayoutIsRefused) {
   p.point_layout = laser_raycast::PointLayout::kVelodyne;
   live.rate = 0.2;
   EXPECT_EQ(applyLiveParams(live, &p), "");
+}
+
+// A head's beams (a preset's lasers) are one turn of the scan time: with scan_time following the
+// rate, a live rate change fires them again over the new turn (VLP-16 at 20 Hz: 904 sequences of
+// 16, the head's azimuth turning twice as fast); with scan_time set, or a change refused, the
+// turn stays; a rate whose turn fires more beams than a list holds is refused by name.
+TEST(LiveParams, AHeadWhoseTurnFollowsTheRateFiresAgainAtTheNewRate) {
+  const Parsed parsed = parse(values({{"sensor_model", "VLP-16"}, {"sweep", "rotating"}}));
+  ASSERT_EQ(parsed.error, "");
+  SensorParams p = parsed.params.sensors.at(0);
+  ASSERT_TRUE(p.calibrated);
+  const auto at_10_hz = p.calibrated;
+  ASSERT_EQ(at_10_hz->size(), 16 * 1808);
+  LiveParams live = liveParams(p);
+  live.rate = 20.0;
+  ASSERT_EQ(applyLiveParams(live, &p), "");
+  ASSERT_TRUE(p.calibrated);
+  EXPECT_EQ(at_10_hz->size(), 16 * 1808);  // the list a cast may hold is left as it was
+  ASSERT_EQ(p.calibrated->size(), 16 * static_cast<int>(0.05 / 55.296e-6));  // 904 sequences
+  // Laser id 0 of sequence 903 (ring 0, -15 deg): at 903 * 55.296 us, the head at pi less the
+  // share of a 0.05 s turn.
+  const int b = 903 * 16;
+  const double t = 903 * 55.296e-6;
+  EXPECT_NEAR(p.calibrated->time(b), t, 1e-15);
+  const Eigen::Vector3d& d = p.calibrated->directions[b];
+  EXPECT_NEAR(std::remainder(std::atan2(d.y(), d.x()) - (M_PI - 2 * M_PI * t / 0.05), 2 * M_PI),
+              0.0, 1e-12);
+  EXPECT_NEAR(p.sweepDuration(), p.calibrated->times.back(), 0.0);
+
+  // scan_time set: the turn does not follow the rate.
+  SensorParams fixed = parsed.params.sensors.at(0);
+  fixed.scan_time = 0.1;
+  const auto before = fixed.calibrated;
+  live.rate = 5.0;
+  ASSERT_EQ(applyLiveParams(live, &fixed), "");
+  EXPECT_EQ(fixed.calibrated, before);
+  // Refused (too fast for that scan_time): the turn stays too.
+  live.rate = 20.0;
+  EXPECT_NE(applyLiveParams(live, &fixed), "");
+  EXPECT_EQ(fixed.calibrated, before);
+
+  // A 40 s turn would fire 11.6M beams.
+  SensorParams slow = parsed.params.sensors.at(0);
+  live.rate = 0.025;
+  expectRefused(live, slow, {"rate 0.025 Hz", "VLP-16 preset's lasers", "40 s", "10000000"});
+  EXPECT_EQ(slow.calibrated->size(), 16 * 1808);
 }
 
 TEST(LiveParams, RatesOutsideTheRangeAreRefused) {

@@ -5,6 +5,7 @@
 
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -110,6 +111,9 @@ struct SensorParams {
   std::string ouster_metadata;
   // The beams of calibration_file or ouster_metadata, or of sensor_model's head (one turn).
   std::shared_ptr<const core::BeamList> calibrated;
+  // The head calibrated's beams are one turn of: its beams over one turn of the given s, to turn
+  // them again when scanTime() changes (a live rate change, scan_time following the rate).
+  std::function<core::BeamList(double)> head_turn;
   // calibrated is the preset's head (core::SensorModel::head), not a file's.
   bool preset_head = false;
   // Where calibrated came from: the file, or "the <sensor_model> preset's lasers".

@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "laser_raycast/core/scan_pattern.h"
+
 namespace laser_raycast {
 namespace core {
 
@@ -60,6 +62,17 @@ BeamList VelodyneHead::scan(double scan_time, double start_azimuth) const {
   const std::vector<int> ring = rings();
   std::vector<const VelodyneLaser*> by_id(lasers.size());
   for (const VelodyneLaser& l : lasers) by_id[l.id] = &l;
+  if (!(std::isfinite(scan_time) && scan_time > 0)) {
+    throw std::invalid_argument("velodyne head: a turn must take a finite time > 0 s");
+  }
+  // Refused before any is made: a slow turn of a dense head fires more beams than a list holds.
+  const double fired = std::floor(scan_time / timing.sequence_period) * lasers.size();
+  if (fired > FanSpec::kMaxBeams) {
+    std::ostringstream msg;
+    msg << "velodyne head: a turn of " << scan_time << " s fires " << static_cast<long long>(fired)
+        << " beams, more than " << FanSpec::kMaxBeams;
+    throw std::invalid_argument(msg.str());
+  }
   const long sequences = std::max(1L, static_cast<long>(scan_time / timing.sequence_period));
   BeamList beams;
   const std::size_t n = static_cast<std::size_t>(sequences) * lasers.size();
