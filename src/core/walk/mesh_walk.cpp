@@ -13,6 +13,8 @@
 #include "geometry/hit_order.h"
 #include "slice/slicer.h"
 #include "util/walk_stack.h"
+#include "walk/beam_rays.h"
+#include "walk/body_triangles.h"
 #include "walk/slot_cache.h"
 #include "walk/sub_ray_filter.h"
 
@@ -43,11 +45,11 @@ constexpr double kPlainSliceBeamsPerTriangle = 0.5;
 template <TriangleMethod M>
 class MeshWalk {
  public:
+  using SensorTriangle = BodyTriangles::Triangle;
+
   MeshWalk(BeamSet& beams, const Mesh& mesh, const PlacedBody& active, const CastConfig& config)
       : beams_(beams),
-        mesh_(mesh),
         wide_(mesh.wideBvh()),
-        slots_(mesh.bvh().triangleVertices()),
         ids_(mesh.bvh().triangleIds()),
         active_(active),
         config_(config),
@@ -62,9 +64,8 @@ class MeshWalk {
         // Without the fast paths every beam is traced from the root, as the reference.
         tracing_only_(planar_ ? !config.planar_fast_path : !config.raster_fast_path),
         basis_(active.sensor_from_body, planar_, config.tmax, spread_),
-        // A sweep's block traces each column from its own origin, all within the shift.
-        origin_(active.sensor_in_body, mesh.bvh().bounds(), config.tmin, spread_.shift) {
-    closed_ = !slicing_ && mesh.hasClosedComponents();
+        triangles_(mesh, active, config.tmin, spread_.shift, !slicing_),
+        rays_(beams, active, mesh.bvh().bounds(), config) {
     if (slicing_) {
       // Cut in the frame's plane coordinates when the walk gives them (as a kept slice is).
       if (active.plane) {
@@ -152,58 +153,6 @@ class MeshWalk {
     for (int j = 0; j < n; ++j) push(children[j]);
   }
 
-  // The beam as a ray in the body's frame, for box tests: the same one for every box test of this
-  // walk.
-  WideBoxRay boxRay(int row, int col) const {
-    return boxRayAlong(row, col, beams_.grid().rebuiltDirection(row, col));
-  }
-  // The beam at (row, col) along sensor-frame direction d as a ray in the body's frame for box
-  // tests: from the sensor, or for a sweep's block turned with the beam's pose and from its own
-  // origin. (origin_ holds every column's origin, the box grown by the block's shift: a centimetre
-  // on every box makes a ray traced through small boxes enter many more of them.)
-  WideBoxRay boxRayAlong(int row, int col, const Eigen::Vector3d& d) const {
-    if (!motion_) return WideBoxRay(origin_, active_.body_from_sensor_rot * d);
-    const Eigen::Isometry3d& pose = motion_->refFromBeam(row, col);
-    const Eigen::Vector3d dir = active_.body_from_sensor_rot * (pose.linear() * d);
-    if (spread_.shift == 0) return WideBoxRay(origin_, dir);
-    return WideBoxRay(originOf(pose), dir);
-  }
-
-  // Where the beams leaving from a sweep's pose start, for box tests in the body's frame: the same
-  // for every beam from that pose, so the last few are kept, by the pose's address (the block's
-  // poses stay where they are for the walk).
-  const WideBoxRay::Origin& originOf(const Eigen::Isometry3d& pose) const {
-    const auto key = reinterpret_cast<std::uintptr_t>(&pose);
-    KeptOrigin& kept = origins_[(key / sizeof(Eigen::Isometry3d)) % origins_.size()];
-    if (kept.pose != &pose) {
-      kept.pose = &pose;
-      const Eigen::Vector3d o =
-          active_.body_from_sensor_rot * pose.translation() + active_.sensor_in_body;
-      kept.origin.emplace(o, mesh_.bvh().bounds(), config_.tmin);
-    }
-    return *kept.origin;
-  }
-
-  // A triangle slot moved into the sensor frame. Every 3D test of this body's triangles is the
-  // beam's sensor-frame ray against these vertices, however the pair was found (traced,
-  // rasterised or tested directly), so shared edges are decided the same way everywhere.
-  struct SensorTriangle {
-    Eigen::Vector3d a, b, c;
-  };
-  SensorTriangle sensorTriangle(std::uint32_t slot) const {
-    const auto& v = slots_[slot];
-    return SensorTriangle{rot_ * v[0] + trans_, rot_ * v[1] + trans_, rot_ * v[2] + trans_};
-  }
-
-  // The same through a small cache: the beams traced through one node meet the same leaves.
-  const SensorTriangle& cachedTriangle(std::uint32_t slot) {
-    return triangles_.get(slot, [&] { return sensorTriangle(slot); });
-  }
-
-  Eigen::Vector3d sensorNormal(std::uint32_t triangle) const {
-    return rot_ * mesh_.normal(triangle);
-  }
-
   // The nearest hit of one beam so far in this walk: a hit improves it if nearer, or as near on a
   // lower triangle index, so the result does not depend on the order triangles are met in.
   struct Best {
@@ -219,7 +168,7 @@ class MeshWalk {
   // A triangle's unit normal in the frame of the beam at (row, col): the sensor's, or for a
   // sweep's block the beam's own pose's.
   Eigen::Vector3d beamNormal(int row, int col, std::uint32_t triangle) const {
-    const Eigen::Vector3d n = sensorNormal(triangle);
+    const Eigen::Vector3d n = triangles_.sensorNormal(triangle);
     return motion_ ? motion_->toBeam(row, col, n) : n;
   }
 
@@ -233,29 +182,6 @@ class MeshWalk {
   void offerSub(int s, int row, int col, const Best& best) {
     beams_.keepNearestSubHit(s, row, col, best.t, active_.index, static_cast<int>(best.triangle),
                              [&] { return beamNormal(row, col, best.triangle); });
-  }
-
-  // Sub-ray s of the bundle's beam at (row, col) for the triangle tests and the box tests, as a
-  // cast of its pattern tests it (a divergent beam's block has the sensor's pose at every column).
-  PreparedRay<double, M> subRay(int s, int row, int col) const {
-    return rayAlong(row, col, beams_.subDirection(s));
-  }
-  WideBoxRay subBoxRay(int s, int row, int col) const {
-    return boxRayAlong(row, col, beams_.subDirection(s));
-  }
-  // The beam at (row, col) along sensor-frame direction d for the triangle tests: from the
-  // sensor, or for a sweep's block from the beam's pose, in the reference sensor frame.
-  LASER_RAYCAST_HOT_INLINE PreparedRay<double, M> rayAlong(int row, int col,
-                                                           const Eigen::Vector3d& d) const {
-    Ray ray{Eigen::Vector3d::Zero(), d, config_.tmin};
-    if (motion_) ray = motion_->ray(row, col, d, config_.tmin);
-    return PreparedRay<double, M>(ray, config_.cull_backfaces);
-  }
-  // The grid's beam for the triangle tests (rayAlong its direction; from the sensor, the grid's
-  // prepared ray).
-  PreparedRay<double, M> beamRay(int row, int col) const {
-    if (!motion_) return beams_.grid().template sensorRay<M>(row, col);
-    return rayAlong(row, col, beams_.grid().rebuiltDirection(row, col));
   }
 
   // A beam (or a bundle's sub-ray) traced on its own through a subtree: its rays, its far limit
@@ -302,8 +228,8 @@ class MeshWalk {
         b.sub = -1;
         b.tmax = std::min(config_.tmax, range);
         b.best = Best{};
-        b.box_ray = boxRay(row, col);
-        if (!slicing_) b.ray.emplace(beamRay(row, col));
+        b.box_ray = rays_.boxRay(row, col);
+        if (!slicing_) b.ray.emplace(rays_.beamRay(row, col));
         if (n == 2) tracePair(e, pair, [this](Traced* t) { return leafOf(t); });
         n %= 2;
       }
@@ -360,8 +286,8 @@ class MeshWalk {
           double tmax = std::min(config_.tmax, beams_.subRange(s));
           if (!(tmax >= e.near)) continue;
           Best best;
-          const PreparedRay<double, M> ray = subRay(s, row, col);
-          traceWide(wide_, e.ref, subBoxRay(s, row, col), &tmax, [&](std::uint32_t slot) {
+          const PreparedRay<double, M> ray = rays_.subRay(s, row, col);
+          traceWide(wide_, e.ref, rays_.subBoxRay(s, row, col), &tmax, [&](std::uint32_t slot) {
             if (!hidden(slot)) testSlot(ray, slot, &tmax, &best);
           });
           if (best.found()) offerSub(s, row, col, best);
@@ -386,8 +312,8 @@ class MeshWalk {
           b.sub = s;
           b.tmax = tmax;
           b.best = Best{};
-          b.box_ray = subBoxRay(s, row, col);
-          b.ray.emplace(subRay(s, row, col));
+          b.box_ray = rays_.subBoxRay(s, row, col);
+          b.ray.emplace(rays_.subRay(s, row, col));
           if (n == 2) tracePair(e, pair, [this](Traced* t) { return subLeafOf(t); });
           n %= 2;
         }
@@ -407,7 +333,7 @@ class MeshWalk {
   // its best so far and its far limit.
   LASER_RAYCAST_HOT_INLINE void testSlot(const PreparedRay<double, M>& ray, std::uint32_t slot,
                                          double* tmax, Best* best) {
-    const SensorTriangle& s = cachedTriangle(slot);
+    const SensorTriangle& s = triangles_.cachedTriangle(slot);
     const auto hit = ray.intersect(s.a, s.b, s.c, *tmax);
     if (hit && best->improves(hit->t, ids_[slot])) {
       *best = Best{hit->t, ids_[slot], slot};
@@ -415,19 +341,10 @@ class MeshWalk {
     }
   }
 
-  // A back face of a closed component that the sensor sees from outside: never the nearest hit of a
-  // beam (hiddenBackFace), so never tested. Only for the 3D tests: a planar fan's segments are
-  // cheap, and kept slices (which must skip what the walk skips) would pay more to decide.
-  // The answer depends on the slot alone for the whole walk, and neighbouring beams ask about the
-  // same slots: the last answers are kept by slot.
-  bool hidden(std::uint32_t slot) { return closed_ && hiddenClosed(slot); }
-  // Out of line: the tests that ask stay small inline.
-  __attribute__((noinline)) bool hiddenClosed(std::uint32_t slot) {
-    return hidden_.get(slot, [&] {
-      // A sweep's block: hidden from every column's origin, all within the shift.
-      return hiddenBackFace(mesh_, slot, active_.sensor_in_body, config_.tmin, spread_.shift);
-    });
-  }
+  // A back face no beam meets first (BodyTriangles::hidden): only for the 3D tests, a planar fan's
+  // segments being cheap, and kept slices (which must skip what the walk skips) paying more to
+  // decide.
+  bool hidden(std::uint32_t slot) { return triangles_.hidden(slot); }
 
   // The slot's segment in the scan plane against one beam, as slicing tests it.
   void sliceOne(std::uint32_t slot, int col, double* tmax, Best* best) const {
@@ -442,7 +359,7 @@ class MeshWalk {
   void testLeaf(const Entry& e) {
     SensorTriangle tris[16];  // the leaf's first triangles, moved once
     const std::uint32_t count = std::min<std::uint32_t>(e.ref.count, 16);
-    for (std::uint32_t i = 0; i < count; ++i) tris[i] = sensorTriangle(e.ref.index + i);
+    for (std::uint32_t i = 0; i < count; ++i) tris[i] = triangles_.sensorTriangle(e.ref.index + i);
     for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
       for (int col = e.rect.col_lo; col <= e.rect.col_hi; ++col) {
         const double range = beams_.range(row, col);
@@ -452,7 +369,7 @@ class MeshWalk {
           for (std::uint32_t i = 0; i < e.ref.count; ++i) {
             const std::uint32_t slot = e.ref.index + i;
             if (hidden(slot)) continue;
-            const SensorTriangle s = i < count ? tris[i] : sensorTriangle(slot);
+            const SensorTriangle s = i < count ? tris[i] : triangles_.sensorTriangle(slot);
             const auto hit = ray.intersect(s.a, s.b, s.c, tmax);
             if (hit && best->improves(hit->t, ids_[slot])) {
               *best = Best{hit->t, ids_[slot], slot};
@@ -463,13 +380,14 @@ class MeshWalk {
         if (bundle_) {
           for (int s = beams_.subBegin(row, col), end = beams_.subEnd(row, col); s < end; ++s) {
             Best sub_best;
-            testRay(subRay(s, row, col), std::min(config_.tmax, beams_.subRange(s)), &sub_best);
+            testRay(rays_.subRay(s, row, col), std::min(config_.tmax, beams_.subRange(s)),
+                    &sub_best);
             if (sub_best.found()) offerSub(s, row, col, sub_best);
           }
           continue;
         }
         Best best;
-        testRay(beamRay(row, col), std::min(config_.tmax, range), &best);
+        testRay(rays_.beamRay(row, col), std::min(config_.tmax, range), &best);
         if (best.found()) offer(row, col, best);
       }
     }
@@ -482,7 +400,7 @@ class MeshWalk {
   void rasterLeaf(const Entry& e) {
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
       if (hidden(slot)) continue;
-      const SensorTriangle s = sensorTriangle(slot);
+      const SensorTriangle s = triangles_.sensorTriangle(slot);
       const std::uint32_t triangle = ids_[slot];
       std::optional<SubRayFilter> filter;
       if (bundle_ && sub_rays_from_origin_) filter.emplace(s.a, s.b, s.c);
@@ -495,7 +413,7 @@ class MeshWalk {
           for (int j = beams_.subBegin(row, col), end = beams_.subEnd(row, col); j < end; ++j) {
             if (filter && filter->misses(beams_.subDirection(j))) continue;
             const auto hit =
-                subRay(j, row, col)
+                rays_.subRay(j, row, col)
                     .intersect(s.a, s.b, s.c, std::min(config_.tmax, beams_.subRange(j)));
             if (!hit) continue;
             beams_.keepNearestSubHit(j, row, col, hit->t, active_.index, static_cast<int>(triangle),
@@ -503,7 +421,8 @@ class MeshWalk {
           }
           return;
         }
-        const auto hit = beamRay(row, col).intersect(s.a, s.b, s.c, std::min(config_.tmax, range));
+        const auto hit =
+            rays_.beamRay(row, col).intersect(s.a, s.b, s.c, std::min(config_.tmax, range));
         if (!hit) return;
         beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
                               [&] { return beamNormal(row, col, triangle); });
@@ -578,9 +497,7 @@ class MeshWalk {
   }
 
   BeamSet& beams_;
-  const Mesh& mesh_;
   const WideBvh& wide_;
-  const SlotVertices<double>& slots_;
   const std::vector<std::uint32_t>& ids_;
   const PlacedBody& active_;
   const CastConfig& config_;
@@ -593,16 +510,9 @@ class MeshWalk {
   // Every sub-ray leaves from the reference origin along its own direction (SubRayFilter).
   const bool sub_rays_from_origin_ =
       !motion_ || (motion_->spread().shift == 0 && motion_->translationsOnly());
-  SlotCache<SensorTriangle, 64> triangles_;
-  SlotCache<bool, 256> hidden_;
-  bool closed_;  // the mesh has closed components
   const ViewBasis basis_;
-  const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame
-  struct KeptOrigin {
-    const Eigen::Isometry3d* pose = nullptr;
-    std::optional<WideBoxRay::Origin> origin;
-  };
-  mutable std::array<KeptOrigin, 64> origins_;  // originOf()'s last ones
+  BodyTriangles triangles_;
+  const BeamRays<M> rays_;
   std::optional<Slicer> slicer_;
   WalkStack<Entry> stack_;
 };

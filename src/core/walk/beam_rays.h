@@ -1,0 +1,108 @@
+// The rays a mesh walk (mesh_walk.cpp) tests a beam with: for the triangle tests in the sensor
+// frame, for the box tests in the body's frame; from the sensor, or for a block of a rotating
+// sweep (beams/column_motion.h) from the beam's own pose.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <optional>
+
+#include "accel/wide_bvh.h"
+#include "beams/beam_set.h"
+#include "beams/column_motion.h"
+#include "beams/placed_body.h"
+#include "laser_raycast/core/aabb.h"
+#include "laser_raycast/core/cast_config.h"
+#include "laser_raycast/core/triangle.h"
+
+namespace laser_raycast {
+namespace core {
+
+template <TriangleMethod M>
+class BeamRays {
+ public:
+  // bounds: the body's tree's, in its frame.
+  BeamRays(const BeamSet& beams, const PlacedBody& active, const Aabb& bounds,
+           const CastConfig& config)
+      : beams_(beams),
+        active_(active),
+        bounds_(bounds),
+        config_(config),
+        motion_(active.motion),
+        shift_(motion_ ? motion_->spread().shift : 0.0),
+        // A sweep's block traces each column from its own origin, all within the shift.
+        origin_(active.sensor_in_body, bounds, config.tmin, shift_) {}
+
+  // The beam as a ray in the body's frame, for box tests: the same one for every box test of this
+  // walk.
+  WideBoxRay boxRay(int row, int col) const {
+    return boxRayAlong(row, col, beams_.grid().rebuiltDirection(row, col));
+  }
+  // The beam at (row, col) along sensor-frame direction d as a ray in the body's frame for box
+  // tests: from the sensor, or for a sweep's block turned with the beam's pose and from its own
+  // origin. (origin_ holds every column's origin, the box grown by the block's shift: a centimetre
+  // on every box makes a ray traced through small boxes enter many more of them.)
+  WideBoxRay boxRayAlong(int row, int col, const Eigen::Vector3d& d) const {
+    if (!motion_) return WideBoxRay(origin_, active_.body_from_sensor_rot * d);
+    const Eigen::Isometry3d& pose = motion_->refFromBeam(row, col);
+    const Eigen::Vector3d dir = active_.body_from_sensor_rot * (pose.linear() * d);
+    if (shift_ == 0) return WideBoxRay(origin_, dir);
+    return WideBoxRay(originOf(pose), dir);
+  }
+
+  // Sub-ray s of the bundle's beam at (row, col) for the triangle tests and the box tests, as a
+  // cast of its pattern tests it (a divergent beam's block has the sensor's pose at every column).
+  PreparedRay<double, M> subRay(int s, int row, int col) const {
+    return rayAlong(row, col, beams_.subDirection(s));
+  }
+  WideBoxRay subBoxRay(int s, int row, int col) const {
+    return boxRayAlong(row, col, beams_.subDirection(s));
+  }
+  // The beam at (row, col) along sensor-frame direction d for the triangle tests: from the
+  // sensor, or for a sweep's block from the beam's pose, in the reference sensor frame.
+  LASER_RAYCAST_HOT_INLINE PreparedRay<double, M> rayAlong(int row, int col,
+                                                           const Eigen::Vector3d& d) const {
+    Ray ray{Eigen::Vector3d::Zero(), d, config_.tmin};
+    if (motion_) ray = motion_->ray(row, col, d, config_.tmin);
+    return PreparedRay<double, M>(ray, config_.cull_backfaces);
+  }
+  // The grid's beam for the triangle tests (rayAlong its direction; from the sensor, the grid's
+  // prepared ray).
+  PreparedRay<double, M> beamRay(int row, int col) const {
+    if (!motion_) return beams_.grid().template sensorRay<M>(row, col);
+    return rayAlong(row, col, beams_.grid().rebuiltDirection(row, col));
+  }
+
+ private:
+  // Where the beams leaving from a sweep's pose start, for box tests in the body's frame: the same
+  // for every beam from that pose, so the last few are kept, by the pose's address (the block's
+  // poses stay where they are for the walk).
+  const WideBoxRay::Origin& originOf(const Eigen::Isometry3d& pose) const {
+    const auto key = reinterpret_cast<std::uintptr_t>(&pose);
+    KeptOrigin& kept = origins_[(key / sizeof(Eigen::Isometry3d)) % origins_.size()];
+    if (kept.pose != &pose) {
+      kept.pose = &pose;
+      const Eigen::Vector3d o =
+          active_.body_from_sensor_rot * pose.translation() + active_.sensor_in_body;
+      kept.origin.emplace(o, bounds_, config_.tmin);
+    }
+    return *kept.origin;
+  }
+
+  const BeamSet& beams_;
+  const PlacedBody& active_;
+  const Aabb& bounds_;
+  const CastConfig& config_;
+  const ColumnMotion* motion_;       // a sweep's block, or null
+  const double shift_;               // the block's
+  const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame
+  struct KeptOrigin {
+    const Eigen::Isometry3d* pose = nullptr;
+    std::optional<WideBoxRay::Origin> origin;
+  };
+  mutable std::array<KeptOrigin, 64> origins_;  // originOf()'s last ones
+};
+
+}  // namespace core
+}  // namespace laser_raycast
