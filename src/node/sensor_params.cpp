@@ -165,6 +165,14 @@ void readPoseSource(ParamReader* r, SensorParams* s) {
   }
 }
 
+// Makes head the sensor's beams: one turn of scanTime() now, and head_turn for a turn of another
+// length (a live rate change). Throws what the head's scan throws.
+template <class Head>
+void fireHead(const Head& head, SensorParams* s) {
+  s->head_turn = [head](double scan_time) { return head.scan(scan_time); };
+  s->calibrated = std::make_shared<const core::BeamList>(s->head_turn(s->scanTime()));
+}
+
 // ~calibration_file: a calibrated Velodyne head's beams instead of the fan.
 void readCalibration(ParamReader* r, SensorParams* s) {
   s->calibration_file = r->text("calibration_file", s->calibration_file);
@@ -178,9 +186,7 @@ void readCalibration(ParamReader* r, SensorParams* s) {
     return;
   }
   try {
-    const core::VelodyneHead head = loadVelodyneCalibration(s->calibration_file);
-    s->head_turn = [head](double scan_time) { return head.scan(scan_time); };
-    s->calibrated = std::make_shared<const core::BeamList>(s->head_turn(s->scanTime()));
+    fireHead(loadVelodyneCalibration(s->calibration_file), s);
   } catch (const std::invalid_argument& e) {
     r->fail("calibration_file", e.what());
   }
@@ -200,8 +206,7 @@ void readOusterMetadata(ParamReader* r, SensorParams* s, std::vector<std::string
   }
   try {
     const core::OusterHead head = loadOusterMetadata(s->ouster_metadata);
-    s->head_turn = [head](double scan_time) { return head.scan(scan_time); };
-    s->calibrated = std::make_shared<const core::BeamList>(s->head_turn(s->scanTime()));
+    fireHead(head, s);
     if (std::abs(head.fps * s->scanTime() - 1) > 1e-6) {
       warnings->push_back(r->prefix() + "ouster_metadata: the file's lidar mode turns at " +
                           formatNumber(head.fps) + " Hz, the sensor once in " +
@@ -241,27 +246,23 @@ void readPresetHead(ParamReader* r, SensorParams* s) {
     return;
   }
   if (model->head) {
-    s->head_turn = [model = *model](double scan_time) { return model.beams(scan_time); };
+    try {
+      fireHead(*model->head, s);
+    } catch (const std::invalid_argument& e) {
+      // A turn too slow for a list (a VLP-16's over 34.56 s: 10M beams).
+      r->fail("sensor_model", "'" + s->sensor_model + "' over one turn of " +
+                                  formatNumber(s->scanTime()) + " s: " + e.what());
+      return;
+    }
   } else {
     try {
-      const core::OusterHead head =
-          loadOusterMetadata(resolvePackageUri(model->head_file, rosPackagePath));
-      s->head_turn = [head](double scan_time) { return head.scan(scan_time); };
+      fireHead(loadOusterMetadata(resolvePackageUri(model->head_file, rosPackagePath)), s);
     } catch (const std::exception& e) {
       // The package's own file: missing or unreadable only in a broken installation.
       r->fail("sensor_model", "'" + s->sensor_model + "': its beams' file " + model->head_file +
                                   " (part of this package): " + e.what());
       return;
     }
-  }
-  try {
-    s->calibrated = std::make_shared<const core::BeamList>(s->head_turn(s->scanTime()));
-  } catch (const std::invalid_argument& e) {
-    // A turn too slow for a list (a VLP-16's over 34.56 s: 10M beams).
-    r->fail("sensor_model", "'" + s->sensor_model + "' over one turn of " +
-                                formatNumber(s->scanTime()) + " s: " + e.what());
-    s->head_turn = nullptr;
-    return;
   }
   s->preset_head = true;
 }

@@ -20,6 +20,7 @@
 
 #include "scan_access.h"
 #include "sensors_rig.h"
+#include "vlp16_manual.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -40,10 +41,10 @@ TEST(NodeSensors, APlanarSensorMatchesHandComputedRanges) {
 }
 
 // The VLP-16 preset: its lasers as the user manual fires them, 16 a firing sequence 2.304 us apart,
-// a sequence every 55.296 us, 1808 sequences in the 0.1 s turn; ring r at -15 + 2r deg is laser id
-// 2r below the horizon and 2(r - 8) + 1 above it. Cast at once (sweep instant), each point keeps
-// its firing time and lies at the head's azimuth then (pi at the stamp, turning clockwise). In the
-// closed room every beam returns, and every point must lie where its beam meets the room's faces.
+// a sequence every 55.296 us, 1808 sequences in the 0.1 s turn (vlp16Firing). Cast at once (sweep
+// instant), each point keeps its firing time and lies at the head's azimuth then (pi at the stamp,
+// turning clockwise). In the closed room every beam returns, and every point must lie where its
+// beam meets the room's faces.
 TEST(NodeSensors, AVlp16CloudMatchesTheGeometryAndTheFiringTimes) {
   const auto cloud = rig->waitFor<sensor_msgs::PointCloud2>(
       &rig->clouds, [](const sensor_msgs::PointCloud2&) { return true; }, 30.0);
@@ -72,15 +73,13 @@ TEST(NodeSensors, AVlp16CloudMatchesTheGeometryAndTheFiringTimes) {
     const double elevation = std::asin(dir.z()) * 180 / M_PI;
     ASSERT_LT(*ring, 16);
     ++per_ring[*ring];
-    const int id = *ring < 8 ? 2 * *ring : 2 * (*ring - 8) + 1;
-    const int sequence = static_cast<int>(std::lround((*time - id * 2.304e-6) / 55.296e-6));
-    fired.insert({sequence, id});
-    const double t = sequence * 55.296e-6 + id * 2.304e-6;
-    const double head = M_PI - 2 * M_PI * t / 0.1;
-    const double azimuth_off = std::remainder(std::atan2(dir.y(), dir.x()) - head, 2 * M_PI);
+    const Vlp16Firing firing = vlp16Firing(*ring, *time, 0.1);
+    fired.insert({static_cast<int>(firing.sequence), firing.id});
+    const double azimuth_off =
+        std::remainder(std::atan2(dir.y(), dir.x()) - firing.azimuth, 2 * M_PI);
     const bool ok = std::abs(r - expected) < kTolerance &&
-                    std::abs(elevation - (-15.0 + 2.0 * *ring)) < 1e-3 && sequence >= 0 &&
-                    sequence < sequences && std::abs(*time - t) < 1e-8 &&
+                    std::abs(elevation - (-15.0 + 2.0 * *ring)) < 1e-3 && firing.sequence >= 0 &&
+                    firing.sequence < sequences && std::abs(*time - firing.time) < 1e-8 &&
                     std::abs(azimuth_off) < 2e-6;
     if (!ok && ++bad <= 5) {
       ADD_FAILURE() << "point " << p.transpose() << " (ring " << *ring << ", elevation "
@@ -480,13 +479,10 @@ TEST(NodeSensors, ALiveRateTurnsTheVlp16sHeadAtTheNewRate) {
     int bad = 0;
     double last = 0;
     for (; x != x.end(); ++x, ++y, ++time, ++ring) {
-      const int id = *ring < 8 ? 2 * *ring : 2 * (*ring - 8) + 1;
-      const long sequence = std::lround((*time - id * 2.304e-6) / 55.296e-6);
-      const double t = sequence * 55.296e-6 + id * 2.304e-6;
-      const double head = M_PI - 2 * M_PI * t / turn;
-      const double off = std::remainder(std::atan2(*y, *x) - head, 2 * M_PI);
+      const Vlp16Firing firing = vlp16Firing(*ring, *time, turn);
+      const double off = std::remainder(std::atan2(*y, *x) - firing.azimuth, 2 * M_PI);
       last = std::max(last, static_cast<double>(*time));
-      if (!(std::abs(off) < 2e-6 && std::abs(*time - t) < 1e-8) && ++bad <= 5) {
+      if (!(std::abs(off) < 2e-6 && std::abs(*time - firing.time) < 1e-8) && ++bad <= 5) {
         ADD_FAILURE() << "at " << rate << " Hz: a point of time " << *time << " lies " << off
                       << " rad from the head's azimuth";
       }

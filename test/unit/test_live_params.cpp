@@ -10,6 +10,7 @@
 #include "expect_invalid.h"
 #include "live_params.h"
 #include "node_params_inputs.h"
+#include "vlp16_manual.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -115,11 +116,11 @@ TEST(LiveParams, AHeadWhoseTurnFollowsTheRateFiresAgainAtTheNewRate) {
   // Laser id 0 of sequence 903 (ring 0, -15 deg): at 903 * 55.296 us, the head at pi less the
   // share of a 0.05 s turn.
   const int b = 903 * 16;
-  const double t = 903 * 55.296e-6;
+  const double t = vlp16FiringTime(903, 0);
   EXPECT_NEAR(p.calibrated->time(b), t, 1e-15);
   const Eigen::Vector3d& d = p.calibrated->directions[b];
-  EXPECT_NEAR(std::remainder(std::atan2(d.y(), d.x()) - (M_PI - 2 * M_PI * t / 0.05), 2 * M_PI),
-              0.0, 1e-12);
+  EXPECT_NEAR(std::remainder(std::atan2(d.y(), d.x()) - vlp16HeadAzimuth(t, 0.05), 2 * M_PI), 0.0,
+              1e-12);
   EXPECT_NEAR(p.sweepDuration(), p.calibrated->times.back(), 0.0);
 
   // scan_time set: the turn does not follow the rate.

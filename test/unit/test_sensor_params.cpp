@@ -14,6 +14,7 @@
 
 #include "laser_raycast/node/node_params.h"
 #include "node_params_inputs.h"
+#include "vlp16_manual.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -132,11 +133,11 @@ TEST(SensorParams, TheLidarPresetsFireTheirLasersAsTheirMakersSay) {
     for (int i = 0; i < 16; ++i) {
       const int b = q * 16 + i;
       const Eigen::Vector3d& d = s.calibrated->directions[b];
-      const double t = q * 55.296e-6 + i * 2.304e-6;
+      const double t = vlp16FiringTime(q, i);
       EXPECT_NEAR(std::asin(d.z()), table[i] * M_PI / 180, 1e-12) << b;
       EXPECT_EQ(s.calibrated->line(b), (table[i] + 15) / 2) << b;
       EXPECT_NEAR(s.calibrated->time(b), t, 1e-15) << b;
-      EXPECT_NEAR(std::remainder(std::atan2(d.y(), d.x()) - (M_PI - 2 * M_PI * t / 0.1), 2 * M_PI),
+      EXPECT_NEAR(std::remainder(std::atan2(d.y(), d.x()) - vlp16HeadAzimuth(t, 0.1), 2 * M_PI),
                   0.0, 1e-12)
           << b;
       EXPECT_EQ(s.calibrated->origin(b), Eigen::Vector3d::Zero()) << b;

@@ -48,7 +48,7 @@ class ColumnMotion {
   struct Reach {
     double shift2 = 0, frobenius2 = 0, z_move2 = 0, deviation2 = 0;
     bool translations_only = true, in_plane = true;
-    // A column's pose (class 0's).
+    // A pose, from its matrix.
     void add(const Eigen::Isometry3d& m) {
       const Eigen::Matrix3d& r = m.linear();
       shift2 = std::max(shift2, m.translation().squaredNorm());

@@ -189,8 +189,7 @@ class BlockPlanner {
   // own, and a block that is halved is dropped before its halves write theirs).
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
     auto origin = [&](int c) { return beams_.origins ? &(*beams_.origins)[c] : nullptr; };
-    ColumnPoses::Relative relative(poses_, column(0, ref),
-                                   beams_.origins ? *origin(ref) : Eigen::Vector3d::Zero());
+    ColumnPoses::Relative relative(poses_, column(0, ref), origin(ref));
     std::vector<Eigen::Isometry3d>& out = *sweep_poses_;
     ColumnMotion::Reach reach;
     for (int c = lo; c <= hi; ++c) relative.at(column(0, c), origin(c), &out[column(0, c)], &reach);

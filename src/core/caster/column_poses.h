@@ -80,16 +80,15 @@ class ColumnPoses {
   // and a column costs its slerp's weights and one rotation matrix.
   class Relative {
    public:
-    Relative(const ColumnPoses& poses, int ref, const Eigen::Vector3d& ref_origin) : poses_(poses) {
+    // ref_origin: null for none (as at()'s origin).
+    Relative(const ColumnPoses& poses, int ref, const Eigen::Vector3d* ref_origin) : poses_(poses) {
       const Bracket& b = poses.brackets_[ref];
       world_from_ref_ = poses.sensor(ref);
       q_ref_conj_ = b.j == b.i ? Eigen::Quaterniond(world_from_ref_.linear()).conjugate()
                                : poses.sample_rotation_.slerp(b).conjugate();
-      world_from_ref_.translation() += world_from_ref_.linear() * ref_origin;
+      if (ref_origin) world_from_ref_.translation() += world_from_ref_.linear() * *ref_origin;
       ref_rot_t_ = world_from_ref_.linear().transpose();
     }
-    // The reference column's sensor pose moved to ref_origin.
-    const Eigen::Isometry3d& worldFromRef() const { return world_from_ref_; }
     // The column's sensor pose moved to origin (its sensor frame; null: none), relative to the
     // reference, added to *reach; returns its translation (as out has it, without reading back
     // what was just stored).
