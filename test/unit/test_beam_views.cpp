@@ -580,10 +580,10 @@ TEST(ColumnMotion, AQuaternionsReachCoversItsRotationMatrix) {
     EXPECT_LE(from_q.frobenius2, from_m.frobenius2 * (1 + 1e-8) + 1e-20) << "angle " << angle;
     EXPECT_EQ(from_q.shift2, from_m.shift2);
     EXPECT_NEAR(from_q.z_move2, from_m.z_move2, 1e-15 * from_m.z_move2);
-    if (from_q.translations_only) EXPECT_TRUE(from_m.translations_only);
-    if (from_q.in_plane) EXPECT_TRUE(from_m.in_plane);
-    if (angle == 0) EXPECT_TRUE(from_q.translations_only);
-    if (axis == Eigen::Vector3d::UnitZ() && t.z() == 0) EXPECT_TRUE(from_q.in_plane);
+    EXPECT_TRUE(!from_q.translations_only || from_m.translations_only);
+    EXPECT_TRUE(!from_q.in_plane || from_m.in_plane);
+    EXPECT_TRUE(angle != 0 || from_q.translations_only);
+    EXPECT_TRUE(!(axis == Eigen::Vector3d::UnitZ() && t.z() == 0) || from_q.in_plane);
   }
 }
 

@@ -17,7 +17,7 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
                            std::vector<std::vector<Eigen::Isometry3d>> ref_from_class)
     : col_lo_(col_lo),
       columns_(static_cast<int>(ref_from_column.size())),
-      own_(std::move(ref_from_column)),
+      own_(ref_from_column.begin(), ref_from_column.end()),
       stride_(columns_),
       classes_(1 + static_cast<int>(ref_from_class.size())),
       class_of_row_(std::move(class_of_row)) {
@@ -28,7 +28,7 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
   measure(reachOf(), steepest, extra_turn);
 }
 
-ColumnMotion::ColumnMotion(int col_lo, int columns, const Eigen::Isometry3d* poses, int stride,
+ColumnMotion::ColumnMotion(int col_lo, int columns, const Pose* poses, int stride,
                            int classes, const Reach& reach, double steepest, double extra_turn,
                            std::vector<int> class_of_row)
     : col_lo_(col_lo),
@@ -45,7 +45,7 @@ ColumnMotion::Reach ColumnMotion::reachOf() const {
   for (int c = 0; c < columns_; ++c) reach.add(poses_[c]);
   for (int k = 1; k < classes_; ++k) {
     for (int c = 0; c < columns_; ++c) {
-      const Eigen::Isometry3d& m = poses_[k * stride_ + c];
+      const Pose& m = poses_[k * stride_ + c];
       reach.add(m);
       reach.addDeviation(m.translation(), poses_[c].translation());
     }

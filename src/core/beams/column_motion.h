@@ -29,6 +29,10 @@ inline double steepestElevation(const ScanPattern& pattern) {
 
 class ColumnMotion {
  public:
+  // A column's (or a row class's) pose relative to the reference: rotation and translation in 12
+  // doubles (an Isometry3d's 16 hold a constant last row): a calibrated Velodyne's sweep has
+  // 28,928 of them, written once and read by the walks, and their memory traffic is their cost.
+  using Pose = Eigen::Transform<double, 3, Eigen::AffineCompact>;
   // A block of columns [col_lo, col_lo + ref_from_column.size()); steepest: the largest angle of a
   // pattern direction from the horizontal (rad). extra_turn (rad): how far more the beams' rays may
   // turn from their pattern directions (a bundle's sub-rays, Caster::castBundle), added to the
@@ -49,7 +53,7 @@ class ColumnMotion {
     double shift2 = 0, frobenius2 = 0, z_move2 = 0, deviation2 = 0;
     bool translations_only = true, in_plane = true;
     // A pose, from its matrix.
-    void add(const Eigen::Isometry3d& m) {
+    void add(const Pose& m) {
       const Eigen::Matrix3d& r = m.linear();
       shift2 = std::max(shift2, m.translation().squaredNorm());
       frobenius2 = std::max(frobenius2, (r - Eigen::Matrix3d::Identity()).squaredNorm());
@@ -82,7 +86,7 @@ class ColumnMotion {
   // block: CasterState::sweep_poses): class k's pose at column c is poses[k * stride + c - col_lo],
   // for `columns` columns and `classes` classes (class_of_row empty if one); reach: every one of
   // them added.
-  ColumnMotion(int col_lo, int columns, const Eigen::Isometry3d* poses, int stride, int classes,
+  ColumnMotion(int col_lo, int columns, const Pose* poses, int stride, int classes,
                const Reach& reach, double steepest, double extra_turn,
                std::vector<int> class_of_row);
   // Its poses may be its own: not copied (a move keeps them where they are).
@@ -92,7 +96,7 @@ class ColumnMotion {
 
   int colLo() const { return col_lo_; }
   int colHi() const { return col_lo_ + columns_ - 1; }
-  const Eigen::Isometry3d& refFromColumn(int col) const { return poses_[col - col_lo_]; }
+  const Pose& refFromColumn(int col) const { return poses_[col - col_lo_]; }
   const Spread& spread() const { return spread_; }
   // True if every column's pose differs from the reference by a turn about the sensor's z axis and
   // a move in its xy plane, exactly (as a level sensor driving on a floor gives): every column scans
@@ -103,7 +107,7 @@ class ColumnMotion {
   bool translationsOnly() const { return translations_only_; }
 
   // The pose the beam at (row, col) leaves from: its column's, or its row's class's.
-  LASER_RAYCAST_HOT_INLINE const Eigen::Isometry3d& refFromBeam(int row, int col) const {
+  LASER_RAYCAST_HOT_INLINE const Pose& refFromBeam(int row, int col) const {
     if (class_of_row_.empty()) return refFromColumn(col);
     return poses_[class_of_row_[row] * stride_ + (col - col_lo_)];
   }
@@ -139,7 +143,7 @@ class ColumnMotion {
   const float* originZ(int base) const { return origin_[2].data() + (base - padded_lo_); }
   // For inPlane(): a point of the scan plane, the reference sensor's x, y, in column col's.
   Eigen::Vector2d pointToColumn(int col, const Eigen::Vector2d& p) const {
-    const Eigen::Isometry3d& m = refFromColumn(col);
+    const Pose& m = refFromColumn(col);
     return m.linear().topLeftCorner<2, 2>().transpose() * (p - m.translation().head<2>());
   }
 
@@ -150,12 +154,12 @@ class ColumnMotion {
 
   int col_lo_;
   int columns_;
-  std::vector<Eigen::Isometry3d> own_;  // the poses, where they are this motion's own
-  const Eigen::Isometry3d* poses_;      // class k's column c at poses_[k * stride_ + c - col_lo_]
+  std::vector<Pose> own_;  // the poses, where they are this motion's own
+  const Pose* poses_;      // class k's column c at poses_[k * stride_ + c - col_lo_]
   int stride_;
   int classes_;
   Spread spread_;
-  LASER_RAYCAST_HOT_INLINE Ray rayFrom(const Eigen::Isometry3d& m, const Eigen::Vector3d& d,
+  LASER_RAYCAST_HOT_INLINE Ray rayFrom(const Pose& m, const Eigen::Vector3d& d,
                                        double tmin) const {
     Ray r;
     r.origin = m.translation();

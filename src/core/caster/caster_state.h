@@ -131,7 +131,7 @@ struct CasterState {
   // A sweep's sensor poses at its columns (ColumnPoses' columns), each relative to its block's
   // reference, kept from sweep to sweep (a calibrated Velodyne's turn has 28,928): the blocks'
   // ColumnMotion of the frames that stay put are views of them.
-  std::vector<Eigen::Isometry3d> sweep_poses;
+  std::vector<ColumnMotion::Pose> sweep_poses;
   ColumnPoses::Storage sweep_columns;  // the ColumnPoses' of a sweep
   ScanResult grid_culling, grid_own;  // castBeamGrids' results for one part, by its grid beams
 

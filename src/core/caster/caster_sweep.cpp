@@ -67,7 +67,7 @@ class BlockPlanner {
   // sweep_poses: storage for the sensor's poses at poses' columns, as many.
   BlockPlanner(const Scene& scene, const ColumnPoses& poses, int base, const ScanPattern& pattern,
                const CastConfig& config, const SweepBeams& beams,
-               std::vector<Eigen::Isometry3d>* sweep_poses)
+               std::vector<ColumnMotion::Pose>* sweep_poses)
       : scene_(scene),
         poses_(poses),
         sweep_poses_(sweep_poses),
@@ -190,7 +190,7 @@ class BlockPlanner {
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
     auto origin = [&](int c) { return beams_.origins ? &(*beams_.origins)[c] : nullptr; };
     ColumnPoses::Relative relative(poses_, column(0, ref), origin(ref));
-    std::vector<Eigen::Isometry3d>& out = *sweep_poses_;
+    std::vector<ColumnMotion::Pose>& out = *sweep_poses_;
     ColumnMotion::Reach reach;
     for (int c = lo; c <= hi; ++c) relative.at(column(0, c), origin(c), &out[column(0, c)], &reach);
     // Class by class, each one's poses written in a row.
@@ -258,7 +258,7 @@ class BlockPlanner {
 
   const Scene& scene_;
   const ColumnPoses& poses_;
-  std::vector<Eigen::Isometry3d>* sweep_poses_;
+  std::vector<ColumnMotion::Pose>* sweep_poses_;
   int base_;
   const ScanPattern& pattern_;
   const CastConfig& config_;

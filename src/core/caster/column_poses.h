@@ -92,8 +92,11 @@ class ColumnPoses {
     // The column's sensor pose moved to origin (its sensor frame; null: none), relative to the
     // reference, added to *reach; returns its translation (as out has it, without reading back
     // what was just stored).
-    Eigen::Vector3d at(int col, const Eigen::Vector3d* origin, Eigen::Isometry3d* out,
-                       ColumnMotion::Reach* reach) {
+    // (Inlined into the loops over a block's columns, which call it once a beam of a calibrated
+    // Velodyne.)
+    LASER_RAYCAST_HOT_INLINE Eigen::Vector3d at(int col, const Eigen::Vector3d* origin,
+                                                ColumnMotion::Pose* out,
+                                                ColumnMotion::Reach* reach) {
       const Bracket& b = poses_.brackets_[col];
       const std::vector<Eigen::Isometry3d>& pose = poses_.samples_.world_from_sensor;
       if (b.j == b.i) {
@@ -122,7 +125,6 @@ class ColumnPoses {
       if (origin) t += r * *origin;
       out->linear() = r;
       out->translation() = t;
-      out->makeAffine();
       reach->add(q, r, t);
       return t;
     }
@@ -164,8 +166,9 @@ class ColumnPoses {
 
  private:
   // The samples' rotations as quaternions, and the slerp between two of them as Eigen's
-  // QuaternionBase::slerp computes it, with the angle between each sample and the next and its
-  // sine worked out once rather than at every column, and the sines of its fractions by smallSin.
+  // QuaternionBase::slerp computes it, with the angle between each sample and the next and the
+  // reciprocal of its sine worked out once rather than at every column (a product an ulp from
+  // Eigen's quotient), and the sines of its fractions by smallSin.
   // Only the samples some column is interpolated between (arc_used[k]: between k and k + 1) are
   // converted: with a sample at every column's time (cast_scan's sweeps), none is.
   class Rotations {
@@ -194,8 +197,8 @@ class ColumnPoses {
         *scale0 = 1 - t;
         *scale1 = t;
       } else {
-        *scale0 = smallSin((1 - t) * arc.theta) / arc.sin_theta;
-        *scale1 = smallSin(t * arc.theta) / arc.sin_theta;
+        *scale0 = smallSin((1 - t) * arc.theta) * arc.inv_sin_theta;
+        *scale1 = smallSin(t * arc.theta) * arc.inv_sin_theta;
       }
       if (arc.flip) *scale1 = -*scale1;
     }
@@ -214,7 +217,7 @@ class ColumnPoses {
     }
     struct Arc {
       bool linear = true, flip = false;
-      double theta = 0, sin_theta = 0;
+      double theta = 0, inv_sin_theta = 0;  // 1 / sin(theta): a product a column, not a quotient
     };
     static Arc arcBetween(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
       const double d = a.dot(b), abs_d = std::abs(d);
@@ -223,7 +226,7 @@ class ColumnPoses {
       arc.linear = abs_d >= 1 - std::numeric_limits<double>::epsilon();
       if (!arc.linear) {
         arc.theta = std::acos(abs_d);
-        arc.sin_theta = std::sin(arc.theta);
+        arc.inv_sin_theta = 1 / std::sin(arc.theta);
       }
       return arc;
     }

@@ -45,7 +45,7 @@ class BeamRays {
   // on every box makes a ray traced through small boxes enter many more of them.)
   WideBoxRay boxRayAlong(int row, int col, const Eigen::Vector3d& d) const {
     if (!motion_) return WideBoxRay(origin_, active_.body_from_sensor_rot * d);
-    const Eigen::Isometry3d& pose = motion_->refFromBeam(row, col);
+    const ColumnMotion::Pose& pose = motion_->refFromBeam(row, col);
     const Eigen::Vector3d dir = active_.body_from_sensor_rot * (pose.linear() * d);
     if (shift_ == 0) return WideBoxRay(origin_, dir);
     return WideBoxRay(originOf(pose), dir);
@@ -78,9 +78,9 @@ class BeamRays {
   // Where the beams leaving from a sweep's pose start, for box tests in the body's frame: the same
   // for every beam from that pose, so the last few are kept, by the pose's address (the block's
   // poses stay where they are for the walk).
-  const WideBoxRay::Origin& originOf(const Eigen::Isometry3d& pose) const {
+  const WideBoxRay::Origin& originOf(const ColumnMotion::Pose& pose) const {
     const auto key = reinterpret_cast<std::uintptr_t>(&pose);
-    KeptOrigin& kept = origins_[(key / sizeof(Eigen::Isometry3d)) % origins_.size()];
+    KeptOrigin& kept = origins_[(key / sizeof(ColumnMotion::Pose)) % origins_.size()];
     if (kept.pose != &pose) {
       kept.pose = &pose;
       const Eigen::Vector3d o =
@@ -98,7 +98,7 @@ class BeamRays {
   const double shift_;               // the block's
   const WideBoxRay::Origin origin_;  // where the traced rays start, in the body's frame
   struct KeptOrigin {
-    const Eigen::Isometry3d* pose = nullptr;
+    const ColumnMotion::Pose* pose = nullptr;
     std::optional<WideBoxRay::Origin> origin;
   };
   mutable std::array<KeptOrigin, 64> origins_;  // originOf()'s last ones

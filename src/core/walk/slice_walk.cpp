@@ -320,7 +320,7 @@ class SliceWalk {
   const PlaneRay& columnRay(int col, double dx, double dy) {
     KeptRay& kept = column_rays_[static_cast<unsigned>(col) % column_rays_.size()];
     if (kept.col != col) {
-      const Eigen::Isometry3d& m = motion_->refFromColumn(col);
+      const ColumnMotion::Pose& m = motion_->refFromColumn(col);
       const Eigen::Vector2d at =
           inverse_ * (m.translation().head<2>() - Eigen::Vector2d(plane_.tx, plane_.ty));
       const Eigen::Vector2d along = m.linear().topLeftCorner<2, 2>() * Eigen::Vector2d(dx, dy);
