@@ -142,7 +142,7 @@ void Sensor::castAndPublish(const core::Scene& scene, const std::vector<double>&
     // A sweep's surfaces are sampled from its first pose (sampleSurfaces); beams off the grid
     // from their own origins and directions.
     if (cast_params_.offGrid()) {
-      core::sampleSurfaces(scene, frames.front(), poses.front(), beams_, *result,
+      core::sampleSurfaces(scene, frames.front(), poses.front(), castList(), *result,
                            output.reflectance_from_color, reflectivity_fixed, &surface_);
     } else {
       core::sampleSurfaces(scene, frames.front(), poses.front(), pattern_, *result,
@@ -177,12 +177,17 @@ const core::ScanResult* Sensor::castPattern(const core::Scene& scene,
     const core::PatternFile& file = *cast_params_.pattern;
     beams_ = file.scan(next_row_, cast_params_.points_per_scan, cast_params_.point_rate);
     next_row_ = (next_row_ + cast_params_.points_per_scan) % file.size();
-  } else if (beams_of_ != cast_params_.calibrated) {
-    beams_ = *cast_params_.calibrated;  // the same every scan, until a live rate change
-    beams_of_ = cast_params_.calibrated;
+    calibrated_.reset();
+  } else {
+    // The same list every scan, until a live rate change makes another: shared with the caster,
+    // which knows it again without comparing its beams.
+    calibrated_ = cast_params_.calibrated;
   }
   // An instant scan casts every point from the stamp's poses; the points keep their times.
   if (cast_params_.sweep != Sweep::kRotating) {
+    if (calibrated_) {
+      return &caster_.castBeams(scene, frames.front(), poses.front(), calibrated_, cast_config_);
+    }
     return &caster_.castBeams(scene, frames.front(), poses.front(), beams_, cast_config_);
   }
   // Each point from the poses at its own time (s after the stamp).
@@ -190,6 +195,7 @@ const core::ScanResult* Sensor::castPattern(const core::Scene& scene,
   for (const ros::Time& t : times) samples.times.push_back((t - times.front()).toSec());
   samples.world_from_sensor = poses;
   samples.frames = frames;
+  if (calibrated_) return &caster_.castBeamsSweep(scene, samples, calibrated_, cast_config_);
   return &caster_.castBeamsSweep(scene, samples, beams_, cast_config_);
 }
 
@@ -218,7 +224,7 @@ void Sensor::publishCloud(const ros::Time& stamp) {
   options.layout = cast_params_.point_layout;
   sensor_msgs::PointCloud2 cloud;
   if (cast_params_.offGrid()) {
-    buildBeamCloud(beams_, measured_, header, options, &cloud);
+    buildBeamCloud(castList(), measured_, header, options, &cloud);
   } else {
     buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud,
                     dual() ? &measured_last_ : nullptr);

@@ -111,10 +111,11 @@ class Sensor {
   core::SurfaceSamples surface_;  // the surfaces' reflectance and incidence, when intensity is on
   std::vector<double> column_times_;  // s after the stamp, per azimuth column (rotating)
   // The beams off any grid this scan casts: a pattern file's, and the row the next scan starts at
-  // (the file a loop); or a copy of the head's turn beams_of_ (a live rate change gives another).
+  // (the file a loop); or the head's turn, calibrated_ (a live rate change gives another).
   core::BeamList beams_;
   std::int64_t next_row_ = 0;
-  std::shared_ptr<const core::BeamList> beams_of_;
+  std::shared_ptr<const core::BeamList> calibrated_;
+  const core::BeamList& castList() const { return calibrated_ ? *calibrated_ : beams_; }
 
   std::unique_ptr<ScanOutput> output_;
   std::unique_ptr<PoseTopic> pose_topic_;

@@ -263,8 +263,10 @@ class Caster {
         const core::FramePoses& at = frames[frames.size() == 1 ? 0 : k];
         if (pattern.offGrid()) {
           const core::BeamList& list = pattern.beamsOf(k, &scratch);
+          // A calibrated head's turn, the same at every pose, shared with the caster.
           const core::ScanResult& result =
-              caster_.castBeams(scene.scene(), at, sensors[k], list, config);
+              pattern.turn ? caster_.castBeams(scene.scene(), at, sensors[k], pattern.turn, config)
+                           : caster_.castBeams(scene.scene(), at, sensors[k], list, config);
           writeScan(scene.scene(), result, spec.output, list.directions, &list.origins,
                     reflectivity, model ? &*model : nullptr, rows.at(k * beams));
         } else {

@@ -93,6 +93,8 @@ Pass pipelinePass(const BenchScene& scene, int threads, bool keep_slices) {
     config.threads = threads;
     config.keep_slices = keep_slices;
     const std::size_t beams = static_cast<std::size_t>(w.beamCount());
+    // The workload's beams shared with the caster, as the node shares a calibrated head's.
+    const auto list = std::make_shared<const core::BeamList>(w.beams);
     for (std::size_t p = 0; p < w.scans(); ++p) {
       caster->forget();
       if (!w.sub_patterns.empty()) {
@@ -108,9 +110,9 @@ Pass pipelinePass(const BenchScene& scene, int threads, bool keep_slices) {
       }
       const core::ScanResult& result =
           w.offGrid() && !w.sweeps.empty()
-              ? caster->castBeamsSweep(scene.scene, w.sweeps[p], w.beams, config)
+              ? caster->castBeamsSweep(scene.scene, w.sweeps[p], list, config)
           : w.offGrid()
-              ? caster->castBeams(scene.scene, scene.frame_poses, w.sensors[p], w.beams, config)
+              ? caster->castBeams(scene.scene, scene.frame_poses, w.sensors[p], list, config)
           : w.sweeps.empty()
               ? caster->cast(scene.scene, scene.frame_poses, w.sensors[p], *w.pattern, config)
               : caster->castSweep(scene.scene, w.sweeps[p], *w.pattern, config, w.time_increment);

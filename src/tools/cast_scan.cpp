@@ -131,6 +131,10 @@ struct Casting {
   double time_increment;       // s between two azimuth columns: > 0 for a rotating sweep
   core::PulseReturns returns;  // with --beam-samples > 1
   core::BeamList beams;        // --pattern-file: this scan's beams
+  // --calibration's or --ouster-metadata's beams, the same every scan (shared with the caster,
+  // which knows them again without comparing them).
+  std::shared_ptr<const core::BeamList> calibrated;
+  const core::BeamList& list() const { return calibrated ? *calibrated : beams; }
   // The radiometry: by label, each one's reflectivity and whether --reflectivity set it; the scan
   // measured (the second return's too, in dual mode).
   std::vector<double> reflectivity;
@@ -182,7 +186,7 @@ void measure(const Args& args, const LoadedScene& loaded, const Eigen::Isometry3
     return;
   }
   if (args.offGrid()) {
-    core::sampleSurfaces(loaded.scene, loaded.poses, sensor, casting->beams, result,
+    core::sampleSurfaces(loaded.scene, loaded.poses, sensor, casting->list(), result,
                          output.reflectance_from_color, casting->reflectivity_fixed,
                          &casting->surface);
   } else {
@@ -205,7 +209,9 @@ std::string rangeAndLink(const Args& args, const LoadedScene& loaded, const core
 // A pattern file's beams of the path's scan number `pose` into casting->beams: its rows from
 // pose * points_per_scan on.
 void patternScan(const Args& args, std::size_t pose, Casting* casting) {
-  if (args.calibrated) casting->beams = *args.calibrated;
+  if (args.calibrated && !args.pattern_file && !casting->calibrated) {
+    casting->calibrated = std::make_shared<const core::BeamList>(*args.calibrated);
+  }
   if (!args.pattern_file) return;
   casting->beams = args.pattern_file->scan(static_cast<std::int64_t>(pose) * args.points_per_scan,
                                            args.points_per_scan, args.point_rate);
@@ -222,7 +228,7 @@ const core::ScanResult& castFrom(const Args& args, const LoadedScene& loaded,
   core::PoseSamples samples;
   if (rotating && args.offGrid()) {
     samples =
-        laser_raycast::tools::sweepSamplesAt(args.path, sensor, loaded.poses, casting->beams.times);
+        laser_raycast::tools::sweepSamplesAt(args.path, sensor, loaded.poses, casting->list().times);
   } else if (rotating) {
     samples = laser_raycast::tools::sweepSamples(args.path, sensor, loaded.poses, casting->pattern);
   }
@@ -240,9 +246,15 @@ const core::ScanResult& castFrom(const Args& args, const LoadedScene& loaded,
   }
   const core::ScanResult* result;
   if (args.offGrid()) {
-    result = rotating
-                 ? &caster.castBeamsSweep(loaded.scene, samples, casting->beams, config)
-                 : &caster.castBeams(loaded.scene, loaded.poses, sensor, casting->beams, config);
+    if (casting->calibrated) {
+      result = rotating ? &caster.castBeamsSweep(loaded.scene, samples, casting->calibrated, config)
+                        : &caster.castBeams(loaded.scene, loaded.poses, sensor,
+                                            casting->calibrated, config);
+    } else {
+      result = rotating
+                   ? &caster.castBeamsSweep(loaded.scene, samples, casting->beams, config)
+                   : &caster.castBeams(loaded.scene, loaded.poses, sensor, casting->beams, config);
+    }
   } else {
     result = rotating ? &caster.castSweep(loaded.scene, samples, casting->pattern, config,
                                           casting->time_increment)
@@ -316,7 +328,7 @@ std::string csvRows(const Args& args, const LoadedScene& loaded, const Casting& 
                     const core::ScanResult& result, std::size_t pose) {
   std::string out;
   if (args.offGrid()) {
-    const core::BeamList& beams = casting.beams;
+    const core::BeamList& beams = casting.list();
     for (int i = 0; i < beams.size(); ++i) {
       const Eigen::Vector3d& d = beams.directions[i];
       if (args.path.pose_column) out += std::to_string(pose) + ",";

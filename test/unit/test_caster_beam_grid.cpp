@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
+#include <stdexcept>
 #include <vector>
 
 #include "beams/beam_cells.h"
@@ -291,6 +293,78 @@ TEST(CastBeamGrid, RotatingSweepsGiveTheRayByRaySweep) {
       EXPECT_GT(nan, beams.size() / 20);
     }
   }
+}
+
+// Whether two results hold the same ranges (NaN where either is), bodies and triangles, bit for bit.
+bool sameBits(const core::ScanResult& a, const core::ScanResult& b) {
+  if (a.range.size() != b.range.size()) return false;
+  for (std::size_t i = 0; i < a.range.size(); ++i) {
+    const bool same_range =
+        a.range[i] == b.range[i] || (std::isnan(a.range[i]) && std::isnan(b.range[i]));
+    if (!same_range || a.body[i] != b.body[i] || a.triangle[i] != b.triangle[i]) return false;
+  }
+  return true;
+}
+
+// A list the caller shares is known again by its pointer; any other list is still compared with
+// the one fitted last, its firing times too: a sweep of the same beams fired twice as fast (a
+// 20 Hz turn's times), passed by value after the shared list, is swept at its own times, and the
+// shared list after it at the shared times again. Each sweep as a fresh caster's, also where the
+// sensor has no pose after a sweep that had one. A null list is refused.
+TEST(CastBeamGrid, ASharedListIsKnownByItsPointerAndOthersAreCompared) {
+  Rng rng(31);
+  const RandomScene s = randomScene(rng);
+  core::PoseSamples samples;
+  for (int k = 0; k <= 5; ++k) {
+    const double t = 0.02 * k;
+    samples.times.push_back(t);
+    samples.world_from_sensor.push_back(pose(Eigen::Vector3d(4 * t, 0.2, 0.3), yaw(3 * t)));
+    samples.frames.push_back(s.poses);
+  }
+  core::CastConfig c = config(true, 25.0);
+  const auto shared = std::make_shared<const core::BeamList>(core::nominalVlp16().scan(0.1));
+  core::BeamList faster = *shared;
+  for (double& t : faster.times) t *= 0.5;
+  auto fresh = [&](const core::BeamList& beams) {
+    core::Caster caster;
+    return caster.castBeamsSweep(s.scene, samples, beams, c);
+  };
+  const core::ScanResult at_shared_times = fresh(*shared), at_faster_times = fresh(faster);
+  int hits = 0;
+  for (int b : at_shared_times.body) hits += b >= 0;
+  EXPECT_GT(hits, shared->size() / 10);
+  // The times matter: the sensor turns 3 rad/s, so some beam meets something else or elsewhere.
+  EXPECT_FALSE(sameBits(at_shared_times, at_faster_times));
+
+  core::Caster caster;
+  EXPECT_TRUE(sameBits(caster.castBeamsSweep(s.scene, samples, shared, c), at_shared_times));
+  EXPECT_TRUE(sameBits(caster.castBeamsSweep(s.scene, samples, shared, c), at_shared_times));
+  EXPECT_TRUE(sameBits(caster.castBeamsSweep(s.scene, samples, faster, c), at_faster_times));
+  EXPECT_TRUE(sameBits(caster.castBeamsSweep(s.scene, samples, shared, c), at_shared_times));
+  const Eigen::Isometry3d sensor = samples.world_from_sensor.front();
+  core::Caster one_pose;
+  EXPECT_TRUE(sameBits(caster.castBeams(s.scene, s.poses, sensor, shared, c),
+                       one_pose.castBeams(s.scene, s.poses, sensor, *shared, c)));
+
+  // Without a sensor pose for the first 20 ms, those beams are NaN and meet nothing, whatever the
+  // caster's last sweep met there.
+  core::PoseSamples late = samples;
+  late.world_from_sensor.front().translation().x() = std::nan("");
+  core::Caster fresh_late;
+  const core::ScanResult& without_start = caster.castBeamsSweep(s.scene, late, shared, c);
+  int nan = 0, nan_meeting = 0;
+  for (std::size_t i = 0; i < without_start.range.size(); ++i) {
+    if (!std::isnan(without_start.range[i])) continue;
+    ++nan;
+    nan_meeting += without_start.body[i] != -1 || without_start.triangle[i] != -1;
+  }
+  EXPECT_GT(nan, shared->size() / 10);
+  EXPECT_EQ(nan_meeting, 0);
+  EXPECT_TRUE(sameBits(without_start, fresh_late.castBeamsSweep(s.scene, late, *shared, c)));
+
+  const std::shared_ptr<const core::BeamList> none;
+  EXPECT_THROW(caster.castBeams(s.scene, s.poses, sensor, none, c), std::invalid_argument);
+  EXPECT_THROW(caster.castBeamsSweep(s.scene, samples, none, c), std::invalid_argument);
 }
 
 }  // namespace

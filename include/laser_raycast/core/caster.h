@@ -58,6 +58,16 @@ class Caster {
   // std::invalid_argument for bad samples or beams.
   const ScanResult& castBeamsSweep(const Scene& scene, const PoseSamples& samples,
                                    const BeamList& beams, const CastConfig& config);
+  // The same two for a list the caller shares and does not change while it does (a calibrated
+  // head's turn, cast scan after scan): passed again, it is known by its pointer rather than
+  // compared beam by beam with the one fitted last. Throws std::invalid_argument for a null list.
+  const ScanResult& castBeams(const Scene& scene, const FramePoses& poses,
+                              const Eigen::Isometry3d& world_from_sensor,
+                              const std::shared_ptr<const BeamList>& beams,
+                              const CastConfig& config);
+  const ScanResult& castBeamsSweep(const Scene& scene, const PoseSamples& samples,
+                                   const std::shared_ptr<const BeamList>& beams,
+                                   const CastConfig& config);
 
   // A bundle: the 3D patterns `patterns`, all of the same rings and azimuths with sub-ray k of each
   // beam at patterns[k]'s (row, column) (a divergent beam's footprint: the same pattern shifted a

@@ -100,10 +100,17 @@ ReuseKey relativeInputs(const Scene& scene, const FramePoses& poses,
   return key;
 }
 
-void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanResult* result) {
-  result->range.assign(beams, sensor_ok ? kInf : std::numeric_limits<double>::quiet_NaN());
-  result->body.assign(beams, -1);
-  result->triangle.assign(beams, -1);
+void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanResult* result,
+                 bool overwritten) {
+  if (overwritten) {
+    result->range.resize(beams);
+    result->body.resize(beams);
+    result->triangle.resize(beams);
+  } else {
+    result->range.assign(beams, sensor_ok ? kInf : std::numeric_limits<double>::quiet_NaN());
+    result->body.assign(beams, -1);
+    result->triangle.assign(beams, -1);
+  }
   if (with_normals) {
     result->normal.assign(beams, Eigen::Vector3d::Zero());
   } else {

@@ -31,9 +31,10 @@ namespace {
 
 // Whether two lists of vectors hold the same bits (so the same values; a list the node casts every
 // scan is compared with the fitted one as memory, not value by value).
-bool sameBits(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+template <class T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() &&
-         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Eigen::Vector3d)) == 0);
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 // The bodies cast against in any of a list's walks, for its CastStats::bodies_culled.
@@ -65,40 +66,44 @@ LASER_RAYCAST_HOT_INLINE void scatterBeam(const ScanResult& own, std::size_t k, 
   }
 }
 
-// A part's result (own, by its grid's beams) into the list's; NaN where column_valid (if given)
-// is 0.
+// A part's result (own, by its grid's beams) into the list's: every beam of the part's range,
+// body and triangle (NaN, -1 and -1 where column_valid, if given, is 0), normal and incidence
+// where it hits.
 void scatter(const BeamListGrid::Part& part, const ScanResult& own, const BeamList& list,
              const CastConfig& config, const std::vector<char>* column_valid,
              ScanResult* result) {
-  const std::size_t cols = part.culling.azimuthCount();
-  // Beam k is at column k % cols, counted along (a division a beam costs a 28,928-beam sweep a
-  // tenth of a millisecond).
-  for (std::size_t k = 0, col = 0; k < part.beam.size(); ++k, col = col + 1 == cols ? 0 : col + 1) {
-    if (column_valid && !(*column_valid)[col]) {
-      result->range[part.beam[k]] = std::numeric_limits<double>::quiet_NaN();
-      continue;
+  const std::size_t cols = part.culling.azimuthCount(), rows = part.beam.size() / cols;
+  // Beam k is row k / cols's column k % cols. A list holds a column's beams together (a
+  // Velodyne's firing sequence, an Ouster's column): taken row by row over the whole scan, each
+  // beam would be written a column's beams away from the last, a cache line each; a few columns
+  // at a time, every row's, they stay in the nearest cache.
+  constexpr std::size_t kTileColumns = 64;
+  for (std::size_t lo = 0; lo < cols; lo += kTileColumns) {
+    const std::size_t hi = std::min(cols, lo + kTileColumns);
+    for (std::size_t row = 0; row < rows; ++row) {
+      for (std::size_t col = lo, k = row * cols + lo; col < hi; ++col, ++k) {
+        if (column_valid && !(*column_valid)[col]) {
+          const int i = part.beam[k];
+          result->range[i] = std::numeric_limits<double>::quiet_NaN();
+          result->body[i] = -1;
+          result->triangle[i] = -1;
+          continue;
+        }
+        scatterBeam(own, k, part.beam[k], list, config, result);
+      }
     }
-    scatterBeam(own, k, part.beam[k], list, config, result);
   }
 }
 
-// A part's lines grouped by when they fire: lines of one class fire at one time in every column
-// (an Ouster's part is one class, each Velodyne laser its own, at its place in the firing
-// sequence). class_of_row by the rows of the part's grid (ascending elevation).
-struct TimeClasses {
-  int count = 0;
-  std::vector<int> class_of_row;
-};
-
 // Appends each class's times at the part's columns to *times (class by class); at_once: every
 // beam at time 0 (a cast from one pose).
-TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list, bool at_once,
-                        std::vector<double>* times) {
+CasterState::TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list,
+                                     bool at_once, std::vector<double>* times) {
   const int rings = part.culling.ringCount(), cols = part.culling.azimuthCount();
   auto time = [&](int ring, int col) {
     return at_once ? 0.0 : list.time(part.beam[ring * cols + col]);
   };
-  TimeClasses out;
+  CasterState::TimeClasses out;
   std::vector<int> first_ring, class_of_ring(rings);
   for (int ring = 0; ring < rings; ++ring) {
     int k = 0;
@@ -124,16 +129,34 @@ TimeClasses timeClasses(const BeamListGrid::Part& part, const BeamList& list, bo
 
 }  // namespace
 
-const BeamListGrid* CasterState::gridOf(const BeamList& beams) {
+const BeamListGrid* CasterState::gridOf(const BeamList& beams,
+                                        const std::shared_ptr<const BeamList>* shared) {
+  if (fitted && shared && fitted->source == *shared) {
+    return fitted->grid ? &*fitted->grid : nullptr;
+  }
   const std::vector<Eigen::Vector3d>& origins = beams.origins;
   if (!fitted || !sameBits(fitted->directions, beams.directions) ||
-      !sameBits(fitted->origins, origins) || fitted->lines != beams.lines) {
+      !sameBits(fitted->origins, origins) || fitted->lines != beams.lines ||
+      !sameBits(fitted->times, beams.times)) {
     fitted.reset();
     beams.validate();
-    fitted = FittedList{beams.directions, origins, beams.lines, fitBeamGrid(beams), {}};
+    fitted = FittedList{beams.directions, origins, beams.lines, beams.times, fitBeamGrid(beams),
+                        {}, {}, {}};
     if (!fitted->grid) fitted->cells = fitBeamCells(beams);
   }
+  fitted->source = shared ? *shared : nullptr;
   return fitted->grid ? &*fitted->grid : nullptr;
+}
+
+const CasterState::SweepTimes& CasterState::sweepTimesOf(const BeamList& list, bool at_once) {
+  std::optional<SweepTimes>& kept = fitted->sweep_times[at_once ? 1 : 0];
+  if (!kept) {
+    kept.emplace();
+    for (const BeamListGrid::Part& part : fitted->grid->parts) {
+      kept->classes.push_back(timeClasses(part, list, at_once, &kept->times));
+    }
+  }
+  return *kept;
 }
 
 void CasterState::castBeamGrids(const Scene& scene, const FramePoses& poses,
@@ -233,12 +256,9 @@ void CasterState::castBeamGridsSweep(const Scene& scene, const PoseSamples& samp
   CastBodies cast_any(bodies);
   std::vector<char> column_valid;
   // Every part's columns' poses at once (the samples are prepared once for all of them).
-  std::vector<TimeClasses> classes;
-  std::vector<double>& times = sweep_columns.times;
-  times.clear();
-  for (const BeamListGrid::Part& part : grid.parts) {
-    classes.push_back(timeClasses(part, list, at_once, &times));
-  }
+  const SweepTimes& sweep_times = sweepTimesOf(list, at_once);
+  const std::vector<TimeClasses>& classes = sweep_times.classes;
+  sweep_columns.times = sweep_times.times;
   const ColumnPoses poses(scene, indexOf(scene), samples, &sweep_columns);
   int base = 0;
   for (std::size_t p = 0; p < grid.parts.size(); ++p) {

@@ -359,36 +359,44 @@ void castBeamList(CasterState& state, const Scene& scene, const BeamList& beams,
   }
 }
 
-// beams has been checked (CasterState::gridOf).
+// beams has been checked (CasterState::gridOf). through_grids: the list is cast through its
+// grids, whose results are scattered into every beam's range, body and triangle (each beam is in
+// one part): those are sized, not filled first (a calibrated head's 28,928 beams, scan after scan).
 void startResult(const Scene& scene, const BeamList& beams, const CastConfig& config,
-                 ScanResult* result) {
+                 bool through_grids, ScanResult* result) {
   config.validate();
   resetResult(beams.size(), static_cast<int>(scene.bodies().size()), true, config.compute_incidence,
-              result);
+              result, through_grids);
   if (config.compute_incidence) result->cos_incidence.assign(beams.size(), 0.0);
 }
 
-}  // namespace
+// The list a caller shares, checked for null.
+const BeamList& sharedList(const std::shared_ptr<const BeamList>& beams) {
+  if (!beams) throw std::invalid_argument("the beam list is null");
+  return *beams;
+}
 
-const ScanResult& Caster::castBeams(const Scene& scene, const FramePoses& poses,
-                                    const Eigen::Isometry3d& world_from_sensor,
-                                    const BeamList& beams, const CastConfig& config) {
+// Caster::castBeams into *result; shared: the caller's shared list beams is, or null.
+void castBeamsAt(CasterState& state, const Scene& scene, const FramePoses& poses,
+                 const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
+                 const std::shared_ptr<const BeamList>* shared, const CastConfig& config,
+                 ScanResult* result) {
   checkFramePoses(scene, poses);
-  state_->previous.reset();
-  const BeamListGrid* grid = state_->gridOf(beams);  // checks beams
-  startResult(scene, beams, config, &result_);
-  if (grid && isValidPose(world_from_sensor)) {
-    state_->castBeamGrids(scene, poses, world_from_sensor, beams, *grid, config, &result_);
-    return result_;
+  state.previous.reset();
+  const BeamListGrid* grid = state.gridOf(beams, shared);  // checks beams
+  const bool through_grids = grid && isValidPose(world_from_sensor);
+  startResult(scene, beams, config, through_grids, result);
+  if (through_grids) {
+    state.castBeamGrids(scene, poses, world_from_sensor, beams, *grid, config, result);
+    return;
   }
-  if (state_->cellsOf() && isValidPose(world_from_sensor)) {
-    state_->castBeamCells(scene, poses, world_from_sensor, beams, *state_->cellsOf(), config,
-                          &result_);
-    return result_;
+  if (state.cellsOf() && isValidPose(world_from_sensor)) {
+    state.castBeamCells(scene, poses, world_from_sensor, beams, *state.cellsOf(), config, result);
+    return;
   }
   GroupPoses placed;
   placeGroupsAt(
-      state_->indexOf(scene), world_from_sensor,
+      state.indexOf(scene), world_from_sensor,
       [&](int frame, Eigen::Isometry3d* pose) {
         if (!poses.valid[frame]) return false;
         *pose = poses.pose[frame];
@@ -397,29 +405,29 @@ const ScanResult& Caster::castBeams(const Scene& scene, const FramePoses& poses,
       &placed);
   for (std::size_t g = 0; g < placed.valid.size(); ++g) {
     if (!placed.valid[g]) {
-      result_.stats.bodies_skipped +=
-          static_cast<int>(state_->indexOf(scene).groups()[g]->bodies.size());
+      result->stats.bodies_skipped +=
+          static_cast<int>(state.indexOf(scene).groups()[g]->bodies.size());
     }
   }
   castBeamList(
-      *state_, scene, beams, config, false, [&](double, GroupPoses* out) { *out = placed; },
-      &result_);
-  return result_;
+      state, scene, beams, config, false, [&](double, GroupPoses* out) { *out = placed; }, result);
 }
 
-const ScanResult& Caster::castBeamsSweep(const Scene& scene, const PoseSamples& samples,
-                                         const BeamList& beams, const CastConfig& config) {
+// Caster::castBeamsSweep into *result; shared as castBeamsAt's.
+void castBeamsOver(CasterState& state, const Scene& scene, const PoseSamples& samples,
+                   const BeamList& beams, const std::shared_ptr<const BeamList>* shared,
+                   const CastConfig& config, ScanResult* result) {
   samples.validate(scene);
-  state_->previous.reset();
-  const BeamListGrid* grid = state_->gridOf(beams);  // checks beams
-  startResult(scene, beams, config, &result_);
+  state.previous.reset();
+  const BeamListGrid* grid = state.gridOf(beams, shared);  // checks beams
+  startResult(scene, beams, config, grid != nullptr, result);
   if (grid) {
-    state_->castBeamGridsSweep(scene, samples, beams, *grid, config, &result_);
-    return result_;
+    state.castBeamGridsSweep(scene, samples, beams, *grid, config, result);
+    return;
   }
-  const SceneIndex& index = state_->indexOf(scene);
+  const SceneIndex& index = state.indexOf(scene);
   castBeamList(
-      *state_, scene, beams, config, true,
+      state, scene, beams, config, true,
       [&](double t, GroupPoses* out) {
         placeGroupsAt(
             index, samples.sensorAt(t),
@@ -428,7 +436,37 @@ const ScanResult& Caster::castBeamsSweep(const Scene& scene, const PoseSamples& 
             },
             out);
       },
-      &result_);
+      result);
+}
+
+}  // namespace
+
+const ScanResult& Caster::castBeams(const Scene& scene, const FramePoses& poses,
+                                    const Eigen::Isometry3d& world_from_sensor,
+                                    const BeamList& beams, const CastConfig& config) {
+  castBeamsAt(*state_, scene, poses, world_from_sensor, beams, nullptr, config, &result_);
+  return result_;
+}
+
+const ScanResult& Caster::castBeams(const Scene& scene, const FramePoses& poses,
+                                    const Eigen::Isometry3d& world_from_sensor,
+                                    const std::shared_ptr<const BeamList>& beams,
+                                    const CastConfig& config) {
+  castBeamsAt(*state_, scene, poses, world_from_sensor, sharedList(beams), &beams, config,
+              &result_);
+  return result_;
+}
+
+const ScanResult& Caster::castBeamsSweep(const Scene& scene, const PoseSamples& samples,
+                                         const BeamList& beams, const CastConfig& config) {
+  castBeamsOver(*state_, scene, samples, beams, nullptr, config, &result_);
+  return result_;
+}
+
+const ScanResult& Caster::castBeamsSweep(const Scene& scene, const PoseSamples& samples,
+                                         const std::shared_ptr<const BeamList>& beams,
+                                         const CastConfig& config) {
+  castBeamsOver(*state_, scene, samples, sharedList(beams), &beams, config, &result_);
   return result_;
 }
 

@@ -71,8 +71,11 @@ void checkFramePoses(const Scene& scene, const FramePoses& poses);
 // each thread min_per_thread beams (waking threads costs more than a small scan does), at least 1.
 int castThreads(const CastConfig& config, int beams, int min_per_thread);
 
-// A result of `beams` beams before a cast: every range inf (NaN if !sensor_ok), nothing hit.
-void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanResult* result);
+// A result of `beams` beams before a cast: every range inf (NaN if !sensor_ok), nothing hit; or,
+// overwritten, sized only: the caller writes every beam's range, body and triangle (a list cast
+// through its grids).
+void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanResult* result,
+                 bool overwritten = false);
 // Each hit beam's |cos| of the angle between its direction and the hit's normal.
 void computeIncidence(const ScanPattern& pattern, ScanResult* result);
 
@@ -118,14 +121,32 @@ struct CasterState {
   std::unique_ptr<KeptSlices> planes;   // CastConfig::keep_slices
   std::optional<ReuseKey> previous;     // the inputs of the result, if it is complete
   std::vector<ScanResult> bundle;       // Caster::castBundle's results, one per sub-ray pattern
-  // The beam list Caster::castBeams last fitted to grids (its directions, origins and lines), and
-  // what fitBeamGrid found, or fitBeamCells where it found none: a node casts the same list scan
-  // after scan.
+  // A grid part's lines grouped by when they fire: lines of one class fire at one time in every
+  // column (an Ouster's part is one class, each Velodyne laser its own, at its place in the firing
+  // sequence). class_of_row by the rows of the part's grid (ascending elevation).
+  struct TimeClasses {
+    int count = 0;
+    std::vector<int> class_of_row;
+  };
+  // The time classes of a list's grid parts, and each class's times at its part's columns (part
+  // by part, class by class: ColumnPoses' columns).
+  struct SweepTimes {
+    std::vector<TimeClasses> classes;  // by part
+    std::vector<double> times;
+  };
+  // The beam list Caster::castBeams last fitted to grids (its directions, origins, lines and
+  // times), and what fitBeamGrid found, or fitBeamCells where it found none: a node casts the same
+  // list scan after scan. source: the list, where the caller shares it (Caster::castBeams'
+  // shared_ptr overloads): while the same one is passed, it is not compared again.
   struct FittedList {
     std::vector<Eigen::Vector3d> directions, origins;
     std::vector<int> lines;
+    std::vector<double> times;
     std::optional<BeamListGrid> grid;
     std::optional<BeamCells> cells;
+    std::shared_ptr<const BeamList> source;
+    // The grid's sweep times, made when first swept: [0] each beam at its time, [1] all at once.
+    std::optional<SweepTimes> sweep_times[2];
   };
   std::optional<FittedList> fitted;
   // A sweep's sensor poses at its columns (ColumnPoses' columns), each relative to its block's
@@ -163,7 +184,12 @@ struct CasterState {
                   const BeamSet::Bundle* bundle = nullptr);
   // beams' grids (beam_list_grid.h), fitted or remembered from the last call; null if it lies on
   // none. A list not remembered is checked first (BeamList::validate throws for a bad one).
-  const BeamListGrid* gridOf(const BeamList& beams);
+  // shared: the same list as the caller shares it, or null.
+  const BeamListGrid* gridOf(const BeamList& beams,
+                             const std::shared_ptr<const BeamList>* shared = nullptr);
+  // After gridOf(list) found a grid: its parts' time classes and times (at_once: every beam at
+  // time 0, a cast from one pose), made once for the list.
+  const SweepTimes& sweepTimesOf(const BeamList& list, bool at_once);
   // After gridOf(beams): beams' cells (beam_cells.h) if it lies on no grid and has some, else null.
   const BeamCells* cellsOf() const { return fitted && fitted->cells ? &*fitted->cells : nullptr; }
   // Casts a beam list in its cells from one pose into result (reset for it, the sensor pose
