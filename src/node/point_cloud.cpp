@@ -273,17 +273,16 @@ void buildBeamCloud(const core::BeamList& beams, const core::MeasuredScan& scan,
                     const std_msgs::Header& header, const CloudOptions& options,
                     sensor_msgs::PointCloud2* cloud) {
   const std::size_t n = beams.size();
+  // Each vector on its own (an empty one is every beam's 0), four maxima at a time: one would
+  // wait for the last at every beam (a fifth of the cloud's time for a 28,928-beam turn).
+  const int lines = 1 + maxOf(beams.lines, 0);
   std::string problem;
   if (scan.ranges.size() != n) {
     problem = "the scan has " + std::to_string(scan.ranges.size()) + " ranges";
   } else if (!scan.intensities.empty() && scan.intensities.size() != n) {
     problem = "the scan has " + std::to_string(scan.intensities.size()) + " intensities";
   } else {
-    // Each vector on its own (an empty one is every beam's 0), four maxima at a time: one would
-    // wait for the last at every beam (a fifth of the cloud's time for a 28,928-beam turn).
-    const int lines = 1 + maxOf(beams.lines, 0);
-    const double last_time = maxOf(beams.times, 0.0);
-    problem = pointLayoutLimit(options.layout, lines, last_time);
+    problem = pointLayoutLimit(options.layout, lines, maxOf(beams.times, 0.0));
   }
   if (!problem.empty()) {
     throw std::invalid_argument("buildBeamCloud: " + problem + " for " + std::to_string(n) +
@@ -295,7 +294,6 @@ void buildBeamCloud(const core::BeamList& beams, const core::MeasuredScan& scan,
   std::vector<int> order;
   int height = 1, width = beams.size();
   if (options.organized && !beams.lines.empty()) {
-    const int lines = *std::max_element(beams.lines.begin(), beams.lines.end()) + 1;
     std::vector<int> per_line(lines, 0);
     for (const int line : beams.lines) ++per_line[line];
     bool uniform = per_line.front() > 0;

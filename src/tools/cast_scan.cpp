@@ -209,9 +209,6 @@ std::string rangeAndLink(const Args& args, const LoadedScene& loaded, const core
 // A pattern file's beams of the path's scan number `pose` into casting->beams: its rows from
 // pose * points_per_scan on.
 void patternScan(const Args& args, std::size_t pose, Casting* casting) {
-  if (args.calibrated && !args.pattern_file && !casting->calibrated) {
-    casting->calibrated = std::make_shared<const core::BeamList>(*args.calibrated);
-  }
   if (!args.pattern_file) return;
   casting->beams = args.pattern_file->scan(static_cast<std::int64_t>(pose) * args.points_per_scan,
                                            args.points_per_scan, args.point_rate);
@@ -390,6 +387,9 @@ int main(int argc, char** argv) {
   Casting casting(args.scan.pattern(), args.scan.castConfig(),
                   laser_raycast::tools::timeIncrement(args.path, args.scan.fan.increment()));
   casting.config.threads = args.threads;
+  if (args.calibrated && !args.pattern_file) {
+    casting.calibrated = std::make_shared<const core::BeamList>(*args.calibrated);
+  }
   try {
     labelReflectivity(args, loaded, &casting);
   } catch (const ArgError& e) {

@@ -258,8 +258,7 @@ void CasterState::castBeamGridsSweep(const Scene& scene, const PoseSamples& samp
   // Every part's columns' poses at once (the samples are prepared once for all of them).
   const SweepTimes& sweep_times = sweepTimesOf(list, at_once);
   const std::vector<TimeClasses>& classes = sweep_times.classes;
-  sweep_columns.times = sweep_times.times;
-  const ColumnPoses poses(scene, indexOf(scene), samples, &sweep_columns);
+  const ColumnPoses poses(scene, indexOf(scene), samples, sweep_times.times, &sweep_columns);
   int base = 0;
   for (std::size_t p = 0; p < grid.parts.size(); ++p) {
     const BeamListGrid::Part& part = grid.parts[p];

@@ -154,6 +154,7 @@ struct CasterState {
   // ColumnMotion of the frames that stay put are views of them.
   std::vector<ColumnMotion::Pose> sweep_poses;
   ColumnPoses::Storage sweep_columns;  // the ColumnPoses' of a sweep
+  std::vector<double> sweep_column_times;  // Caster::castSweep's columns' times
   ScanResult grid_culling, grid_own;  // castBeamGrids' results for one part, by its grid beams
 
   // The scene's index for this scene version.

@@ -301,12 +301,12 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
   }
   forget();  // a sweep is never reused, and the last single cast is not this one
   const int azimuths = pattern.azimuthCount();
-  std::vector<double>& times = state_->sweep_columns.times;
+  std::vector<double>& times = state_->sweep_column_times;
   times.resize(azimuths);
   for (int c = 0; c < azimuths; ++c) times[c] = c * time_increment;
   resetResult(pattern.size(), static_cast<int>(scene.bodies().size()), true,
               config.compute_incidence, &result_);
-  const ColumnPoses poses(scene, state_->indexOf(scene), samples, &state_->sweep_columns);
+  const ColumnPoses poses(scene, state_->indexOf(scene), samples, times, &state_->sweep_columns);
   std::vector<char> column_valid;
   state_->sweepColumns(scene, poses, 0, pattern, SweepBeams{}, config, &result_, &column_valid);
   if (config.compute_incidence) computeIncidence(pattern, &result_);

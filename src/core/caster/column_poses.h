@@ -31,18 +31,17 @@ class ColumnPoses {
     std::size_t i, j;
     double s;
   };
-  // Its columns' times and what it finds of them, in storage the caller keeps from sweep to sweep
-  // (a calibrated Velodyne's turn has 28,928 columns: written, not made and zeroed anew).
+  // What it finds of its columns, in storage the caller keeps from sweep to sweep (a calibrated
+  // Velodyne's turn has 28,928 columns: written, not made and zeroed anew).
   struct Storage {
-    std::vector<double> times;  // by column: set by the caller
     std::vector<Bracket> brackets;
     std::vector<char> sensor_valid;
   };
-  // Column c at storage->times[c].
+  // Column c at times[c]; times, like storage, kept by the caller while this lives.
   ColumnPoses(const Scene& scene, const SceneIndex& index, const PoseSamples& samples,
-              Storage* storage)
+              const std::vector<double>& times, Storage* storage)
       : samples_(samples),
-        times_(storage->times),
+        times_(times),
         brackets_(storage->brackets),
         sensor_valid_(storage->sensor_valid) {
     const int columns = static_cast<int>(times_.size());
