@@ -121,10 +121,10 @@ def bays():
 
 
 def aisles():
-    """The y of each aisle's centre line, between consecutive rows."""
-    pitch = (2 * HALF_Y - 2 * BAY_DEPTH - AISLE) / ROW_PAIRS
-    return [-HALF_Y + BAY_DEPTH + 0.1 + p * pitch + (pitch - AISLE) / 2 + AISLE / 2 - pitch / 2
-            for p in range(1, ROW_PAIRS + 1)]
+    """The y of each aisle's centre line: midway between two neighbouring rows that do not stand
+    back to back (those are a bay's depth and the flue apart)."""
+    rows = sorted(set(round(y, 6) for _, y, _ in bays()))
+    return [(a + b) / 2 for a, b in zip(rows, rows[1:]) if b - a > BAY_DEPTH + FLUE + 1e-6]
 
 
 def urdf(rack_path):
