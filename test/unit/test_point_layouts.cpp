@@ -184,10 +184,11 @@ using namespace laser_raycast::core;
 using sensor_msgs::PointField;
 
 // sixBeams() with intensities (rho cos(theta)) that test the rounding of the drivers' calibrated
-// reflectivity, 100 x the intensity (12.4 -> 12, 0.75 -> 1), and its clamping (300 -> 255).
+// reflectivity, 100 x the intensity (a half away from zero: 12.5 -> 13; 0.75 -> 1), and its
+// clamping (300 -> 255).
 MeasuredScan sixBeamsBright() {
   MeasuredScan scan = sixBeams();
-  scan.intensities = {0.124f, 0.0f, 3.0f, 0.0f, 0.0075f, 0.0f};
+  scan.intensities = {0.125f, 0.0f, 3.0f, 0.0f, 0.0075f, 0.0f};
   return scan;
 }
 
@@ -270,7 +271,7 @@ pcl::PointCloud<PointT> readAs(const sensor_msgs::PointCloud2& cloud) {
 
 // The three valid returns in beam order: (ring, column, range, intensity as cast, the drivers'
 // calibrated reflectivity of it, Ouster's signal: the reflectivity times (10 m / range)^2, rounded:
-// 12 x 25, 255 x 44.4, 1 x 11.1).
+// 13 x 25, 255 x 44.4, 1 x 11.1).
 struct Return {
   int ring, column;
   double range;
@@ -278,7 +279,7 @@ struct Return {
   float reflectivity;
   float signal;
 };
-const Return kReturns[3] = {{0, 0, 2.0, 0.124f, 12, 300},
+const Return kReturns[3] = {{0, 0, 2.0, 0.125f, 13, 325},
                             {0, 2, 1.5, 3.0f, 255, 11333},
                             {1, 1, 3.0, 0.0075f, 1, 11}};
 
