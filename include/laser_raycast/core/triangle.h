@@ -357,12 +357,20 @@ template <typename T>
 class PreparedRay<T, TriangleMethod::kWatertight> {
  public:
   PreparedRay(const RayT<T>& ray, bool cull_backfaces)
-      : origin_(ray.origin),
-        // An invalid ray gets tmin = NaN, so that no t passes the range test. An infinite
-        // direction component would otherwise give sz_ = 0 and a hit at t = 0 on every triangle
-        // the ray's line crosses.
-        tmin_(isValidRay(ray) ? ray.tmin : std::numeric_limits<T>::quiet_NaN()),
-        cull_(cull_backfaces) {
+      // An invalid ray gets tmin = NaN, so that no t passes the range test. An infinite direction
+      // component would otherwise give sz_ = 0 and a hit at t = 0 on every triangle the ray's line
+      // crosses.
+      : PreparedRay(ray, cull_backfaces,
+                    isValidRay(ray) ? ray.tmin : std::numeric_limits<T>::quiet_NaN()) {}
+  // A ray its maker knows to be valid (isValidRay), not checked again: a sweep's beam, a finite
+  // pose's turn of a unit direction (BeamRays, for every triangle a beam is tested against).
+  struct KnownValid {};
+  PreparedRay(const RayT<T>& ray, bool cull_backfaces, KnownValid)
+      : PreparedRay(ray, cull_backfaces, ray.tmin) {}
+
+ private:
+  PreparedRay(const RayT<T>& ray, bool cull_backfaces, T tmin)
+      : origin_(ray.origin), tmin_(tmin), cull_(cull_backfaces) {
     // Permute so that z is the dimension where the direction is largest; swapping x and y when that
     // component is negative keeps the winding (and so the front face) unchanged.
     kz_ = 0;
@@ -377,6 +385,7 @@ class PreparedRay<T, TriangleMethod::kWatertight> {
     sz_ = T(1) / ray.dir[kz_];
   }
 
+ public:
   LASER_RAYCAST_HOT_INLINE std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a,
                                                                     const Vec3<T>& b,
                                                                     const Vec3<T>& c,

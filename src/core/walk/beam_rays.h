@@ -65,7 +65,15 @@ class BeamRays {
                                                            const Eigen::Vector3d& d) const {
     Ray ray{Eigen::Vector3d::Zero(), d, config_.tmin};
     if (motion_) ray = motion_->ray(row, col, d, config_.tmin);
-    return PreparedRay<double, M>(ray, config_.cull_backfaces);
+    if constexpr (M == TriangleMethod::kWatertight) {
+      // Valid: the beam directions are finite unit vectors (a list's are checked when it is
+      // validated, a pattern's when it is made), and a sweep casts only from poses that are
+      // (ColumnPoses: isValidPose at both samples).
+      return PreparedRay<double, M>(ray, config_.cull_backfaces,
+                                    typename PreparedRay<double, M>::KnownValid{});
+    } else {
+      return PreparedRay<double, M>(ray, config_.cull_backfaces);
+    }
   }
   // The grid's beam for the triangle tests (rayAlong its direction; from the sensor, the grid's
   // prepared ray).
