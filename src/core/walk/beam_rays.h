@@ -40,15 +40,18 @@ class BeamRays {
     return boxRayAlong(row, col, beams_.grid().rebuiltDirection(row, col));
   }
   // The beam at (row, col) along sensor-frame direction d as a ray in the body's frame for box
-  // tests: from the sensor, or for a sweep's block turned with the beam's pose and from its own
-  // origin. (origin_ holds every column's origin, the box grown by the block's shift: a centimetre
-  // on every box makes a ray traced through small boxes enter many more of them.)
+  // tests: from the sensor, or for a sweep's block turned with the beam's pose and from its
+  // column's origin, the boxes grown by how far the column's beams leave from it (its row
+  // classes', ColumnMotion::deviation: a calibrated Velodyne's lasers fire 35 us apart, each from
+  // where the sensor is then), so that a column's beams share one. (origin_ holds every column's
+  // origin, the box grown by the block's shift: a centimetre on every box makes a ray traced
+  // through small boxes enter many more of them.)
   WideBoxRay boxRayAlong(int row, int col, const Eigen::Vector3d& d) const {
     if (!motion_) return WideBoxRay(origin_, active_.body_from_sensor_rot * d);
     const ColumnMotion::Pose& pose = motion_->refFromBeam(row, col);
     const Eigen::Vector3d dir = active_.body_from_sensor_rot * (pose.linear() * d);
     if (shift_ == 0) return WideBoxRay(origin_, dir);
-    return WideBoxRay(originOf(pose), dir);
+    return WideBoxRay(originOf(motion_->refFromColumn(col)), dir);
   }
 
   // Sub-ray s of the bundle's beam at (row, col) for the triangle tests and the box tests, as a
@@ -83,9 +86,9 @@ class BeamRays {
   }
 
  private:
-  // Where the beams leaving from a sweep's pose start, for box tests in the body's frame: the same
-  // for every beam from that pose, so the last few are kept, by the pose's address (the block's
-  // poses stay where they are for the walk).
+  // Where the beams of a sweep's column start, for box tests in the body's frame (within the
+  // block's deviation of its pose's origin): the same for every beam of the column, so the last
+  // few are kept, by the pose's address (the block's poses stay where they are for the walk).
   const WideBoxRay::Origin& originOf(const ColumnMotion::Pose& pose) const {
     const auto key = reinterpret_cast<std::uintptr_t>(&pose);
     KeptOrigin& kept = origins_[(key / sizeof(ColumnMotion::Pose)) % origins_.size()];
@@ -93,7 +96,7 @@ class BeamRays {
       kept.pose = &pose;
       const Eigen::Vector3d o =
           active_.body_from_sensor_rot * pose.translation() + active_.sensor_in_body;
-      kept.origin.emplace(o, bounds_, config_.tmin);
+      kept.origin.emplace(o, bounds_, config_.tmin, motion_->deviation());
     }
     return *kept.origin;
   }
