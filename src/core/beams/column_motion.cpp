@@ -54,10 +54,10 @@ ColumnMotion::Reach ColumnMotion::reachOf() const {
 }
 
 void ColumnMotion::measure(const Reach& reach, double steepest, double extra_turn) {
-  const double frobenius2 = reach.frobenius2, z_move2 = reach.z_move2;
+  const double frobenius2 = reach.turnFrobenius2(), z_move2 = reach.z_move2;
   const double deviation2 = reach.deviation2;
-  translations_only_ = reach.translations_only;
-  in_plane_ = reach.in_plane;
+  translations_only_ = reach.translationsOnly();
+  in_plane_ = reach.inPlane();
   // The largest norm (a square root is monotonic and correctly rounded: the root of the largest
   // square is the largest root), widened for its rounding.
   deviation_ = deviation2 > 0 ? std::sqrt(deviation2) * (1 + 1e-9) : 0;

@@ -188,20 +188,24 @@ class BlockPlanner {
   // the sweep's poses (their place there is their column's in poses_: blocks hold columns of their
   // own, and a block that is halved is dropped before its halves write theirs).
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
-    auto origin = [&](int c) { return beams_.origins ? &(*beams_.origins)[c] : nullptr; };
+    const std::vector<Eigen::Vector3d>* origins = beams_.origins;
+    auto origin = [origins](int c) { return origins ? &(*origins)[c] : nullptr; };
     ColumnPoses::Relative relative(poses_, column(0, ref), origin(ref));
-    std::vector<ColumnMotion::Pose>& out = *sweep_poses_;
+    // Row class k's pose at column c is out[column(k, c)]: class 0's at out[first + c].
+    ColumnMotion::Pose* const out = sweep_poses_->data();
+    const int first = column(0, 0), classes = beams_.classes, azimuths = pattern_.azimuthCount();
     ColumnMotion::Reach reach;
-    for (int c = lo; c <= hi; ++c) relative.at(column(0, c), origin(c), &out[column(0, c)], &reach);
+    for (int c = lo; c <= hi; ++c) relative.at(first + c, origin(c), &out[first + c], &reach);
     // Class by class, each one's poses written in a row.
-    for (int k = 1; k < beams_.classes; ++k) {
+    for (int k = 1; k < classes; ++k) {
+      const int row = first + k * azimuths;
       for (int c = lo; c <= hi; ++c) {
-        const Eigen::Vector3d t = relative.at(column(k, c), origin(c), &out[column(k, c)], &reach);
-        reach.addDeviation(t, out[column(0, c)].translation());
+        const Eigen::Vector3d t = relative.at(row + c, origin(c), &out[row + c], &reach);
+        reach.addDeviation(t, out[first + c].translation());
       }
     }
     return std::make_shared<ColumnMotion>(
-        lo, hi - lo + 1, &out[column(0, lo)], pattern_.azimuthCount(), beams_.classes, reach,
+        lo, hi - lo + 1, &out[first + lo], azimuths, classes, reach,
         steepest_, beams_.turn, beams_.classes > 1 ? beams_.class_of_row : std::vector<int>());
   }
 
