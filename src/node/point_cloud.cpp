@@ -32,6 +32,36 @@ struct Beam {
   double range;  // m; 0 without a return
 };
 
+// The bytes of a field of type `datatype`.
+constexpr std::uint32_t fieldBytes(std::uint8_t datatype) {
+  switch (datatype) {
+    case PointField::INT8:
+    case PointField::UINT8:
+      return 1;
+    case PointField::INT16:
+    case PointField::UINT16:
+      return 2;
+    case PointField::INT32:
+    case PointField::UINT32:
+    case PointField::FLOAT32:
+      return 4;
+    default:
+      return 8;
+  }
+}
+
+// Whether a layout's fields, one after the other from offset 0, fill its points: no padding.
+template <std::size_t N>
+constexpr bool everyByteIsAField(const PointLayoutTable<N>& table) {
+  std::uint32_t end = 0;
+  for (const PointLayoutField& f : table.fields) {
+    if (f.offset != end) return false;
+    end += fieldBytes(f.datatype);
+  }
+  return end == table.point_step;
+}
+static_assert(everyByteIsAField(point_layouts::kVelodyne), "velodyne_pointcloud packs its points");
+
 // memcpy: the data buffer gives no alignment guarantee.
 template <typename T>
 void put(T value, std::uint8_t* out) {
@@ -206,8 +236,17 @@ void fillCloud(int beams, int height, int width, const core::MeasuredScan& scan,
     cloud->point_step += 1;
   }
   cloud->row_step = cloud->width * cloud->point_step;
-  // Zeroed, the padding too, so that equal clouds are equal bytes.
-  cloud->data.assign(static_cast<std::size_t>(points) * cloud->point_step, 0);
+  // Every byte is written: the fields below, and the padding zeroed where the layout has some, so
+  // that equal clouds are equal bytes. A packed layout's bytes are all fields: its buffer is only
+  // sized (a cloud built into the last one's, as the node's are, writes over it in place).
+  const std::size_t bytes = static_cast<std::size_t>(points) * cloud->point_step;
+  withPointLayout(options.layout, [&](auto ref) {
+    if constexpr (everyByteIsAField(decltype(ref)::table)) {
+      cloud->data.resize(bytes);
+    } else {
+      cloud->data.assign(bytes, 0);
+    }
+  });
 
   constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
   const auto stamp_ns = static_cast<std::int64_t>(header.stamp.toNSec());

@@ -222,14 +222,13 @@ void Sensor::publishCloud(const ros::Time& stamp) {
   CloudOptions options;
   options.organized = cast_params_.organized;
   options.layout = cast_params_.point_layout;
-  sensor_msgs::PointCloud2 cloud;
   if (cast_params_.offGrid()) {
-    buildBeamCloud(castList(), measured_, header, options, &cloud);
+    buildBeamCloud(castList(), measured_, header, options, &cloud_);
   } else {
-    buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud,
+    buildPointCloud(pattern_, measured_, column_times_, header, options, &cloud_,
                     dual() ? &measured_last_ : nullptr);
   }
-  output_->send(cloud);
+  output_->send(cloud_);
 }
 
 void Sensor::publishLabels(const core::Scene& scene, const std_msgs::Header& header) {

@@ -108,6 +108,8 @@ class Sensor {
   core::MeasuredScan measured_;
   core::PulseReturns returns_;        // with divergent beams (beam_samples > 1)
   core::MeasuredScan measured_last_;  // return_mode dual: the beams' last returns
+  // The last cloud published, its buffer written over by the next (a VLP-16's turn is 636 KB).
+  sensor_msgs::PointCloud2 cloud_;
   core::SurfaceSamples surface_;  // the surfaces' reflectance and incidence, when intensity is on
   std::vector<double> column_times_;  // s after the stamp, per azimuth column (rotating)
   // The beams off any grid this scan casts: a pattern file's, and the row the next scan starts at
