@@ -68,11 +68,12 @@ class ColumnMotion {
                  r(2, 2) == 1 && m.translation().z() == 0;
     }
     // The same for a pose of rotation r and translation t, r being QuaternionBase's
-    // toRotationMatrix of q, taken from q where that costs less: r - I is 2 w [v]x + 2 [v]x^2, whose
-    // |.|_F^2 is 8 |v|^2 |q|^2, at most 8 max |v|^2 max |q|^2 over the poses (raised by a relative
-    // 2e-9 and 1e-21 to cover the rounding of r's entries, which moves |r - I|_F by a few 1e-16: a
-    // turn of 1e-11 rad at most); r is exactly I where v = 0, and turns about z alone exactly
-    // where v has no x and y (where it has, r is taken as turning, which only costs speed).
+    // toRotationMatrix of q, taken from q where that costs less: r - I is 2 w [v]x + 2 [v]x^2,
+    // whose |.|_F^2 is 8 |v|^2 |q|^2, at most 8 max |v|^2 max |q|^2 over the poses (raised by a
+    // relative 2e-9 and 1e-21 to cover the rounding of r's entries, which moves |r - I|_F by a few
+    // 1e-16: a turn of 1e-11 rad at most); r is exactly I where v = 0, and turns about z alone
+    // exactly where v has no x and y (where it has, r is taken as turning, which only costs
+    // speed).
     void add(const Eigen::Quaterniond& q, const Eigen::Matrix3d& r, const Eigen::Vector3d& t) {
       const double pose_v2 = q.vec().squaredNorm();
       shift2 = std::max(shift2, t.squaredNorm());

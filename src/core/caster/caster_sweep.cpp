@@ -204,9 +204,9 @@ class BlockPlanner {
         reach.addDeviation(t, out[first + c].translation());
       }
     }
-    return std::make_shared<ColumnMotion>(
-        lo, hi - lo + 1, &out[first + lo], azimuths, classes, reach,
-        steepest_, beams_.turn, beams_.classes > 1 ? beams_.class_of_row : std::vector<int>());
+    return std::make_shared<ColumnMotion>(lo, hi - lo + 1, &out[first + lo], azimuths, classes,
+                                          reach, steepest_, beams_.turn,
+                                          classes > 1 ? beams_.class_of_row : std::vector<int>());
   }
 
   // The columns' beams from a sensor that does not move relative to the frame: each from its own
