@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -156,12 +157,19 @@ inline bool hiddenBackFace(const Mesh& mesh, std::uint32_t slot, const Eigen::Ve
                            double tmin, double spread = 0) {
   const int facing = mesh.slotFacing(slot);
   if (!facing) return false;
+  // In scalars throughout: Eigen's temporaries here went through the stack, and a wide load of
+  // narrow stores cannot be forwarded (a sweep asks this of every slot in every block: one such
+  // load held a sixth of its profile's samples).
   const Aabb& box = mesh.slotComponentBounds(slot);
-  const double gap2 = (box.lo - eye).cwiseMax(eye - box.hi).cwiseMax(0.0).squaredNorm();
+  const double ex = eye.x(), ey = eye.y(), ez = eye.z();
+  auto gap = [](double lo, double hi, double e) { return std::max(std::max(lo - e, e - hi), 0.0); };
+  const double gx = gap(box.lo.x(), box.hi.x(), ex), gy = gap(box.lo.y(), box.hi.y(), ey),
+               gz = gap(box.lo.z(), box.hi.z(), ez);
+  const double gap2 = gx * gx + gy * gy + gz * gz;
   // Outside the bounds, and its front faces no nearer than tmin (written so that NaN fails); with
   // a spread, from every eye within that distance of `eye` (a rotating sweep's block): a gap above
-  // spread + tmin, compared squared (a sweep asks this of every slot in every block: a square
-  // root's wait was a tenth of its time). Each side is widened by far more than its rounding.
+  // spread + tmin, compared squared (a square root's wait was a tenth of this test's time). Each
+  // side is widened by far more than its rounding.
   if (spread == 0) {
     if (!(gap2 > 0 && gap2 > tmin * tmin * (1 + 1e-9))) return false;
   } else {
@@ -169,18 +177,22 @@ inline bool hiddenBackFace(const Mesh& mesh, std::uint32_t slot, const Eigen::Ve
     if (!(gap2 > need * need * (1 + 1e-9))) return false;
   }
   const auto& v = mesh.bvh().triangleVertices()[slot];
-  const Eigen::Vector3d ab = v[1] - v[0], ac = v[2] - v[0], from_eye = v[0] - eye;
+  const double ax = v[0].x(), ay = v[0].y(), az = v[0].z();
+  const double bx = v[1].x() - ax, by = v[1].y() - ay, bz = v[1].z() - az;  // b - a
+  const double cx = v[2].x() - ax, cy = v[2].y() - ay, cz = v[2].z() - az;  // c - a
+  const double fx = ax - ex, fy = ay - ey, fz = az - ez;                    // a - eye
   // The front normal's side of the eye: positive when it points away from it (from every eye of
   // the spread: an eye moved by d changes it by at most |n| |d|, compared squared as above).
-  const Eigen::Vector3d n = ab.cross(ac);
-  const double side = n.dot(from_eye);
-  const double tolerance =
-      1e-10 * ab.lpNorm<1>() * ac.lpNorm<1>() * (from_eye.lpNorm<1>() + 3 * spread);
+  const double nx = by * cz - bz * cy, ny = bz * cx - bx * cz, nz = bx * cy - by * cx;
+  const double side = nx * fx + ny * fy + nz * fz;
+  const double tolerance = 1e-10 * (std::abs(bx) + std::abs(by) + std::abs(bz)) *
+                           (std::abs(cx) + std::abs(cy) + std::abs(cz)) *
+                           (std::abs(fx) + std::abs(fy) + std::abs(fz) + 3 * spread);
   const double clear = facing * side - tolerance;
   if (!(clear > 0)) return false;
   if (spread == 0) return true;
   const double moved = spread * (1 + 1e-9);
-  return clear * clear > n.squaredNorm() * moved * moved * (1 + 1e-9);
+  return clear * clear > (nx * nx + ny * ny + nz * nz) * moved * moved * (1 + 1e-9);
 }
 
 }  // namespace core
