@@ -8,7 +8,9 @@
                   bays of rack.stl in 16 rows along 8 aisles and a cross aisle (1.19M triangles),
                   120 drums (cylinders) on 60 pallets and 30 pallet stacks (boxes) by the end walls
   drive.bag       /tf_static (base_link -> velodyne, 1.2 m up) and /tf at 100 Hz for 60 s:
-                  base_link driving at 1 m/s down an aisle (56 m), then turning towards the next
+                  base_link driving at 1 m/s down an aisle (56 m), then turning towards the next,
+                  its heading swaying by 1 degree either side every 4 s as a robot's controller
+                  holds its line (never two TF samples with one heading)
   config.yaml     the node's parameters: a rotating VLP-16 (its preset, 10 Hz) on velodyne
 
 Then:  rosrun laser_raycast simulate_bag --input DIR/drive.bag --output DIR/scans.bag \\
@@ -31,6 +33,9 @@ BAYS_PER_SECTION, CROSS_AISLE = 10, 3.0
 ROW_PAIRS, FLUE, AISLE = 8, 0.1, 3.2
 LEVELS = (0.15, 1.15, 2.15, 3.15)
 SPEED, TF_RATE, DURATION, SENSOR_Z = 1.0, 100.0, 60.0, 1.2
+# The heading's sway about the path (rad, s): a robot that follows a line corrects its heading all
+# the time; a drive of exactly one heading would flatter the caster (no sample's rotation differs).
+SWAY, SWAY_PERIOD = math.radians(1.0), 4.0
 
 
 def box(centre, size, yaw=0.0, roll=0.0):
@@ -173,6 +178,15 @@ def pose_at(s, y0, y1):
     return x0 + straight - (s - arc), y1, math.pi
 
 
+def swayed(s, x, y, yaw):
+    """The pose at s m along the path, its heading turned by the sway and moved sideways by what
+    that heading makes of the distance (v sin(sway), integrated: 1.1 cm either side)."""
+    w = 2 * math.pi / SWAY_PERIOD
+    t = s / SPEED
+    side = -SPEED * SWAY / w * math.cos(w * t)
+    return x - side * math.sin(yaw), y + side * math.cos(yaw), yaw + SWAY * math.sin(w * t)
+
+
 def transform(stamp, parent, child, x, y, z, yaw):
     t = TransformStamped()
     t.header.stamp = stamp
@@ -204,7 +218,7 @@ def main():
                                                      SENSOR_Z, 0)]), start)
         for i in range(int(DURATION * TF_RATE) + 1):
             t = start + rospy.Duration(i / TF_RATE)
-            x, y, yaw = pose_at(SPEED * i / TF_RATE, y0, y1)
+            x, y, yaw = swayed(SPEED * i / TF_RATE, *pose_at(SPEED * i / TF_RATE, y0, y1))
             bag.write("/tf", TFMessage([transform(t, "map", "base_link", x, y, 0, yaw)]), t)
     print("%d triangles a bay, %d bays: %d triangles; %s" %
           (len(tris), len(bays()), len(tris) * len(bays()), out))
