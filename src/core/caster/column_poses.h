@@ -195,6 +195,12 @@ class ColumnPoses {
       if (arc.linear) {
         *scale0 = 1 - t;
         *scale1 = t;
+      } else if (arc.terms == 3) {
+        *scale0 = sin3((1 - t) * arc.theta) * arc.inv_sin_theta;
+        *scale1 = sin3(t * arc.theta) * arc.inv_sin_theta;
+      } else if (arc.terms == 4) {
+        *scale0 = sin4((1 - t) * arc.theta) * arc.inv_sin_theta;
+        *scale1 = sin4(t * arc.theta) * arc.inv_sin_theta;
       } else {
         *scale0 = smallSin((1 - t) * arc.theta) * arc.inv_sin_theta;
         *scale1 = smallSin(t * arc.theta) * arc.inv_sin_theta;
@@ -214,8 +220,22 @@ class ColumnPoses {
       return x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 +
                   x2 * (-1.0 / 39916800 + x2 * (1.0 / 6227020800.0)))))));
     }
+    // The same series to x^5 and to x^7, for the arcs short enough that the first term left out is
+    // below 2^-64 of |x| (kSin3Arc: x^7 / 5040 <= 2^-54 / 5040 |x|; kSin4Arc: x^9 / 362880 <=
+    // 2^-48 / 362880 |x|): two TF samples 10 ms apart differ by a few 1e-4 rad as a robot sways,
+    // and every beam of a sweep takes two of these sines.
+    static constexpr double kSin3Arc = 1.0 / 512, kSin4Arc = 1.0 / 64;
+    static double sin3(double x) {
+      const double x2 = x * x;
+      return x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120)));
+    }
+    static double sin4(double x) {
+      const double x2 = x * x;
+      return x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040))));
+    }
     struct Arc {
       bool linear = true, flip = false;
+      int terms = 7;  // of the sine's series its weights take (sin3, sin4 or smallSin's)
       double theta = 0, inv_sin_theta = 0;  // 1 / sin(theta): a product a column, not a quotient
     };
     static Arc arcBetween(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
@@ -226,6 +246,8 @@ class ColumnPoses {
       if (!arc.linear) {
         arc.theta = std::acos(abs_d);
         arc.inv_sin_theta = 1 / std::sin(arc.theta);
+        // Both fractions of the arc are within it.
+        arc.terms = arc.theta <= kSin3Arc ? 3 : arc.theta <= kSin4Arc ? 4 : 7;
       }
       return arc;
     }
