@@ -199,9 +199,16 @@ class BlockPlanner {
     // Class by class, each one's poses written in a row.
     for (int k = 1; k < classes; ++k) {
       const int row = first + k * azimuths;
-      for (int c = lo; c <= hi; ++c) {
+      for (int c = lo; c <= hi;) {
+        // Two columns at once where they allow it (no origins, both between the same samples).
+        if (!origins && c < hi &&
+            relative.atPair(row + c, &out[row + c], &reach, out[first + c], out[first + c + 1])) {
+          c += 2;
+          continue;
+        }
         const Eigen::Vector3d t = relative.at(row + c, origin(c), &out[row + c], &reach);
         reach.addDeviation(t, out[first + c].translation());
+        ++c;
       }
     }
     return std::make_shared<ColumnMotion>(lo, hi - lo + 1, &out[first + lo], azimuths, classes,
