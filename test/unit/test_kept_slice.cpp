@@ -79,6 +79,35 @@ TEST(KeptSlice, KeptSlicesNeverChangeAResult) {
   EXPECT_GT(hits, 10000);
 }
 
+// A laser on a turning base, its pose composed as TF composes it: its height h comes out as h (c^2
+// + s^2) of the base's heading quaternion (c, s), off by a few ulp from one heading to the next.
+// Its plane is still met again (ScanPlane keeps 44 bits), and the casts keep their bits.
+TEST(KeptSlice, APlaneOffByUlpsFromTfsCompositionIsMetAgain) {
+  Rng rng(61);
+  const RandomScene rs = randomScene(rng);
+  const core::ScanPattern pattern(fanBySamples(-2.35, 2.35, 1081));
+  const core::CastConfig cfg = config(true, 25.0);
+  core::Caster caster;
+  std::vector<double> heights;
+  for (int cast = 0; cast < 12; ++cast) {
+    const double heading = uniform(rng, -M_PI, M_PI);
+    const double c = std::cos(heading / 2), s = std::sin(heading / 2);
+    const double height = 0.3 * (c * c + s * s);
+    heights.push_back(height);
+    const Eigen::Isometry3d sensor =
+        pose(Eigen::Vector3d(uniform(rng, -8, 8), uniform(rng, -8, 8), height), yaw(heading));
+    const core::ScanResult& r = caster.cast(rs.scene, rs.poses, sensor, pattern, cfg);
+    if (cast >= 1) {
+      EXPECT_EQ(r.stats.kept_slices, 2) << "cast " << cast << ", height " << height;
+    }
+    expectSameBits(castFresh(rs, sensor, pattern, cfg), r, "composed height");
+    if (HasFailure()) return;
+  }
+  // The heights did differ in their last bits.
+  std::sort(heights.begin(), heights.end());
+  EXPECT_GT(std::unique(heights.begin(), heights.end()) - heights.begin(), 1);
+}
+
 // A field of small primitives as a warehouse's barrels and crates (upright and tilted cylinders,
 // boxes, spheres, near and far): a kept slice's walk meets many of them with one traced beam at a
 // time, and must find what a fresh cut finds, bit for bit, and what the brute force finds.

@@ -34,13 +34,25 @@ Eigen::Vector3d perpendicular(const Eigen::Vector3d& n) {
   return n.cross(Eigen::Vector3d::Unit(axis)).normalized();
 }
 
+// x to its kKeptPlaneBits most significant bits (to nearest): a plane met again differs by a few
+// ulp in the last ones when TF composes its poses (a laser 1.2 m up on a base that turns: the
+// rotation of its offset by a quaternion gives 1.2 (c^2 + s^2), the heading's c and s, so the
+// plane's offset moves by ulps as the robot turns), and a kept slice is found by its plane's bits.
+double keptBits(double x) {
+  int e;
+  const double m = std::frexp(x, &e);
+  if (m == 0 || !std::isfinite(m)) return x;
+  constexpr int kBits = ScanPlane::kKeptPlaneBits;
+  return std::ldexp(std::nearbyint(std::ldexp(m, kBits)), e - kBits);
+}
+
 }  // namespace
 
 ScanPlane::ScanPlane(const Eigen::Isometry3d& sensor_from_frame) {
   const Eigen::Matrix3d& rot = sensor_from_frame.linear();
   const Eigen::Vector3d& trans = sensor_from_frame.translation();
-  n = rot.row(2).transpose();
-  offset = trans.z();
+  n = rot.row(2).transpose().unaryExpr(&keptBits);
+  offset = keptBits(trans.z());
   u = perpendicular(n);
   v = n.cross(u);
   a = rot.row(0).dot(u);
