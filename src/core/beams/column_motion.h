@@ -94,6 +94,17 @@ class ColumnMotion {
     void addDeviation(const Eigen::Vector3d& t, const Eigen::Vector3d& column_origin) {
       deviation2 = std::max(deviation2, (t - column_origin).squaredNorm());
     }
+    // The same quantities as add(q, r, t) and addDeviation take, already the largest of a few
+    // poses' (ColumnPoses::Relative::atPair gathers two at a time).
+    void addMaxima(double pose_shift2, double pose_v2, double pose_q2, double pose_z_move2,
+                   double pose_off_plane, double pose_deviation2) {
+      shift2 = std::max(shift2, pose_shift2);
+      v2 = std::max(v2, pose_v2);
+      q2 = std::max(q2, pose_q2);
+      z_move2 = std::max(z_move2, pose_z_move2);
+      off_plane = std::max(off_plane, pose_off_plane);
+      deviation2 = std::max(deviation2, pose_deviation2);
+    }
   };
   // The same over poses the caller keeps while this lives (a sweep's, written in place block by
   // block: CasterState::sweep_poses): class k's pose at column c is poses[k * stride + c - col_lo],

@@ -187,16 +187,11 @@ class ColumnPoses {
       const __m128d deviation2 =
           _mm_add_pd(_mm_add_pd(sq(_mm_sub_pd(t0, column(0))), sq(_mm_sub_pd(t1, column(1)))),
                      sq(_mm_sub_pd(t2, column(2))));
-      auto most = [](double* into, __m128d x) {
-        const double lanes[2] = {_mm_cvtsd_f64(x), _mm_cvtsd_f64(_mm_unpackhi_pd(x, x))};
-        *into = std::max(*into, std::max(lanes[0], lanes[1]));
+      auto most = [](__m128d x) {
+        return std::max(_mm_cvtsd_f64(x), _mm_cvtsd_f64(_mm_unpackhi_pd(x, x)));
       };
-      most(&reach->shift2, shift2);
-      most(&reach->v2, v2);
-      most(&reach->q2, q2);
-      most(&reach->z_move2, z_move2);
-      most(&reach->off_plane, off_plane);
-      most(&reach->deviation2, deviation2);
+      reach->addMaxima(most(shift2), most(v2), most(q2), most(z_move2), most(off_plane),
+                       most(deviation2));
       return true;
     }
 

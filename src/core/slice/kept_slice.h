@@ -2,11 +2,11 @@
 // the static world in the same plane scan after scan: the plane's pose in each frame (ScanPlane's
 // normal and offset, kept to 44 bits) stays the same, bit for bit, while the robot drives and turns
 // in it (whatever ulps TF's composition of its pose moves it by), and so do the segments where the
-// frame's meshes cross it, in plane coordinates. Kept, with the primitives
-// that cross the plane, in one tree per frame, they make a planar cast a 2D problem (slice_walk.h):
-// no per-body work for what lies out of view, no triangle that misses the plane. The cast's result
-// is the same either way: the walk without a kept slice computes a segment's ends by the same steps
-// from the same vertices (slicer.h).
+// frame's meshes cross it, in plane coordinates. Kept, with the primitives that cross the plane, in
+// one tree per frame, they make a planar cast a 2D problem (slice_walk.h): no per-body work for
+// what lies out of view, no triangle that misses the plane. The cast's result is the same either
+// way: the walk without a kept slice computes a segment's ends by the same steps from the same
+// vertices (slicer.h).
 #pragma once
 
 #include <Eigen/Geometry>
