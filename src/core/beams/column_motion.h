@@ -29,10 +29,22 @@ inline double steepestElevation(const ScanPattern& pattern) {
 
 class ColumnMotion {
  public:
-  // A column's (or a row class's) pose relative to the reference: rotation and translation in 12
-  // doubles (an Isometry3d's 16 hold a constant last row): a calibrated Velodyne's sweep has
-  // 28,928 of them, written once and read by the walks, and their memory traffic is their cost.
+  // A column's pose relative to the reference: rotation and translation in 12 doubles (an
+  // Isometry3d's 16 hold a constant last row), written once and read by the walks, whose memory
+  // traffic is their cost.
   using Pose = Eigen::Transform<double, 3, Eigen::AffineCompact>;
+  // Where a row class's beams leave from relative to their column's pose (a Velodyne's laser fires
+  // a few microseconds after its sequence's first): the beam of class k at column c leaves from
+  // refFromColumn(c).translation() + offset along refFromColumn(c).linear() * rot * d. Between two
+  // pose samples the sensor turns at one rate about one axis (a slerp) and moves at one velocity,
+  // so every column between the same two samples whose class fires the same time after it shares
+  // one such delta: a sweep stores the columns' poses and a few deltas, not a pose for every
+  // class at every column (a calibrated Velodyne's 28,928 a turn, whose making and memory traffic
+  // were a tenth of a sweep's time).
+  struct ClassDelta {
+    Eigen::Matrix3d rot;     // in the column's sensor frame
+    Eigen::Vector3d offset;  // in the reference sensor frame
+  };
   // A block of columns [col_lo, col_lo + ref_from_column.size()); steepest: the largest angle of a
   // pattern direction from the horizontal (rad). extra_turn (rad): how far more the beams' rays may
   // turn from their pattern directions (a bundle's sub-rays, Caster::castBundle), added to the
@@ -41,21 +53,21 @@ class ColumnMotion {
                double extra_turn = 0);
   // Rows that leave at times of their own (a Velodyne's lasers, each at its place in the firing
   // sequence): the beam at (row, col) leaves from the pose of class class_of_row[row] (grid rows)
-  // at col, class 0 being ref_from_column, class k >= 1 ref_from_class[k - 1][col - col_lo]. The
-  // columns' poses above are class 0's; deviation() bounds how far any beam's origin lies from its
-  // column's, and the spread holds every class's poses.
+  // at col, class 0 being ref_from_column, class k >= 1 ref_from_class[k - 1][col - col_lo] (kept
+  // as each column's ClassDelta). The columns' poses above are class 0's; deviation() bounds how
+  // far any beam's origin lies from its column's, and the spread holds every class's poses.
   ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_column, double steepest,
                double extra_turn, std::vector<int> class_of_row,
-               std::vector<std::vector<Eigen::Isometry3d>> ref_from_class);
+               const std::vector<std::vector<Eigen::Isometry3d>>& ref_from_class);
   // How far a block's poses reach from the reference, gathered pose by pose (as they are written,
-  // with their values at hand, rather than read back: a calibrated Velodyne's block has 2,048).
+  // with their values at hand, rather than read back).
   struct Reach {
-    double shift2 = 0, frobenius2 = 0, z_move2 = 0, deviation2 = 0;
+    double shift2 = 0, frobenius2 = 0, z_move2 = 0;
     bool translations_only = true, in_plane = true;
     // Of the poses added by quaternion: the largest |v|^2 and |q|^2 (v its vector part), and the
     // largest |q.x|, |q.y| and |t.z| (0 exactly where every one turns about z alone and stays in
     // the xy plane). Only maxima, each pose's own test deferred to turnFrobenius2() and
-    // translationsOnly(): a calibrated Velodyne's block adds 2,048 poses.
+    // translationsOnly(): a sweep's block adds 128 poses.
     double v2 = 0, q2 = 0, off_plane = 0;
     // A pose, from its matrix.
     void add(const Pose& m) {
@@ -90,29 +102,29 @@ class ColumnMotion {
     }
     bool translationsOnly() const { return translations_only && v2 == 0; }
     bool inPlane() const { return in_plane && off_plane == 0; }
-    // Where a class's pose lies from its column's, whose own starts at column_origin.
-    void addDeviation(const Eigen::Vector3d& t, const Eigen::Vector3d& column_origin) {
-      deviation2 = std::max(deviation2, (t - column_origin).squaredNorm());
-    }
-    // The same quantities as add(q, r, t) and addDeviation take, already the largest of a few
-    // poses' (ColumnPoses::Relative::atPair gathers two at a time).
-    void addMaxima(double pose_shift2, double pose_v2, double pose_q2, double pose_z_move2,
-                   double pose_off_plane, double pose_deviation2) {
-      shift2 = std::max(shift2, pose_shift2);
-      v2 = std::max(v2, pose_v2);
-      q2 = std::max(q2, pose_q2);
-      z_move2 = std::max(z_move2, pose_z_move2);
-      off_plane = std::max(off_plane, pose_off_plane);
-      deviation2 = std::max(deviation2, pose_deviation2);
+    // Of the row classes' deltas from their columns' poses (ClassDelta): the largest |rot - I|_F,
+    // |rot e_z - e_z| and |offset|. A class's pose is its column's composed with its delta, so it
+    // turns, tilts and moves from the reference by at most the sums of the two (measure()).
+    double delta_turn = 0, delta_tilt = 0, delta_offset = 0;
+    bool deltas_identity = true, deltas_in_plane = true;
+    void addDelta(const ClassDelta& d) {
+      const Eigen::Matrix3d& r = d.rot;
+      delta_turn = std::max(delta_turn, (r - Eigen::Matrix3d::Identity()).norm());
+      delta_tilt = std::max(delta_tilt, (r.col(2) - Eigen::Vector3d::UnitZ()).norm());
+      delta_offset = std::max(delta_offset, d.offset.norm());
+      deltas_identity = deltas_identity && r == Eigen::Matrix3d::Identity();
+      deltas_in_plane = deltas_in_plane && r(0, 2) == 0 && r(1, 2) == 0 && r(2, 0) == 0 &&
+                        r(2, 1) == 0 && r(2, 2) == 1 && d.offset.z() == 0;
     }
   };
   // The same over poses the caller keeps while this lives (a sweep's, written in place block by
-  // block: CasterState::sweep_poses): class k's pose at column c is poses[k * stride + c - col_lo],
-  // for `columns` columns and `classes` classes (class_of_row empty if one); reach: every one of
-  // them added.
-  ColumnMotion(int col_lo, int columns, const Pose* poses, int stride, int classes,
-               const Reach& reach, double steepest, double extra_turn,
-               std::vector<int> class_of_row);
+  // block: CasterState::sweep_poses): column c's pose is poses[c - col_lo], for `columns` columns;
+  // with row classes (class_of_row not empty), class k's beams at column c leave from it moved by
+  // deltas[delta_set[c - col_lo] * classes + k] (class 0's the identity); reach: every column's
+  // pose and every delta added.
+  ColumnMotion(int col_lo, int columns, const Pose* poses, const Reach& reach, double steepest,
+               double extra_turn, std::vector<int> class_of_row = {},
+               std::vector<ClassDelta> deltas = {}, std::vector<int> delta_set = {});
   // Its poses may be its own: not copied (a move keeps them where they are).
   ColumnMotion(const ColumnMotion&) = delete;
   ColumnMotion& operator=(const ColumnMotion&) = delete;
@@ -130,11 +142,6 @@ class ColumnMotion {
   // its own origin: Caster::castBeams).
   bool translationsOnly() const { return translations_only_; }
 
-  // The pose the beam at (row, col) leaves from: its column's, or its row's class's.
-  LASER_RAYCAST_HOT_INLINE const Pose& refFromBeam(int row, int col) const {
-    if (class_of_row_.empty()) return refFromColumn(col);
-    return poses_[class_of_row_[row] * stride_ + (col - col_lo_)];
-  }
   // The most any beam's origin lies from its column's (0 without row classes).
   double deviation() const { return deviation_; }
 
@@ -145,7 +152,21 @@ class ColumnMotion {
   // Beam d at (row, col), from its row's class's pose.
   LASER_RAYCAST_HOT_INLINE Ray ray(int row, int col, const Eigen::Vector3d& d,
                                    double tmin) const {
-    return rayFrom(refFromBeam(row, col), d, tmin);
+    if (class_of_row_.empty()) return rayFrom(refFromColumn(col), d, tmin);
+    const Pose& m = refFromColumn(col);
+    const ClassDelta& x = deltaOf(row, col);
+    Ray r;
+    r.origin = m.translation() + x.offset;
+    r.dir = translations_only_ ? d : Eigen::Vector3d(m.linear() * (x.rot * d));
+    r.tmin = tmin;
+    return r;
+  }
+  // The direction of beam d at (row, col) in the reference sensor frame (ray(row, col, d).dir).
+  LASER_RAYCAST_HOT_INLINE Eigen::Vector3d direction(int row, int col,
+                                                     const Eigen::Vector3d& d) const {
+    if (translations_only_) return d;
+    if (class_of_row_.empty()) return refFromColumn(col).linear() * d;
+    return refFromColumn(col).linear() * (deltaOf(row, col).rot * d);
   }
   // A unit normal in the reference sensor frame as column col's sensor frame has it (the frame
   // ScanResult's normals are in).
@@ -156,7 +177,9 @@ class ColumnMotion {
   // The same in the frame of the beam at (row, col).
   Eigen::Vector3d toBeam(int row, int col, const Eigen::Vector3d& n) const {
     if (translations_only_) return n;
-    return refFromBeam(row, col).linear().transpose() * n;
+    const Eigen::Vector3d column_n = refFromColumn(col).linear().transpose() * n;
+    if (class_of_row_.empty()) return column_n;
+    return deltaOf(row, col).rot.transpose() * column_n;
   }
   // Each column's origin (refFromColumn(c).translation()) rounded to float, one array per axis,
   // for the columns from colLo() rounded down to a multiple of 4 to colHi() rounded up to one less
@@ -172,16 +195,20 @@ class ColumnMotion {
   }
 
  private:
-  Reach reachOf() const;
   // Sets the spread and the columns' origins from the poses' reach.
   void measure(const Reach& reach, double steepest, double extra_turn);
+
+  LASER_RAYCAST_HOT_INLINE const ClassDelta& deltaOf(int row, int col) const {
+    return deltas_[delta_set_[col - col_lo_] * classes_ + class_of_row_[row]];
+  }
 
   int col_lo_;
   int columns_;
   std::vector<Pose> own_;  // the poses, where they are this motion's own
-  const Pose* poses_;      // class k's column c at poses_[k * stride_ + c - col_lo_]
-  int stride_;
-  int classes_;
+  const Pose* poses_;      // column c's at poses_[c - col_lo_]
+  int classes_ = 1;
+  std::vector<ClassDelta> deltas_;  // by set and class
+  std::vector<int> delta_set_;      // by column
   Spread spread_;
   LASER_RAYCAST_HOT_INLINE Ray rayFrom(const Pose& m, const Eigen::Vector3d& d,
                                        double tmin) const {

@@ -149,8 +149,8 @@ struct CasterState {
     std::optional<SweepTimes> sweep_times[2];
   };
   std::optional<FittedList> fitted;
-  // A sweep's sensor poses at its columns (ColumnPoses' columns), each relative to its block's
-  // reference, kept from sweep to sweep (a calibrated Velodyne's turn has 28,928): the blocks'
+  // A sweep's sensor poses at its columns (ColumnPoses' columns; of a calibrated lidar's, row
+  // class 0's), each relative to its block's reference, kept from sweep to sweep: the blocks'
   // ColumnMotion of the frames that stay put are views of them.
   std::vector<ColumnMotion::Pose> sweep_poses;
   ColumnPoses::Storage sweep_columns;  // the ColumnPoses' of a sweep

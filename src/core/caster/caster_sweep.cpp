@@ -184,37 +184,83 @@ class BlockPlanner {
     return true;
   }
 
-  // The sensor's poses at each row class's columns lo..hi relative to the reference, written into
-  // the sweep's poses (their place there is their column's in poses_: blocks hold columns of their
-  // own, and a block that is halved is dropped before its halves write theirs).
+  // The sensor's poses at columns lo..hi relative to the reference, written into the sweep's
+  // poses (their place there is their column's in poses_: blocks hold columns of their own, and a
+  // block that is halved is dropped before its halves write theirs), and each row class's delta
+  // from them (ColumnMotion::ClassDelta).
   std::shared_ptr<const ColumnMotion> sensorMotion(int lo, int hi, int ref) const {
     const std::vector<Eigen::Vector3d>* origins = beams_.origins;
     auto origin = [origins](int c) { return origins ? &(*origins)[c] : nullptr; };
     ColumnPoses::Relative relative(poses_, column(0, ref), origin(ref));
-    // Row class k's pose at column c is out[column(k, c)]: class 0's at out[first + c].
+    // Column c's pose is out[first + c].
     ColumnMotion::Pose* const out = sweep_poses_->data();
-    const int first = column(0, 0), classes = beams_.classes, azimuths = pattern_.azimuthCount();
+    const int first = column(0, 0), classes = beams_.classes;
     ColumnMotion::Reach reach;
     for (int c = lo; c <= hi; ++c) relative.at(first + c, origin(c), &out[first + c], &reach);
-    // Class by class, each one's poses written in a row.
-    for (int k = 1; k < classes; ++k) {
-      const int row = first + k * azimuths;
-      for (int c = lo; c <= hi;) {
-        // Two columns at once where they allow it (no origins, both between the same samples).
-        if (!origins && c < hi &&
-            relative.atPair(row + c, &out[row + c], &reach, out[first + c], out[first + c + 1])) {
-          c += 2;
+    if (classes == 1) {
+      return std::make_shared<ColumnMotion>(lo, hi - lo + 1, &out[first + lo], reach, steepest_,
+                                            beams_.turn);
+    }
+    // The columns strictly between two samples whose classes are too, each at the same fraction
+    // of the samples' interval after its column (within kSameTime, the rounding of their times),
+    // share one set of deltas; any other column (a class beyond the next sample, at a sample, or
+    // beams from origins of their own) has its own, from its classes' poses.
+    std::vector<ColumnMotion::ClassDelta> deltas;
+    std::vector<int> delta_set(hi - lo + 1);
+    std::vector<double> sigma(classes, 0.0), shared_sigma(classes, 0.0);
+    int shared = -1;  // the set the previous column took from its pair, or -1
+    std::size_t shared_pair = 0;
+    double tolerance = 0;  // kSameTime as a fraction of the shared pair's interval
+    const std::vector<double>& sample_times = poses_.sampleTimes();
+    const ColumnMotion::ClassDelta identity{Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+    for (int c = lo; c <= hi; ++c) {
+      const ColumnPoses::Bracket& b = poses_.bracket(first + c);
+      bool between = !origins && b.j != b.i;
+      for (int k = 1; k < classes && between; ++k) {
+        const ColumnPoses::Bracket& bk = poses_.bracket(column(k, c));
+        between = bk.i == b.i && bk.j != bk.i;
+        sigma[k] = bk.s - b.s;
+      }
+      if (between && shared >= 0 && b.i == shared_pair) {
+        bool same = true;
+        for (int k = 1; k < classes && same; ++k) {
+          same = std::abs(sigma[k] - shared_sigma[k]) <= tolerance;
+        }
+        if (same) {
+          delta_set[c - lo] = shared;
           continue;
         }
-        const Eigen::Vector3d t = relative.at(row + c, origin(c), &out[row + c], &reach);
-        reach.addDeviation(t, out[first + c].translation());
-        ++c;
       }
+      const int set = static_cast<int>(deltas.size()) / classes;
+      delta_set[c - lo] = set;
+      deltas.push_back(identity);
+      if (between) {
+        for (int k = 1; k < classes; ++k) deltas.push_back(relative.classDelta(b, sigma[k]));
+        shared = set;
+        shared_pair = b.i;
+        shared_sigma = sigma;
+        tolerance = kSameTime / (sample_times[b.j] - sample_times[b.i]);
+      } else {
+        const ColumnMotion::Pose& m = out[first + c];
+        for (int k = 1; k < classes; ++k) {
+          ColumnMotion::Pose pose;
+          ColumnMotion::Reach unused;
+          relative.at(column(k, c), origin(c), &pose, &unused);
+          deltas.push_back(ColumnMotion::ClassDelta{m.linear().transpose() * pose.linear(),
+                                                    pose.translation() - m.translation()});
+        }
+        shared = -1;
+      }
+      for (int k = 1; k < classes; ++k) reach.addDelta(deltas[set * classes + k]);
     }
-    return std::make_shared<ColumnMotion>(lo, hi - lo + 1, &out[first + lo], azimuths, classes,
-                                          reach, steepest_, beams_.turn,
-                                          classes > 1 ? beams_.class_of_row : std::vector<int>());
+    return std::make_shared<ColumnMotion>(lo, hi - lo + 1, &out[first + lo], reach, steepest_,
+                                          beams_.turn, beams_.class_of_row, std::move(deltas),
+                                          std::move(delta_set));
   }
+  // How far apart two beams' times may be and still share a delta: a femtosecond, far below any
+  // motion's resolution (1e-13 rad at 100 rad/s) and far above the rounding of times within a
+  // second (2e-16 s).
+  static constexpr double kSameTime = 1e-15;  // s
 
   // The columns' beams from a sensor that does not move relative to the frame: each from its own
   // origin, relative to the reference's, with the sensor's axes (one class: the rows' times do not

@@ -2,8 +2,6 @@
 // (Caster::castSweep, and a calibrated lidar's columns in Caster::castBeamsSweep).
 #pragma once
 
-#include <emmintrin.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -64,6 +62,9 @@ class ColumnPoses {
 
   int columns() const { return static_cast<int>(times_.size()); }
   double time(int col) const { return times_[col]; }
+  // The samples the column lies between (i == j: at sample i, or beyond the samples).
+  const Bracket& bracket(int col) const { return brackets_[col]; }
+  const std::vector<double>& sampleTimes() const { return samples_.times; }
   bool sensorValid(int col) const { return sensor_valid_[col]; }
   // The sensor's pose at the column's time (sensorValid(col)).
   Eigen::Isometry3d sensor(int col) const {
@@ -122,87 +123,30 @@ class ColumnPoses {
       return t;
     }
 
-    // at() of columns col and col + 1 (no origins) at once, each lane of SSE2's two doubles one
-    // column's, the same operations in the same order (so the same bits); false (nothing written)
-    // unless both lie strictly between the same two samples. Writes their poses into out[0] and
-    // out[1], adds them to *reach, and each one's deviation from its column's own pose (column0's
-    // and column1's origins).
-    LASER_RAYCAST_HOT_INLINE bool atPair(int col, ColumnMotion::Pose* out,
-                                         ColumnMotion::Reach* reach,
-                                         const ColumnMotion::Pose& column0,
-                                         const ColumnMotion::Pose& column1) {
-      const Bracket& b0 = poses_.brackets_[col];
-      const Bracket& b1 = poses_.brackets_[col + 1];
-      if (b0.j == b0.i || b1.j == b1.i || b0.i != b1.i) return false;
-      if (b0.i != pair_) enterPair(b0);
-      __m128d w0, w1;
-      poses_.sample_rotation_.weightsPair(b0, b1, &w0, &w1);
-      auto blend = [&](double a, double c) {
-        return _mm_add_pd(_mm_mul_pd(w0, _mm_set1_pd(a)), _mm_mul_pd(w1, _mm_set1_pd(c)));
-      };
-      const __m128d qw = blend(p_.w(), q_.w()), qx = blend(p_.x(), q_.x()),
-                    qy = blend(p_.y(), q_.y()), qz = blend(p_.z(), q_.z());
-      const __m128d s = _mm_set_pd(b1.s, b0.s);
-      auto along = [&](int k) {
-        return _mm_add_pd(_mm_set1_pd(alpha_[k]), _mm_mul_pd(s, _mm_set1_pd(beta_[k])));
-      };
-      const __m128d t0 = along(0), t1 = along(1), t2 = along(2);
-      // rotationOf, lane by lane.
-      const __m128d two = _mm_set1_pd(2), one = _mm_set1_pd(1);
-      const __m128d tx = _mm_mul_pd(two, qx), ty = _mm_mul_pd(two, qy), tz = _mm_mul_pd(two, qz);
-      const __m128d twx = _mm_mul_pd(tx, qw), twy = _mm_mul_pd(ty, qw), twz = _mm_mul_pd(tz, qw);
-      const __m128d txx = _mm_mul_pd(tx, qx), txy = _mm_mul_pd(ty, qx), txz = _mm_mul_pd(tz, qx);
-      const __m128d tyy = _mm_mul_pd(ty, qy), tyz = _mm_mul_pd(tz, qy), tzz = _mm_mul_pd(tz, qz);
-      // The pose's 12 doubles, column-major as AffineCompact keeps them.
-      const __m128d m[12] = {_mm_sub_pd(one, _mm_add_pd(tyy, tzz)),  // (0, 0)
-                             _mm_add_pd(txy, twz),                   // (1, 0)
-                             _mm_sub_pd(txz, twy),                   // (2, 0)
-                             _mm_sub_pd(txy, twz),                   // (0, 1)
-                             _mm_sub_pd(one, _mm_add_pd(txx, tzz)),  // (1, 1)
-                             _mm_add_pd(tyz, twx),                   // (2, 1)
-                             _mm_add_pd(txz, twy),                   // (0, 2)
-                             _mm_sub_pd(tyz, twx),                   // (1, 2)
-                             _mm_sub_pd(one, _mm_add_pd(txx, tyy)),  // (2, 2)
-                             t0,
-                             t1,
-                             t2};
-      double* d0 = out[0].data();
-      double* d1 = out[1].data();
-      for (int k = 0; k < 12; ++k) {
-        _mm_storel_pd(d0 + k, m[k]);
-        _mm_storeh_pd(d1 + k, m[k]);
-      }
-      // Reach::add(q, r, t) of each, and addDeviation.
-      auto sq = [](__m128d x) { return _mm_mul_pd(x, x); };
-      const __m128d shift2 = _mm_add_pd(_mm_add_pd(sq(t0), sq(t1)), sq(t2));
-      const __m128d v2 = _mm_add_pd(_mm_add_pd(sq(qx), sq(qy)), sq(qz));
-      const __m128d q2 = _mm_add_pd(sq(qw), v2);
-      const __m128d z_move2 = _mm_add_pd(_mm_add_pd(sq(m[6]), sq(m[7])), sq(_mm_sub_pd(m[8], one)));
-      const __m128d sign = _mm_set1_pd(-0.0);
-      const __m128d off_plane = _mm_max_pd(
-          _mm_max_pd(_mm_andnot_pd(sign, qx), _mm_andnot_pd(sign, qy)), _mm_andnot_pd(sign, t2));
-      auto column = [&](int k) {
-        return _mm_set_pd(column1.translation()[k], column0.translation()[k]);
-      };
-      const __m128d deviation2 =
-          _mm_add_pd(_mm_add_pd(sq(_mm_sub_pd(t0, column(0))), sq(_mm_sub_pd(t1, column(1)))),
-                     sq(_mm_sub_pd(t2, column(2))));
-      auto most = [](__m128d x) {
-        return std::max(_mm_cvtsd_f64(x), _mm_cvtsd_f64(_mm_unpackhi_pd(x, x)));
-      };
-      reach->addMaxima(most(shift2), most(v2), most(q2), most(z_move2), most(off_plane),
-                       most(deviation2));
-      return true;
+    // How a row class that fires `sigma` of the samples' interval after its column turns and moves
+    // from the column's pose, for every column strictly between bracket b's samples whose class
+    // is too (ColumnMotion::ClassDelta): between two samples the slerp turns at one rate about one
+    // axis, q(s + sigma) = q(s) conj(q_a) slerp(q_a, q_b, sigma), and the translation moves
+    // sigma (t_b - t_a), here in the reference's frame.
+    ColumnMotion::ClassDelta classDelta(const Bracket& b, double sigma) {
+      if (b.i != pair_) enterPair(b);
+      double scale0, scale1;
+      poses_.sample_rotation_.weights(Bracket{b.i, b.j, sigma}, &scale0, &scale1);
+      Eigen::Quaterniond r(scale1 * step_.coeffs());
+      r.w() += scale0;  // scale0 conj(q_a) q_a, q_a a unit quaternion
+      return ColumnMotion::ClassDelta{rotationOf(r), sigma * beta_};
     }
 
    private:
-    // The products of the bracket's two samples that its columns share (p_, q_, alpha_, beta_).
+    // The products of the bracket's two samples that its columns share (p_, q_, step_, alpha_,
+    // beta_).
     void enterPair(const Bracket& b) {
       pair_ = b.i;
       const Rotations& rotation = poses_.sample_rotation_;
       const std::vector<Eigen::Isometry3d>& pose = poses_.samples_.world_from_sensor;
       p_ = q_ref_conj_ * rotation.sample(b.i);
       q_ = q_ref_conj_ * rotation.sample(b.j);
+      step_ = rotation.sample(b.i).conjugate() * rotation.sample(b.j);
       const Eigen::Vector3d& ta = pose[b.i].translation();
       alpha_ = ref_rot_t_ * (ta - world_from_ref_.translation());
       beta_ = ref_rot_t_ * (pose[b.j].translation() - ta);
@@ -213,7 +157,7 @@ class ColumnPoses {
     Eigen::Matrix3d ref_rot_t_;
     Eigen::Quaterniond q_ref_conj_;
     std::size_t pair_ = std::numeric_limits<std::size_t>::max();  // the sample pair p_.. are of
-    Eigen::Quaterniond p_, q_;
+    Eigen::Quaterniond p_, q_, step_;
     Eigen::Vector3d alpha_, beta_;
   };
   const std::vector<int>& framesWithBodies() const { return frames_; }
@@ -285,34 +229,6 @@ class ColumnPoses {
         *scale1 = smallSin(t * arc.theta) * arc.inv_sin_theta;
       }
       if (arc.flip) *scale1 = -*scale1;
-    }
-    // weights() of two brackets between the same two samples, a lane each.
-    void weightsPair(const Bracket& b0, const Bracket& b1, __m128d* scale0, __m128d* scale1) const {
-      const Arc& arc = arc_[b0.i];
-      const __m128d t = _mm_set_pd(b1.s, b0.s), one = _mm_set1_pd(1);
-      if (arc.linear) {
-        *scale0 = _mm_sub_pd(one, t);
-        *scale1 = t;
-      } else if (arc.terms == 3) {
-        // sin3, lane by lane.
-        const __m128d theta = _mm_set1_pd(arc.theta), inv = _mm_set1_pd(arc.inv_sin_theta);
-        auto sine = [&](__m128d x) {
-          const __m128d x2 = _mm_mul_pd(x, x);
-          const __m128d inner =
-              _mm_add_pd(_mm_set1_pd(-1.0 / 6), _mm_mul_pd(x2, _mm_set1_pd(1.0 / 120)));
-          return _mm_mul_pd(x, _mm_add_pd(one, _mm_mul_pd(x2, inner)));
-        };
-        *scale0 = _mm_mul_pd(sine(_mm_mul_pd(_mm_sub_pd(one, t), theta)), inv);
-        *scale1 = _mm_mul_pd(sine(_mm_mul_pd(t, theta)), inv);
-      } else {
-        double s0[2], s1[2];
-        weights(b0, &s0[0], &s1[0]);
-        weights(b1, &s0[1], &s1[1]);
-        *scale0 = _mm_loadu_pd(s0);
-        *scale1 = _mm_loadu_pd(s1);
-        return;  // flipped there
-      }
-      if (arc.flip) *scale1 = _mm_xor_pd(*scale1, _mm_set1_pd(-0.0));
     }
     // Sample k's quaternion (k or k - 1 must have its arc used).
     const Eigen::Quaterniond& sample(std::size_t k) const { return q_[k]; }

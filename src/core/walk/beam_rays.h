@@ -48,8 +48,7 @@ class BeamRays {
   // through small boxes enter many more of them.)
   WideBoxRay boxRayAlong(int row, int col, const Eigen::Vector3d& d) const {
     if (!motion_) return WideBoxRay(origin_, active_.body_from_sensor_rot * d);
-    const ColumnMotion::Pose& pose = motion_->refFromBeam(row, col);
-    const Eigen::Vector3d dir = active_.body_from_sensor_rot * (pose.linear() * d);
+    const Eigen::Vector3d dir = active_.body_from_sensor_rot * motion_->direction(row, col, d);
     if (shift_ == 0) return WideBoxRay(origin_, dir);
     return WideBoxRay(originOf(motion_->refFromColumn(col)), dir);
   }
