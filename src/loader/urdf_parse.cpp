@@ -3,9 +3,13 @@
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include <algorithm>
 #include <exception>
 #include <mutex>
 #include <regex>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "laser_raycast/loader/errors.h"
 
@@ -15,16 +19,18 @@ namespace {
 // Collects what urdfdom reports through console_bridge while it parses: that is the only place
 // it says why a parse failed, and it drops a <visual> or <collision> it cannot parse (a "nan" size,
 // an empty <geometry>) without failing the parse. Errors are kept; the rest goes on to the
-// previous handler.
+// previous handler. Silent: console_bridge formats and reports nothing while this lives.
 class UrdfParseLog : public console_bridge::OutputHandler {
  public:
-  UrdfParseLog()
+  explicit UrdfParseLog(bool silent = false)
       : lock_(mutex()),
         previous_(console_bridge::getOutputHandler()),
         previous_level_(console_bridge::getLogLevel()) {
     console_bridge::useOutputHandler(this);
-    // Errors must reach us even if the application silenced console_bridge.
-    if (previous_level_ > console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+    if (silent) {
+      console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
+    } else if (previous_level_ > console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+      // Errors must reach us even if the application silenced console_bridge.
       console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_ERROR);
     }
   }
@@ -66,21 +72,46 @@ class UrdfParseLog : public console_bridge::OutputHandler {
 // one character of a name).
 constexpr std::size_t kTinyXmlOverread = 16;
 
+// urdfdom's parse of xml, or null with the exception's message added to *errors.
+urdf::ModelInterfaceSharedPtr tryParse(const std::string& xml, std::vector<std::string>* errors) {
+  try {
+    // TinyXML 2.6.2 (under urdfdom) can read a few bytes past the terminator when the text ends
+    // inside a UTF-8 sequence in a name (found by test/fuzz/fuzz_urdf_loader under
+    // AddressSanitizer): terminators to spare keep those reads inside the buffer.
+    return urdf::parseURDF(xml + std::string(kTinyXmlOverread, '\0'));
+  } catch (const std::exception& e) {
+    errors->push_back(e.what());
+    return nullptr;
+  }
+}
+
 }  // namespace
 
 urdf::ModelInterfaceSharedPtr parseUrdf(const std::string& xml, const std::string& source,
                                         DroppedElements* dropped) {
   urdf::ModelInterfaceSharedPtr model;
   std::vector<std::string> errors;
+  // urdfdom hands some of the text it cannot read to console_bridge as the format of its message
+  // (an origin's xyz holding "%n" made vsnprintf write through a null pointer: found by
+  // test/fuzz/fuzz_urdf_loader). Text with a '%' is therefore parsed with console_bridge silent,
+  // and what urdfdom says of it is taken from a second parse of a copy whose '%' are '_', which
+  // reads and fails alike: a '%' is never part of a number, and any other text urdfdom only keeps.
+  const bool percent = xml.find('%') != std::string::npos;
+  if (percent) {
+    UrdfParseLog silent(true);
+    model = tryParse(xml, &errors);
+  }
+  std::string safe;
+  if (percent) {
+    safe = xml;
+    std::replace(safe.begin(), safe.end(), '%', '_');
+  }
   UrdfParseLog log;
-  try {
-    // TinyXML 2.6.2 (under urdfdom) can read a few bytes past the terminator when the text ends
-    // inside a UTF-8 sequence in a name (found by test/fuzz/fuzz_urdf_loader under
-    // AddressSanitizer): terminators to spare keep those reads inside the buffer.
-    model = urdf::parseURDF(xml + std::string(kTinyXmlOverread, '\0'));
-  } catch (const std::exception& e) {
-    model.reset();
-    errors.push_back(e.what());
+  if (percent) {
+    std::vector<std::string> unused;
+    tryParse(safe, &unused);
+  } else {
+    model = tryParse(xml, &errors);
   }
   // urdfdom logs the reasons first, then "Could not parse visual element for Link [name]".
   static const std::regex kDropped(
@@ -104,6 +135,21 @@ urdf::ModelInterfaceSharedPtr parseUrdf(const std::string& xml, const std::strin
     throw SceneLoadError(msg);
   }
   for (const std::string& text : reasons) log.forward(text);  // not ours to judge
+  if (percent && !dropped->empty()) {
+    // The copy's link names have '_' for '%': each dropped element under its link's own name.
+    DroppedElements own;
+    for (auto& [key, why] : *dropped) {
+      std::string link = key.first;
+      for (const auto& [name, unused] : model->links_) {
+        std::string copy = name;
+        std::replace(copy.begin(), copy.end(), '%', '_');
+        if (copy == key.first) link = name;
+      }
+      std::vector<std::string>& to = own[{link, key.second}];
+      to.insert(to.end(), why.begin(), why.end());
+    }
+    *dropped = std::move(own);
+  }
   return model;
 }
 

@@ -145,6 +145,47 @@ TEST_F(SceneLoaderTest, DroppedElementsAreFoundWhenConsoleBridgeIsSilenced) {
   console_bridge::setLogLevel(level);
 }
 
+// Regression (found by test/fuzz/fuzz_urdf_loader): urdfdom passes text it cannot read to
+// console_bridge as the format of its message, and "%n" in an origin's xyz crashed the loader in
+// vsnprintf. Such text is an error (or with skip_bad_geometry a warning) naming the link, as
+// urdfdom says it with '_' for '%', under the link's own name; '%' elsewhere (a link's name) loads.
+TEST_F(SceneLoaderTest, PercentSignsInTheUrdfAreNeverAFormat) {
+  const std::string bad_origin =
+      "<origin xyz=\"0 %n%n%n%n%s%s%p 0\"/><geometry><box size=\"1 1 1\"/></geometry>";
+  for (const std::string link : {"bad", "bad%n%s"}) {
+    SCOPED_TRACE(link);
+    const std::string xml =
+        robot(boxLink("good") + visualLink(link, bad_origin) + joint("j", "fixed", "good", link));
+    core::Scene scene;
+    try {
+      loader_.addUrdfString(xml, "", {}, &scene, "the test URDF");
+      ADD_FAILURE() << "no exception";
+    } catch (const SceneLoadError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("the test URDF"), std::string::npos) << what;
+      EXPECT_NE(what.find("'" + link + "'"), std::string::npos) << what;
+      EXPECT_NE(what.find("_n_n_n_n_s_s_p"), std::string::npos) << what;
+    }
+    LoaderOptions options;
+    options.skip_bad_geometry = true;
+    const LoadedModel model = loader_.addUrdfString(xml, "", options, &scene, "the test URDF");
+    EXPECT_EQ(model.bodies, 1u);
+    ASSERT_EQ(model.warnings.size(), 1u);
+    EXPECT_NE(model.warnings[0].find("'" + link + "'"), std::string::npos) << model.warnings[0];
+  }
+  core::Scene scene;
+  const LoadedModel model = loader_.addUrdfString(
+      robot(boxLink("wheel%n%s") + boxLink("b") + joint("j", "fixed", "wheel%n%s", "b")), "", {},
+      &scene);
+  EXPECT_EQ(model.bodies, 2u);
+  EXPECT_TRUE(model.warnings.empty());
+  ASSERT_EQ(scene.bodies().size(), 2u);
+  EXPECT_EQ(scene.labels()[scene.bodies()[0].label], "wheel%n%s");
+  // Malformed with a '%': an error naming the source.
+  EXPECT_THROW(loader_.addUrdfString("<robot name=\"%n%s\"><link name=\"%n\"", "", {}, &scene),
+               SceneLoadError);
+}
+
 TEST_F(SceneLoaderTest, UnreadableMeshIsAnError) {
   if (::geteuid() == 0) GTEST_SKIP() << "root reads any file";
   const std::string path = writeFile("unreadable.stl", "solid x\nendsolid x\n");
