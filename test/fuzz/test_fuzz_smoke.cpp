@@ -5,8 +5,10 @@
 // same way every time), so a test run, CI's included, checks the inputs that the last passing run
 // checked, and a new finding comes from a long run (docs/testing.md), not as a failure of an
 // unrelated change. A time bound (60 s per harness with start-up) stops a slow machine early: it
-// then checks a prefix of the same inputs. Without clang the harnesses are not built and these
-// tests are skipped, unless LASER_RAYCAST_REQUIRE_FUZZ=1 (CI, .ci/run) makes that a failure.
+// then checks a prefix of the same inputs (so a faster machine can reach an input no earlier run
+// did, and find there what a long run would have: the '%n' in a URDF of 2026-11-29). Without
+// clang the harnesses are not built and these tests are skipped, unless
+// LASER_RAYCAST_REQUIRE_FUZZ=1 (CI, .ci/run) makes that a failure.
 //
 // LASER_RAYCAST_FUZZ_SEED=N picks another seed (0: a random one, libFuzzer's choice);
 // LASER_RAYCAST_FUZZ_RUNS=N and LASER_RAYCAST_FUZZ_SECONDS=N set the number of inputs and the time
