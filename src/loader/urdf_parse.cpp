@@ -101,13 +101,10 @@ urdf::ModelInterfaceSharedPtr parseUrdf(const std::string& xml, const std::strin
     UrdfParseLog silent(true);
     model = tryParse(xml, &errors);
   }
-  std::string safe;
-  if (percent) {
-    safe = xml;
-    std::replace(safe.begin(), safe.end(), '%', '_');
-  }
   UrdfParseLog log;
   if (percent) {
+    std::string safe = xml;
+    std::replace(safe.begin(), safe.end(), '%', '_');
     std::vector<std::string> unused;
     tryParse(safe, &unused);
   } else {

@@ -28,13 +28,10 @@ ColumnMotion::ColumnMotion(int col_lo, std::vector<Eigen::Isometry3d> ref_from_c
     // Each column's deltas of its own: its classes' poses taken relative to its pose.
     deltas_.reserve(static_cast<std::size_t>(columns_) * classes_);
     for (int c = 0; c < columns_; ++c) {
-      const Pose& m = poses_[c];
       delta_set_.push_back(c);
-      deltas_.push_back(ClassDelta{Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()});
+      deltas_.push_back(ClassDelta::identity());
       for (const auto& poses_of_class : ref_from_class) {
-        const Eigen::Isometry3d& k = poses_of_class[c];
-        deltas_.push_back(
-            ClassDelta{m.linear().transpose() * k.linear(), k.translation() - m.translation()});
+        deltas_.push_back(ClassDelta::between(poses_[c], poses_of_class[c]));
         reach.addDelta(deltas_.back());
       }
     }

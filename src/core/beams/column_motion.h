@@ -44,6 +44,16 @@ class ColumnMotion {
   struct ClassDelta {
     Eigen::Matrix3d rot;     // in the column's sensor frame
     Eigen::Vector3d offset;  // in the reference sensor frame
+    // Class 0's: the column's own pose.
+    static ClassDelta identity() {
+      return ClassDelta{Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+    }
+    // A class's pose (relative to the reference) taken relative to its column's.
+    template <class ColumnPose, class ClassPose>
+    static ClassDelta between(const ColumnPose& column, const ClassPose& pose) {
+      return ClassDelta{column.linear().transpose() * pose.linear(),
+                        pose.translation() - column.translation()};
+    }
   };
   // A block of columns [col_lo, col_lo + ref_from_column.size()); steepest: the largest angle of a
   // pattern direction from the horizontal (rad). extra_turn (rad): how far more the beams' rays may

@@ -212,7 +212,6 @@ class BlockPlanner {
     std::size_t shared_pair = 0;
     double tolerance = 0;  // kSameTime as a fraction of the shared pair's interval
     const std::vector<double>& sample_times = poses_.sampleTimes();
-    const ColumnMotion::ClassDelta identity{Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
     for (int c = lo; c <= hi; ++c) {
       const ColumnPoses::Bracket& b = poses_.bracket(first + c);
       bool between = !origins && b.j != b.i;
@@ -233,7 +232,7 @@ class BlockPlanner {
       }
       const int set = static_cast<int>(deltas.size()) / classes;
       delta_set[c - lo] = set;
-      deltas.push_back(identity);
+      deltas.push_back(ColumnMotion::ClassDelta::identity());
       if (between) {
         for (int k = 1; k < classes; ++k) deltas.push_back(relative.classDelta(b, sigma[k]));
         shared = set;
@@ -241,13 +240,11 @@ class BlockPlanner {
         shared_sigma = sigma;
         tolerance = kSameTime / (sample_times[b.j] - sample_times[b.i]);
       } else {
-        const ColumnMotion::Pose& m = out[first + c];
         for (int k = 1; k < classes; ++k) {
           ColumnMotion::Pose pose;
           ColumnMotion::Reach unused;
           relative.at(column(k, c), origin(c), &pose, &unused);
-          deltas.push_back(ColumnMotion::ClassDelta{m.linear().transpose() * pose.linear(),
-                                                    pose.translation() - m.translation()});
+          deltas.push_back(ColumnMotion::ClassDelta::between(out[first + c], pose));
         }
         shared = -1;
       }
