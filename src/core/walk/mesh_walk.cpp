@@ -4,7 +4,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <new>
 #include <optional>
+#include <type_traits>
 
 #include "accel/wide_bvh.h"
 #include "beams/column_motion.h"
@@ -396,7 +398,8 @@ class MeshWalk {
   // Each triangle of the leaf against the open beams of the leaf's window: column by column
   // through a conservative float test of its edge planes and its plane (ColumnRaster, widened by a
   // sweep block's spread), or for patterns too steep for it row by row (EdgeFilter; for a sweep's
-  // block, the triangle's own window instead), then the exact test for the beams let through.
+  // block, the triangle's own window instead), then the exact test for the beams let through
+  // (TriangleBatch: their rays made a batch at a time, then tested).
   void rasterLeaf(const Entry& e) {
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
       if (hidden(slot)) continue;
@@ -404,6 +407,7 @@ class MeshWalk {
       const std::uint32_t triangle = ids_[slot];
       std::optional<SubRayFilter> filter;
       if (bundle_ && sub_rays_from_origin_) filter.emplace(s.a, s.b, s.c);
+      TriangleBatch batch(*this, s, triangle);
       auto test = [&](int row, int col) {
         // The range rounded up to float (compact, so cheaper to read here than the result's): a
         // hit it lets through beyond the exact range is turned down by keepNearestHit().
@@ -412,20 +416,11 @@ class MeshWalk {
         if (bundle_) {
           for (int j = beams_.subBegin(row, col), end = beams_.subEnd(row, col); j < end; ++j) {
             if (filter && filter->misses(beams_.subDirection(j))) continue;
-            const auto hit =
-                rays_.subRay(j, row, col)
-                    .intersect(s.a, s.b, s.c, std::min(config_.tmax, beams_.subRange(j)));
-            if (!hit) continue;
-            beams_.keepNearestSubHit(j, row, col, hit->t, active_.index, static_cast<int>(triangle),
-                                     [&] { return beamNormal(row, col, triangle); });
+            batch.add(row, col, j, std::min(config_.tmax, beams_.subRange(j)));
           }
           return;
         }
-        const auto hit =
-            rays_.beamRay(row, col).intersect(s.a, s.b, s.c, std::min(config_.tmax, range));
-        if (!hit) return;
-        beams_.keepNearestHit(row, col, hit->t, active_.index, static_cast<int>(triangle),
-                              [&] { return beamNormal(row, col, triangle); });
+        batch.add(row, col, -1, std::min(config_.tmax, range));
       };
       if (beams_.grid().columnRaster()) {
         (motion_ ? ColumnRaster(beams_, s.a, s.b, s.c, *motion_, e.near)
@@ -434,14 +429,67 @@ class MeshWalk {
       } else if (motion_) {
         forEachInWindow(s, e.rect, test);
       } else {
-        const EdgeFilter filter(s.a, s.b, s.c);
+        const EdgeFilter edges(s.a, s.b, s.c);
         for (int row = e.rect.row_lo; row <= e.rect.row_hi; ++row) {
-          filter.forEachCandidate(beams_, row, e.rect.col_lo, e.rect.col_hi,
-                                  [&](int col) { test(row, col); });
+          edges.forEachCandidate(beams_, row, e.rect.col_lo, e.rect.col_hi,
+                                 [&](int col) { test(row, col); });
         }
       }
+      batch.flush();
     }
   }
+
+  // The exact tests of one triangle with the beams (or sub-rays) a raster lets through, kBatch at
+  // a time: each beam's ray made first (a division's latency each, which the next beam's need not
+  // wait for), then tested, each hit offered as it would be one beam at a time. A beam meets the
+  // triangle once, so deferring its test changes nothing another beam reads.
+  class TriangleBatch {
+   public:
+    TriangleBatch(MeshWalk& walk, const SensorTriangle& s, std::uint32_t triangle)
+        : walk_(walk), s_(s), triangle_(triangle) {}
+    // The beam at (row, col), or its sub-ray sub (>= 0), out to tmax.
+    LASER_RAYCAST_HOT_INLINE void add(int row, int col, int sub, double tmax) {
+      pending_[n_++] = Pending{row, col, sub, tmax};
+      if (n_ == kBatch) flush();
+    }
+    void flush() {
+      Ray* rays = reinterpret_cast<Ray*>(storage_);
+      for (int i = 0; i < n_; ++i) {
+        const Pending& p = pending_[i];
+        new (&rays[i]) Ray(p.sub < 0 ? walk_.rays_.beamRay(p.row, p.col)
+                                     : walk_.rays_.subRay(p.sub, p.row, p.col));
+      }
+      for (int i = 0; i < n_; ++i) {
+        const Pending& p = pending_[i];
+        const auto hit = rays[i].intersect(s_.a, s_.b, s_.c, p.tmax);
+        if (!hit) continue;
+        const int row = p.row, col = p.col;
+        auto normal = [&] { return walk_.beamNormal(row, col, triangle_); };
+        const int body = walk_.active_.index, triangle = static_cast<int>(triangle_);
+        if (p.sub < 0) {
+          walk_.beams_.keepNearestHit(row, col, hit->t, body, triangle, normal);
+        } else {
+          walk_.beams_.keepNearestSubHit(p.sub, row, col, hit->t, body, triangle, normal);
+        }
+      }
+      n_ = 0;
+    }
+
+   private:
+    using Ray = PreparedRay<double, M>;
+    static_assert(std::is_trivially_destructible_v<Ray>, "the batch's rays are never destroyed");
+    static constexpr int kBatch = 16;
+    struct Pending {
+      int row, col, sub;
+      double tmax;
+    };
+    MeshWalk& walk_;
+    const SensorTriangle& s_;
+    const std::uint32_t triangle_;
+    int n_ = 0;
+    Pending pending_[kBatch];
+    alignas(Ray) unsigned char storage_[kBatch * sizeof(Ray)];
+  };
 
   // The beams of rect in the triangle's own window (the view of its sensor-frame box, widened by
   // the sweep block's spread): f(row, col) for each.
