@@ -4,9 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <new>
 #include <optional>
-#include <type_traits>
 
 #include "accel/wide_bvh.h"
 #include "beams/column_motion.h"
@@ -19,6 +17,7 @@
 #include "walk/body_triangles.h"
 #include "walk/slot_cache.h"
 #include "walk/sub_ray_filter.h"
+#include "walk/triangle_batch.h"
 
 namespace laser_raycast {
 namespace core {
@@ -399,7 +398,7 @@ class MeshWalk {
   // through a conservative float test of its edge planes and its plane (ColumnRaster, widened by a
   // sweep block's spread), or for patterns too steep for it row by row (EdgeFilter; for a sweep's
   // block, the triangle's own window instead), then the exact test for the beams let through
-  // (TriangleBatch: their rays made a batch at a time, then tested).
+  // (walk/triangle_batch.h: their rays made a batch at a time, then tested).
   void rasterLeaf(const Entry& e) {
     for (std::uint32_t slot = e.ref.index; slot < e.ref.index + e.ref.count; ++slot) {
       if (hidden(slot)) continue;
@@ -407,7 +406,8 @@ class MeshWalk {
       const std::uint32_t triangle = ids_[slot];
       std::optional<SubRayFilter> filter;
       if (bundle_ && sub_rays_from_origin_) filter.emplace(s.a, s.b, s.c);
-      TriangleBatch batch(*this, s, triangle);
+      TriangleBatch batch(beams_, rays_, s, active_.index, static_cast<int>(triangle),
+                          [&](int row, int col) { return beamNormal(row, col, triangle); });
       auto test = [&](int row, int col) {
         // The range rounded up to float (compact, so cheaper to read here than the result's): a
         // hit it lets through beyond the exact range is turned down by keepNearestHit().
@@ -438,58 +438,6 @@ class MeshWalk {
       batch.flush();
     }
   }
-
-  // The exact tests of one triangle with the beams (or sub-rays) a raster lets through, kBatch at
-  // a time: each beam's ray made first (a division's latency each, which the next beam's need not
-  // wait for), then tested, each hit offered as it would be one beam at a time. A beam meets the
-  // triangle once, so deferring its test changes nothing another beam reads.
-  class TriangleBatch {
-   public:
-    TriangleBatch(MeshWalk& walk, const SensorTriangle& s, std::uint32_t triangle)
-        : walk_(walk), s_(s), triangle_(triangle) {}
-    // The beam at (row, col), or its sub-ray sub (>= 0), out to tmax.
-    LASER_RAYCAST_HOT_INLINE void add(int row, int col, int sub, double tmax) {
-      pending_[n_++] = Pending{row, col, sub, tmax};
-      if (n_ == kBatch) flush();
-    }
-    void flush() {
-      Ray* rays = reinterpret_cast<Ray*>(storage_);
-      for (int i = 0; i < n_; ++i) {
-        const Pending& p = pending_[i];
-        new (&rays[i]) Ray(p.sub < 0 ? walk_.rays_.beamRay(p.row, p.col)
-                                     : walk_.rays_.subRay(p.sub, p.row, p.col));
-      }
-      for (int i = 0; i < n_; ++i) {
-        const Pending& p = pending_[i];
-        const auto hit = rays[i].intersect(s_.a, s_.b, s_.c, p.tmax);
-        if (!hit) continue;
-        const int row = p.row, col = p.col;
-        auto normal = [&] { return walk_.beamNormal(row, col, triangle_); };
-        const int body = walk_.active_.index, triangle = static_cast<int>(triangle_);
-        if (p.sub < 0) {
-          walk_.beams_.keepNearestHit(row, col, hit->t, body, triangle, normal);
-        } else {
-          walk_.beams_.keepNearestSubHit(p.sub, row, col, hit->t, body, triangle, normal);
-        }
-      }
-      n_ = 0;
-    }
-
-   private:
-    using Ray = PreparedRay<double, M>;
-    static_assert(std::is_trivially_destructible_v<Ray>, "the batch's rays are never destroyed");
-    static constexpr int kBatch = 16;
-    struct Pending {
-      int row, col, sub;
-      double tmax;
-    };
-    MeshWalk& walk_;
-    const SensorTriangle& s_;
-    const std::uint32_t triangle_;
-    int n_ = 0;
-    Pending pending_[kBatch];
-    alignas(Ray) unsigned char storage_[kBatch * sizeof(Ray)];
-  };
 
   // The beams of rect in the triangle's own window (the view of its sensor-frame box, widened by
   // the sweep block's spread): f(row, col) for each.
