@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <map>
 #include <mutex>
 #include <regex>
 #include <string>
@@ -110,6 +111,16 @@ urdf::ModelInterfaceSharedPtr parseUrdf(const std::string& xml, const std::strin
   } else {
     model = tryParse(xml, &errors);
   }
+  // What urdfdom said came from the copy, whose link names have '_' for '%': each link's own name
+  // by its copy's, to file a dropped element under.
+  std::map<std::string, std::string> own_name;
+  if (percent && model) {
+    for (const auto& [name, unused] : model->links_) {
+      std::string copy = name;
+      std::replace(copy.begin(), copy.end(), '%', '_');
+      own_name[copy] = name;
+    }
+  }
   // urdfdom logs the reasons first, then "Could not parse visual element for Link [name]".
   static const std::regex kDropped(
       "Could not parse (visual|collision) element for Link \\[(.*)\\]");
@@ -119,7 +130,9 @@ urdf::ModelInterfaceSharedPtr parseUrdf(const std::string& xml, const std::strin
     if (model && std::regex_search(text, match, kDropped)) {
       std::string why;
       for (const std::string& reason : reasons) why += (why.empty() ? "" : "; ") + reason;
-      (*dropped)[{match[2].str(), match[1].str()}].push_back(why.empty() ? text : why);
+      const auto own = own_name.find(match[2].str());
+      const std::string link = own == own_name.end() ? match[2].str() : own->second;
+      (*dropped)[{link, match[1].str()}].push_back(why.empty() ? text : why);
       reasons.clear();
     } else {
       reasons.push_back(text);
@@ -132,21 +145,6 @@ urdf::ModelInterfaceSharedPtr parseUrdf(const std::string& xml, const std::strin
     throw SceneLoadError(msg);
   }
   for (const std::string& text : reasons) log.forward(text);  // not ours to judge
-  if (percent && !dropped->empty()) {
-    // The copy's link names have '_' for '%': each dropped element under its link's own name.
-    DroppedElements own;
-    for (auto& [key, why] : *dropped) {
-      std::string link = key.first;
-      for (const auto& [name, unused] : model->links_) {
-        std::string copy = name;
-        std::replace(copy.begin(), copy.end(), '%', '_');
-        if (copy == key.first) link = name;
-      }
-      std::vector<std::string>& to = own[{link, key.second}];
-      to.insert(to.end(), why.begin(), why.end());
-    }
-    *dropped = std::move(own);
-  }
   return model;
 }
 
