@@ -1,8 +1,7 @@
 // The conservative pieces of the caster's walk, each against its exact counterpart: a box's view
 // (float, four children at once, and double) holds every beam whose exact ray enters the box, and
-// no point of the box is nearer than its near distance; the edge filter lets through every beam
-// the exact triangle test hits; the occlusion tiles never call a window closed that has an open
-// beam.
+// no point of the box is nearer than its near distance; the occlusion tiles never call a window
+// closed that has an open beam. (The triangles' candidate filters: test_candidate_filters.)
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,12 +11,11 @@
 #include <set>
 #include <vector>
 
+#include "beam_set_cases.h"
 #include "fan_specs.h"
 #include "laser_raycast/core/aabb.h"
 #include "beams/beam_set.h"
 #include "beams/column_motion.h"
-#include "beams/column_raster.h"
-#include "beams/edge_filter.h"
 #include "laser_raycast/core/mesh.h"
 #include "beams/node_views.h"
 #include "laser_raycast/core/scan_spec.h"
@@ -66,23 +64,6 @@ std::optional<long double> entryFrom(const Eigen::Vector3d& lo, const Eigen::Vec
   return entry(lo, hi, shifted, d, tmax);
 }
 
-// A sweep block's columns: each a random pose at most `shift` m and `turn` rad from the reference.
-core::ColumnMotion randomColumns(Rng& rng, int cols, double shift, double turn,
-                                 double steepest) {
-  std::vector<Eigen::Isometry3d> m(cols);
-  for (Eigen::Isometry3d& p : m) {
-    p = Eigen::Isometry3d::Identity();
-    p.linear() = Eigen::AngleAxisd(turn * uniform(rng, 0, 1), randomUnitVector(rng)).toRotationMatrix();
-    p.translation() = shift * uniform(rng, 0, 1) * randomUnitVector(rng);
-  }
-  return core::ColumnMotion(0, m, steepest);
-}
-
-double steepest(const core::ScanPattern& pattern) {
-  double e = 0;
-  for (double x : pattern.elevations()) e = std::max(e, std::abs(x));
-  return e;
-}
 
 // A few beam patterns: fans and rings.
 std::vector<core::ScanPattern> patterns() {
@@ -93,17 +74,6 @@ std::vector<core::ScanPattern> patterns() {
   return out;
 }
 
-// A beam set over a pattern with no hits yet, as a cast starts it.
-struct FreshBeams {
-  core::ScanResult result;
-  core::BeamSet beams;
-  FreshBeams(const core::ScanPattern& pattern, const core::CastConfig& config) {
-    result.range.assign(pattern.size(), kInf);
-    result.body.assign(pattern.size(), -1);
-    result.triangle.assign(pattern.size(), -1);
-    beams.reset(pattern, config, &result);
-  }
-};
 
 // The beam set rebuilds a beam's direction from its row's and column's factors, the pattern's own
 // expression: the same bits as the pattern's directions.
@@ -289,194 +259,6 @@ TEST(NodeViews, WithASpreadEveryColumnsBeamThatEntersAChildBoxIsInItsWindow) {
   EXPECT_GT(inside, 5000);
 }
 
-// Random triangles near the sensor and far, large and tiny, some through the sensor's axis; each
-// beam given a random current range (a third of them none): the beams whose exact hit could be
-// kept, t <= range and t <= tmax.
-struct FilterCase {
-  Eigen::Vector3d a, b, c;
-};
-
-FilterCase randomTriangle(Rng& rng) {
-  const double scale = std::pow(10.0, uniform(rng, -1, 1.5));
-  const Eigen::Vector3d c = scale * randomUnitVector(rng);
-  const double size = scale * uniform(rng, 0.001, 1.5);
-  return FilterCase{c + size * randomUnitVector(rng), c + size * randomUnitVector(rng),
-                    c + size * randomUnitVector(rng)};
-}
-
-// Casts nothing: sets the beams' ranges through keepNearestHit(), as the walks do.
-void setRandomRanges(Rng& rng, core::BeamSet* beams) {
-  for (int row = 0; row < beams->grid().rows(); ++row) {
-    for (int col = 0; col < beams->grid().cols(); ++col) {
-      if (rng() % 3 == 0) continue;
-      beams->keepNearestHit(row, col, uniform(rng, 0.05, 40), 0, 0, [] { return Eigen::Vector3d(); });
-    }
-  }
-}
-
-// The candidates a filter gave, and the beams that must be among them.
-template <class Candidates>
-void expectEveryKeptHitACandidate(Rng& rng, const core::ScanPattern& pattern, Candidates&& run,
-                                  long long* hits, const core::ColumnMotion* motion = nullptr) {
-  core::CastConfig config;
-  config.tmax = 25;
-  FreshBeams fresh(pattern, config);
-  core::BeamSet& beams = fresh.beams;
-  setRandomRanges(rng, &beams);
-  long long passed = 0, tested = 0;
-  for (int i = 0; i < 3000; ++i) {
-    const FilterCase t = randomTriangle(rng);
-    std::vector<char> candidate(pattern.size(), 0);
-    run(beams, t, [&](int row, int col) { candidate[beams.grid().beam(row, col)] = 1; });
-    for (int row = 0; row < beams.grid().rows(); ++row) {
-      for (int col = 0; col < beams.grid().cols(); ++col) {
-        ++tested;
-        passed += candidate[beams.grid().beam(row, col)];
-        core::Ray ray;
-        ray.dir = beams.grid().direction(row, col);
-        if (motion) ray = motion->ray(col, ray.dir, 0.0);  // a sweep's beam from its column
-        ray.tmax = std::min(config.tmax, beams.range(row, col));
-        if (!core::intersectTriangle<core::TriangleMethod::kWatertight>(ray, t.a, t.b, t.c)) {
-          continue;
-        }
-        ++*hits;
-        EXPECT_TRUE(candidate[beams.grid().beam(row, col)])
-            << "triangle " << i << " row " << row << " col " << col;
-      }
-    }
-    if (::testing::Test::HasFailure()) return;
-  }
-  // And it does filter (less for a sweep's block: triangles within a few shifts of the sensor let
-  // every beam through).
-  EXPECT_LT(passed, motion ? tested / 2 : tested / 4);
-}
-
-TEST(EdgeFilter, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
-  Rng rng(29);
-  const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 360),
-                                  std::vector<double>{-0.5, -0.2, 0.0, 0.1, 0.4});
-  long long hits = 0;
-  expectEveryKeptHitACandidate(
-      rng, pattern,
-      [](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
-        const core::EdgeFilter filter(t.a, t.b, t.c);
-        for (int row = 0; row < beams.grid().rows(); ++row) {
-          filter.forEachCandidate(beams, row, 0, beams.grid().cols() - 1,
-                                  [&](int col) { mark(row, col); });
-        }
-      },
-      &hits);
-  EXPECT_GT(hits, 1000);
-}
-
-// The same for the column raster, on a lidar's rings and on rings up to its steepest elevation.
-// For a sweep block (ColumnMotion): every beam from its column's pose whose exact hit could be
-// kept is a candidate, the raster widened by the block's spread with the triangle's plane distance
-// as the near distance, and the raster that follows each column's origin (its planes nearer than
-// twice the shift widened instead: shifts up to 5 cm and triangles from 10 cm away have both).
-TEST(ColumnRaster, WithASpreadLetsThroughEveryColumnsBeamWhoseExactHitCouldBeKept) {
-  Rng rng(47);
-  std::vector<double> lidar;
-  for (int r = 0; r < 16; ++r) lidar.push_back(-0.27 + 0.54 * r / 15);
-  for (const auto& rings : {lidar, std::vector<double>{0.0}}) {
-    const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 512), rings);
-    long long hits = 0;
-    for (int trial = 0; trial < 4; ++trial) {
-      const core::ColumnMotion motion = randomColumns(rng, pattern.azimuthCount(),
-                                                      uniform(rng, 0, 0.05), uniform(rng, 0, 0.03),
-                                                      steepest(pattern));
-      const core::Spread& spread = motion.spread();
-      expectEveryKeptHitACandidate(
-          rng, pattern,
-          [&](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
-            const Eigen::Vector3d n = (t.b - t.a).cross(t.c - t.a);
-            const double near = std::abs(n.dot(t.a)) / n.norm();
-            const double widen =
-                near > 2 * spread.shift
-                    ? std::sin(std::min(M_PI / 2, spread.turn + std::asin(spread.shift / near)))
-                    : 1.0;
-            core::ColumnRaster(beams, t.a, t.b, t.c, widen, spread.shift, spread.turn)
-                .forEachCandidate(beams, beams.grid().all(),
-                                  [&](int row, int col) { mark(row, col); });
-          },
-          &hits, &motion);
-      if (HasFailure()) return;
-      if (pattern.planar()) continue;  // the walks raster a planar fan by its windows
-      expectEveryKeptHitACandidate(
-          rng, pattern,
-          [&](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
-            core::ColumnRaster(beams, t.a, t.b, t.c, motion, 0.0)
-                .forEachCandidate(beams, beams.grid().all(),
-                                  [&](int row, int col) { mark(row, col); });
-          },
-          &hits, &motion);
-      if (HasFailure()) return;
-    }
-    EXPECT_GT(hits, 1000);
-  }
-}
-
-TEST(ColumnRaster, LetsThroughEveryBeamWhoseExactHitCouldBeKept) {
-  Rng rng(43);
-  std::vector<double> lidar, steep;
-  for (int r = 0; r < 32; ++r) lidar.push_back(-0.27 + 0.54 * r / 31);
-  for (int r = 0; r < 9; ++r) {
-    steep.push_back(-core::BeamGrid::kMaxColumnRasterElevation * (1 - r / 4.0));
-  }
-  for (const auto& rings : {lidar, steep}) {
-    const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 512), rings);
-    long long hits = 0;
-    expectEveryKeptHitACandidate(
-        rng, pattern,
-        [](const core::BeamSet& beams, const FilterCase& t, auto&& mark) {
-          ASSERT_TRUE(beams.grid().columnRaster());
-          core::ColumnRaster(beams, t.a, t.b, t.c)
-              .forEachCandidate(beams, beams.grid().all(), [&](int row, int col) { mark(row, col); });
-        },
-        &hits);
-    EXPECT_GT(hits, 1000);
-  }
-}
-
-// A rect of the grid gets the candidates the whole grid gets inside it, no more and no fewer: the
-// raster skips the columns whose bounds miss the rect's rows before it looks rows up, and that
-// must change nothing. The whole grid (64 rows) is scanned column by column and the rects (at most
-// 13 rows) row by row, so this also holds the two scans to the same candidates.
-TEST(ColumnRaster, ARectGetsTheWholeGridsCandidatesInsideIt) {
-  Rng rng(53);
-  std::vector<double> rings;
-  for (int r = 0; r < 64; ++r) rings.push_back(-0.26 + 0.52 * r / 63);
-  const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 256), rings);
-  core::CastConfig config;
-  config.tmax = 25;
-  FreshBeams fresh(pattern, config);
-  core::BeamSet& beams = fresh.beams;
-  setRandomRanges(rng, &beams);
-  long long inside = 0;
-  for (int i = 0; i < 3000; ++i) {
-    const FilterCase t = randomTriangle(rng);
-    const core::ColumnRaster raster(beams, t.a, t.b, t.c);
-    std::set<int> whole, part;
-    core::BeamRect rect;
-    rect.row_lo = static_cast<int>(uniform(rng, 0, beams.grid().rows()));
-    rect.row_hi = std::min(beams.grid().rows() - 1, rect.row_lo + static_cast<int>(uniform(rng, 0, 12)));
-    rect.col_lo = static_cast<int>(uniform(rng, 0, beams.grid().cols()));
-    rect.col_hi = std::min(beams.grid().cols() - 1, rect.col_lo + static_cast<int>(uniform(rng, 0, 40)));
-    raster.forEachCandidate(beams, beams.grid().all(), [&](int row, int col) {
-      if (row >= rect.row_lo && row <= rect.row_hi && col >= rect.col_lo && col <= rect.col_hi) {
-        whole.insert(beams.grid().beam(row, col));
-      }
-    });
-    raster.forEachCandidate(beams, rect, [&](int row, int col) {
-      EXPECT_TRUE(row >= rect.row_lo && row <= rect.row_hi && col >= rect.col_lo &&
-                  col <= rect.col_hi);
-      part.insert(beams.grid().beam(row, col));
-    });
-    ASSERT_EQ(whole, part) << "triangle " << i;
-    inside += static_cast<long long>(part.size());
-  }
-  EXPECT_GT(inside, 1000);
-}
 
 TEST(OcclusionTiles, AWindowWithAnOpenBeamIsNeverClosed) {
   Rng rng(31);
