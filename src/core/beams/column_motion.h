@@ -167,7 +167,14 @@ class ColumnMotion {
     const ClassDelta& x = deltaOf(row, col);
     Ray r;
     r.origin = m.translation() + x.offset;
-    r.dir = translations_only_ ? d : Eigen::Vector3d(m.linear() * (x.rot * d));
+    if (translations_only_) {
+      r.dir = d;
+    } else {
+      // The class's turn first, into a vector of its own: written as one expression, the nested
+      // product is evaluated out of line, through temporaries on the stack, at every call.
+      const Eigen::Vector3d turned = x.rot * d;
+      r.dir = m.linear() * turned;
+    }
     r.tmin = tmin;
     return r;
   }
@@ -176,7 +183,8 @@ class ColumnMotion {
                                                      const Eigen::Vector3d& d) const {
     if (translations_only_) return d;
     if (class_of_row_.empty()) return refFromColumn(col).linear() * d;
-    return refFromColumn(col).linear() * (deltaOf(row, col).rot * d);
+    const Eigen::Vector3d turned = deltaOf(row, col).rot * d;  // as ray() turns it
+    return refFromColumn(col).linear() * turned;
   }
   // A unit normal in the reference sensor frame as column col's sensor frame has it (the frame
   // ScanResult's normals are in).
