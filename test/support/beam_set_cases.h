@@ -3,8 +3,6 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <algorithm>
-#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -18,7 +16,7 @@
 namespace laser_raycast_test {
 
 // A sweep block's columns: each a random pose at most `shift` m and `turn` rad from the reference.
-// steepest: the pattern's (steepest()).
+// steepest: the pattern's (steepestElevation, column_motion.h).
 inline laser_raycast::core::ColumnMotion randomColumns(Rng& rng, int cols, double shift,
                                                        double turn, double steepest) {
   std::vector<Eigen::Isometry3d> m(cols);
@@ -29,13 +27,6 @@ inline laser_raycast::core::ColumnMotion randomColumns(Rng& rng, int cols, doubl
     p.translation() = shift * uniform(rng, 0, 1) * randomUnitVector(rng);
   }
   return laser_raycast::core::ColumnMotion(0, m, steepest);
-}
-
-// The largest angle of the pattern's rings from the horizontal.
-inline double steepest(const laser_raycast::core::ScanPattern& pattern) {
-  double e = 0;
-  for (double x : pattern.elevations()) e = std::max(e, std::abs(x));
-  return e;
 }
 
 // A beam set over a pattern with no hits yet, as a cast starts it.

@@ -166,7 +166,7 @@ void expectBoxViewsHoldEveryBeam(Rng& rng, bool spread, int boxes, long long min
       const Eigen::Isometry3d pose = randomPose(rng, 5);
       const core::ColumnMotion motion =
           spread ? randomColumns(rng, grid.cols(), uniform(rng, 0, 0.3), uniform(rng, 0, 0.1),
-                                 steepest(pattern))
+                                 core::steepestElevation(pattern))
                  : randomColumns(rng, grid.cols(), 0, 0, 0);
       const Eigen::Matrix3d& r = pose.linear();
       const core::View view =
@@ -222,8 +222,9 @@ TEST(NodeViews, WithASpreadEveryColumnsBeamThatEntersAChildBoxIsInItsWindow) {
       // Large spreads, and small ones without a turn (where the corners still narrow windows).
       const bool small = scene % 2 == 0;
       const double shift = small ? uniform(rng, 0.02, 0.05) : uniform(rng, 0, 0.3);
-      const core::ColumnMotion motion = randomColumns(
-          rng, grid.cols(), shift, small ? 0.0 : uniform(rng, 0, 0.1), steepest(pattern));
+      const core::ColumnMotion motion =
+          randomColumns(rng, grid.cols(), shift, small ? 0.0 : uniform(rng, 0, 0.1),
+                        core::steepestElevation(pattern));
       const core::ViewBasis frame(pose, pattern.planar(), 30.0, motion.spread());
       for (const core::WideBvh::Node& node : mesh.wideBvh().nodes()) {
         core::NodeViews views;

@@ -119,7 +119,7 @@ TEST(ColumnRaster, WithASpreadLetsThroughEveryColumnsBeamWhoseExactHitCouldBeKep
     for (int trial = 0; trial < 4; ++trial) {
       const core::ColumnMotion motion =
           randomColumns(rng, pattern.azimuthCount(), uniform(rng, 0, 0.05), uniform(rng, 0, 0.03),
-                        steepest(pattern));
+                        core::steepestElevation(pattern));
       const core::Spread& spread = motion.spread();
       expectEveryKeptHitACandidate(
           rng, pattern,

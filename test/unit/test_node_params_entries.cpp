@@ -4,6 +4,8 @@
 // the entry and the value. Parsed from values built here (no parameter server, no roscore).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -13,7 +15,6 @@
 namespace laser_raycast_test {
 namespace {
 
-using laser_raycast::NodeParams;
 using XmlRpc::XmlRpcValue;
 
 TEST(NodeParams, BadModelsEntriesNameTheEntry) {
