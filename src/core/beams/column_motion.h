@@ -16,6 +16,7 @@
 #include "laser_raycast/core/ray.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/triangle.h"
+#include "util/turn.h"
 
 namespace laser_raycast {
 namespace core {
@@ -170,10 +171,8 @@ class ColumnMotion {
     if (translations_only_) {
       r.dir = d;
     } else {
-      // The class's turn first, into a vector of its own: written as one expression, the nested
-      // product is evaluated out of line, through temporaries on the stack, at every call.
-      const Eigen::Vector3d turned = x.rot * d;
-      r.dir = m.linear() * turned;
+      // The class's turn first, then the column's (util/turn.h: inlined, Eigen's sums).
+      r.dir = turn(m.linear(), turn(x.rot, d));
     }
     r.tmin = tmin;
     return r;
@@ -182,9 +181,8 @@ class ColumnMotion {
   LASER_RAYCAST_HOT_INLINE Eigen::Vector3d direction(int row, int col,
                                                      const Eigen::Vector3d& d) const {
     if (translations_only_) return d;
-    if (class_of_row_.empty()) return refFromColumn(col).linear() * d;
-    const Eigen::Vector3d turned = deltaOf(row, col).rot * d;  // as ray() turns it
-    return refFromColumn(col).linear() * turned;
+    if (class_of_row_.empty()) return turn(refFromColumn(col).linear(), d);
+    return turn(refFromColumn(col).linear(), turn(deltaOf(row, col).rot, d));  // as ray() does
   }
   // A unit normal in the reference sensor frame as column col's sensor frame has it (the frame
   // ScanResult's normals are in).
@@ -233,7 +231,7 @@ class ColumnMotion {
     Ray r;
     r.origin = m.translation();
     // Turning by the identity gives d's bits: skipped where no column turns.
-    r.dir = translations_only_ ? d : Eigen::Vector3d(m.linear() * d);
+    r.dir = translations_only_ ? d : turn(m.linear(), d);
     r.tmin = tmin;
     return r;
   }

@@ -15,6 +15,7 @@
 #include "laser_raycast/core/aabb.h"
 #include "laser_raycast/core/cast_config.h"
 #include "laser_raycast/core/triangle.h"
+#include "util/turn.h"
 
 namespace laser_raycast {
 namespace core {
@@ -47,8 +48,8 @@ class BeamRays {
   // origin, the box grown by the block's shift: a centimetre on every box makes a ray traced
   // through small boxes enter many more of them.)
   WideBoxRay boxRayAlong(int row, int col, const Eigen::Vector3d& d) const {
-    if (!motion_) return WideBoxRay(origin_, active_.body_from_sensor_rot * d);
-    const Eigen::Vector3d dir = active_.body_from_sensor_rot * motion_->direction(row, col, d);
+    if (!motion_) return WideBoxRay(origin_, turn(active_.body_from_sensor_rot, d));
+    const Eigen::Vector3d dir = turn(active_.body_from_sensor_rot, motion_->direction(row, col, d));
     if (shift_ == 0) return WideBoxRay(origin_, dir);
     return WideBoxRay(originOf(motion_->refFromColumn(col)), dir);
   }
@@ -94,7 +95,7 @@ class BeamRays {
     if (kept.pose != &pose) {
       kept.pose = &pose;
       const Eigen::Vector3d o =
-          active_.body_from_sensor_rot * pose.translation() + active_.sensor_in_body;
+          turn(active_.body_from_sensor_rot, pose.translation()) + active_.sensor_in_body;
       kept.origin.emplace(o, bounds_, config_.tmin, motion_->deviation());
     }
     return *kept.origin;
