@@ -1,11 +1,14 @@
 // The candidate filters of the caster's walk, each against the exact triangle test: the edge
 // filter and the column raster (from one pose, and for a sweep block whose columns leave from
 // poses of their own) let through every beam whose exact hit could be kept, and a rect of the
-// grid gets exactly the whole grid's candidates inside it.
+// grid gets exactly the whole grid's candidates inside it; the pre-test of a bundle's sub-rays,
+// in float four at a time, lets through every sub-ray that hits and every one its double form
+// lets through.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <vector>
 
@@ -17,6 +20,7 @@
 #include "fan_specs.h"
 #include "laser_raycast/core/triangle.h"
 #include "random.h"
+#include "walk/sub_ray_filter.h"
 
 namespace laser_raycast_test {
 namespace {
@@ -214,6 +218,76 @@ TEST(ColumnRaster, ARectGetsTheWholeGridsCandidatesInsideIt) {
     inside += static_cast<long long>(part.size());
   }
   EXPECT_GT(inside, 1000);
+}
+
+// SubRayFilter over a bundle's sub-rays (one a beam, from the sensor's origin): random triangles,
+// the sub-rays aimed at random points in and around each (barycentrics from -0.05 to 1.05) or
+// anywhere, taken in runs of 1 to 9 so that every lane count of the four-wide float test is met.
+// With the directions kept in float (Bundle::from_origin) it lets through every sub-ray the exact
+// test hits and every one the double test lets through, and turns away nearly all the double test
+// turns away; without them it is the double test.
+TEST(SubRayFilter, InFloatLetsThroughEveryHitAndEverySubRayTheDoubleTestDoes) {
+  Rng rng(61);
+  const core::ScanPattern pattern(fanBySamples(-M_PI, M_PI, 200),
+                                  std::vector<double>{-0.3, -0.1, 0.0, 0.2});
+  const std::size_t n = pattern.size();
+  std::vector<Eigen::Vector3d> directions(n);
+  core::ScanResult own;
+  own.range.assign(n, std::numeric_limits<double>::infinity());
+  own.body.assign(n, -1);
+  own.triangle.assign(n, -1);
+  core::CastConfig config;
+  for (const bool from_origin : {true, false}) {
+    core::BeamSet::Bundle bundle;
+    bundle.directions.push_back(&directions);
+    bundle.results.push_back(&own);
+    bundle.from_origin = from_origin;
+    long long hits = 0, double_misses = 0, float_misses = 0;
+    for (int i = 0; i < 400; ++i) {
+      const FilterCase t = randomTriangle(rng);
+      for (Eigen::Vector3d& d : directions) {
+        if (rng() % 4 == 0) {
+          d = randomUnitVector(rng);
+          continue;
+        }
+        const double u = uniform(rng, -0.05, 1.05), v = uniform(rng, -0.05, 1.05 - u);
+        d = ((1 - u - v) * t.a + u * t.b + v * t.c).normalized();
+      }
+      FreshBeams fresh(pattern, config);
+      fresh.beams.reset(pattern, config, &fresh.result, &bundle);
+      ASSERT_EQ(fresh.beams.subDirectionsFloat() != nullptr, from_origin);
+      const core::SubRayFilter filter(t.a, t.b, t.c);
+      std::vector<char> passed(n, 0);
+      for (int begin = 0; begin < static_cast<int>(n);) {
+        const int end = std::min(static_cast<int>(n), begin + 1 + static_cast<int>(rng() % 9));
+        int last = begin - 1;
+        filter.forEachPassing(fresh.beams, begin, end, [&](int s) {
+          EXPECT_TRUE(s > last && s < end) << "sub-ray " << s << " of " << begin << " to " << end;
+          last = s;
+          passed[s] = 1;
+        });
+        begin = end;
+      }
+      for (std::size_t s = 0; s < n; ++s) {
+        core::Ray ray;
+        ray.dir = directions[s];
+        const bool hit =
+            core::intersectTriangle<core::TriangleMethod::kWatertight>(ray, t.a, t.b, t.c)
+                .has_value();
+        const bool double_miss = filter.misses(directions[s]);
+        hits += hit;
+        double_misses += double_miss;
+        float_misses += !passed[s];
+        EXPECT_TRUE(passed[s] || !hit) << "triangle " << i << " sub-ray " << s;
+        EXPECT_TRUE(passed[s] || double_miss) << "triangle " << i << " sub-ray " << s;
+        if (!from_origin) EXPECT_EQ(!passed[s], double_miss);
+      }
+      if (::testing::Test::HasFailure()) return;
+    }
+    EXPECT_GT(hits, 10000);
+    EXPECT_GT(double_misses, 10000);
+    EXPECT_GE(float_misses, double_misses * 99 / 100) << "from_origin " << from_origin;
+  }
 }
 
 }  // namespace

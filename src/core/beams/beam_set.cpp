@@ -45,6 +45,18 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
     }
     sub_direction_ = interleaved_directions_.data();
   }
+  if (bundle->from_origin) {
+    const std::size_t n = first_ ? first_->back() : pattern.size() * sub_rays_;
+    for (std::vector<float>* axis :
+         {&sub_direction_float_.x, &sub_direction_float_.y, &sub_direction_float_.z}) {
+      axis->assign(n + 3, 0.0f);
+    }
+    for (std::size_t s = 0; s < n; ++s) {
+      sub_direction_float_.x[s] = static_cast<float>(sub_direction_[s].x());
+      sub_direction_float_.y[s] = static_cast<float>(sub_direction_[s].y());
+      sub_direction_float_.z[s] = static_cast<float>(sub_direction_[s].z());
+    }
+  }
   sub_range_ = own->range.data();
   sub_body_ = own->body.data();
   sub_triangle_ = own->triangle.data();

@@ -36,6 +36,14 @@ class BeamSet {
     std::vector<const std::vector<Eigen::Vector3d>*> directions;  // each indexed as the pattern's
     std::vector<ScanResult*> results;
     const std::vector<int>* first = nullptr;  // by grid beam, one more at the end
+    // Every sub-ray leaves from the reference origin along its own direction, unturned (a cast
+    // from one pose): the walks pre-test them against each triangle (walk/sub_ray_filter.h), four
+    // at a time from their directions in float, which reset() then keeps.
+    bool from_origin = false;
+  };
+  // Directions in float, one array per axis, indexed by sub-ray, with three zeros at the end.
+  struct FloatDirections {
+    std::vector<float> x, y, z;
   };
 
   // Starts a scan: every beam open (result's ranges as resetResult left them, and a bundle's
@@ -76,6 +84,10 @@ class BeamSet {
   // Sub-ray s: its direction (sensor frame) and its range so far.
   const Eigen::Vector3d& subDirection(int s) const { return sub_direction_[s]; }
   double subRange(int s) const { return sub_range_[s]; }
+  // The sub-rays' directions in float for a bundle cast from_origin, else null.
+  const FloatDirections* subDirectionsFloat() const {
+    return bundle_ && bundle_->from_origin ? &sub_direction_float_ : nullptr;
+  }
   // keepNearestHit for sub-ray s of the beam at (row, col), by the same order; the beam's culling
   // range follows the farthest of its sub-rays'.
   template <class Normal>
@@ -100,6 +112,7 @@ class BeamSet {
   Eigen::Vector3d* sub_normal_ = nullptr;
   // What the pointers above point into when the bundle's own arrays are not sub-ray by sub-ray.
   std::vector<Eigen::Vector3d> interleaved_directions_;
+  FloatDirections sub_direction_float_;
   ScanResult interleaved_;
   ScanResult* result_ = nullptr;
   bool with_normals_ = false;

@@ -198,6 +198,7 @@ void CasterState::castBeamGrids(const Scene& scene, const FramePoses& poses,
     BeamSet::Bundle sub_rays;
     sub_rays.directions.push_back(&part.directions);
     sub_rays.results.push_back(&own);
+    sub_rays.from_origin = motion.spread().shift == 0;  // a Velodyne's columns, not an Ouster's
     castOnThreads(
         scene, part.culling, config, &culling,
         [&](const BeamRect& within) {
@@ -233,6 +234,7 @@ void CasterState::castBeamCells(const Scene& scene, const FramePoses& poses,
   sub_rays.directions.push_back(&cells.directions);
   sub_rays.results.push_back(&own);
   sub_rays.first = &cells.first;
+  sub_rays.from_origin = true;
   castOnThreads(
       scene, cells.culling, config, &culling,
       [&](const BeamRect& within) {

@@ -98,6 +98,7 @@ const std::vector<ScanResult>& Caster::castBundle(const Scene& scene, const Fram
       0, std::vector<Eigen::Isometry3d>(culling.azimuthCount(), Eigen::Isometry3d::Identity()),
       steepestElevation(culling), bundleTurn(patterns));
   BeamSet::Bundle bundle;
+  bundle.from_origin = true;
   for (std::size_t k = 0; k < patterns.size(); ++k) {
     bundle.directions.push_back(&patterns[k].directions());
     bundle.results.push_back(&results[k]);

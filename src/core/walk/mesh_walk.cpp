@@ -414,9 +414,14 @@ class MeshWalk {
         const double range = beams_.rangeAbove(row)[col];
         if (!(range >= e.near)) return;
         if (bundle_) {
-          for (int j = beams_.subBegin(row, col), end = beams_.subEnd(row, col); j < end; ++j) {
-            if (filter && filter->misses(beams_.subDirection(j))) continue;
+          const auto add = [&](int j) {
             batch.add(row, col, j, std::min(config_.tmax, beams_.subRange(j)));
+          };
+          const int begin = beams_.subBegin(row, col), end = beams_.subEnd(row, col);
+          if (filter) {
+            filter->forEachPassing(beams_, begin, end, add);
+          } else {
+            for (int j = begin; j < end; ++j) add(j);
           }
           return;
         }
