@@ -7,7 +7,6 @@
 #include <emmintrin.h>
 
 #include <Eigen/Core>
-#include <cmath>
 
 #include "beams/beam_set.h"
 #include "laser_raycast/core/triangle.h"
