@@ -167,10 +167,14 @@ class MeshWalk {
   };
 
   // A triangle's unit normal in the frame of the beam at (row, col): the sensor's, or for a
-  // sweep's block the beam's own pose's.
-  Eigen::Vector3d beamNormal(int row, int col, std::uint32_t triangle) const {
-    const Eigen::Vector3d n = triangles_.sensorNormal(triangle);
-    return motion_ ? motion_->toBeam(row, col, n) : n;
+  // sweep's block the beam's own pose's. The last one is kept: a bundle's sub-rays of one beam
+  // that keep hits on one triangle ask for it one after another.
+  Eigen::Vector3d beamNormal(int row, int col, std::uint32_t triangle) {
+    if (triangle != normal_kept_.triangle || row != normal_kept_.row || col != normal_kept_.col) {
+      const Eigen::Vector3d n = triangles_.sensorNormal(triangle);
+      normal_kept_ = {triangle, row, col, motion_ ? motion_->toBeam(row, col, n) : n};
+    }
+    return normal_kept_.normal;
   }
 
   void offer(int row, int col, const Best& best) {
@@ -516,6 +520,11 @@ class MeshWalk {
   const BeamRays<M> rays_;
   std::optional<Slicer> slicer_;
   WalkStack<Entry> stack_;
+  struct KeptNormal {
+    std::uint32_t triangle = std::numeric_limits<std::uint32_t>::max();
+    int row = -1, col = -1;
+    Eigen::Vector3d normal;
+  } normal_kept_;  // beamNormal's last
 };
 
 }  // namespace
