@@ -97,14 +97,15 @@ Pass pipelinePass(const BenchScene& scene, int threads, bool keep_slices) {
     const auto list = std::make_shared<const core::BeamList>(w.beams);
     for (std::size_t p = 0; p < w.scans(); ++p) {
       caster->forget();
-      if (!w.sub_patterns.empty()) {
-        // Divergent beams: every sub-ray pattern in one bundle, as castReturns casts them.
-        const std::vector<core::ScanResult>& results =
-            caster->castBundle(scene.scene, scene.frame_poses, w.sensors[p], w.sub_patterns,
-                               config);
-        auto at = out->begin() + p * beams;
-        for (const core::ScanResult& r : results) {
-          at = std::copy(r.range.begin(), r.range.end(), at);
+      if (w.sub_rays) {
+        // Divergent beams: every sub-ray pattern in one bundle, as castReturns casts them; out
+        // holds them pattern after pattern, the result beam by beam.
+        const core::ScanResult& all =
+            caster->castBundle(scene.scene, scene.frame_poses, w.sensors[p], w.sub_rays, config);
+        const std::size_t count = w.sub_rays->subRays(), n = w.sub_rays->beams();
+        double* at = out->data() + p * beams;
+        for (std::size_t k = 0; k < count; ++k) {
+          for (std::size_t i = 0; i < n; ++i) *at++ = all.range[i * count + k];
         }
         continue;
       }
@@ -293,8 +294,9 @@ WorkloadRays makeRays(const BenchScene& scene, const core::Bvh& soup_bvh, const 
     core::ReturnsConfig returns;
     returns.beam_samples = workload.beam_samples;
     returns.beam_divergence = workload.beam_divergence;
-    w.sub_patterns = core::subRayPatterns(workload.fan, workload.elevations, returns);
-    for (const core::ScanPattern& p : w.sub_patterns) {
+    w.sub_rays = std::make_shared<const core::SubRayBundle>(
+        core::subRayPatterns(workload.fan, workload.elevations, returns));
+    for (const core::ScanPattern& p : w.sub_rays->patterns()) {
       w.beams.directions.insert(w.beams.directions.end(), p.directions().begin(),
                                 p.directions().end());
     }

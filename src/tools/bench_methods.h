@@ -13,6 +13,7 @@
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/pose_samples.h"
 #include "laser_raycast/core/scan_pattern.h"
+#include "laser_raycast/core/sub_ray_bundle.h"
 
 namespace laser_raycast {
 namespace bench {
@@ -72,9 +73,10 @@ struct WorkloadRays {
   const Workload* workload = nullptr;
   std::unique_ptr<core::ScanPattern> pattern;  // the grid (a pattern file's workload: unused)
   core::BeamList beams;  // a pattern file's beams (Workload::pattern_file), else empty
-  // Divergent beams (Workload::beam_samples > 1): the sub-ray patterns, whose directions, pattern
-  // after pattern, are also beams' (so that the peers cast each sub-ray as a ray of its own).
-  std::vector<core::ScanPattern> sub_patterns;
+  // Divergent beams (Workload::beam_samples > 1): the sub-ray patterns as castReturns keeps them,
+  // whose directions, pattern after pattern, are also beams' (so that the peers cast each sub-ray
+  // as a ray of its own).
+  std::shared_ptr<const core::SubRayBundle> sub_rays;
   std::vector<SensorPose> poses;
   std::vector<Eigen::Isometry3d> sensors;  // the poses rounded to double (what the pipeline gets)
   std::vector<core::Ray> rays;

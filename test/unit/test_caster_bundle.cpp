@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include "cast_reference.h"
@@ -98,6 +99,63 @@ TEST(CastBundle, EachSubRayIsItsPatternsOwnCast) {
               hits, differing);
 }
 
+// The kept form, as castReturns casts scan after scan: one SubRayBundle handed to one caster again
+// and again (its directions' float copy made once), then another footprint, then the first again.
+// Entry i * subRays() + k of each result is sub-ray k of beam i, bit for bit its pattern's own
+// cast from that scan's pose.
+TEST(CastBundle, AKeptBundleGivesEachSubRayItsPatternsOwnCastScanAfterScan) {
+  Rng rng(90210);
+  const RandomScene rs = randomScene(rng);
+  const core::FanSpec fan = fanBySamples(-M_PI, M_PI - 2 * M_PI / 360, 360);
+  const std::vector<double> rings = {-0.2, -0.1, -0.02, 0.0, 0.05, 0.15, 0.25};
+  const double step = 2 * M_PI / 360;
+  const auto narrow = std::make_shared<const core::SubRayBundle>(subPatterns(fan, rings, step, 7));
+  const auto wide =
+      std::make_shared<const core::SubRayBundle>(subPatterns(fan, rings, 6 * step, 4));
+  core::CastConfig config;
+  config.tmax = 40;
+  config.compute_incidence = true;
+  core::Caster kept;
+  long long sub_rays = 0, hits = 0;
+  for (int scan = 0; scan < 5; ++scan) {
+    const std::shared_ptr<const core::SubRayBundle>& bundle = scan == 2 ? wide : narrow;
+    const Eigen::Isometry3d sensor =
+        pose(uniformInBox(rng, Eigen::Vector3d(-4, -4, -0.3), Eigen::Vector3d(4, 4, 0.3)),
+             rpy(uniform(rng, -0.2, 0.2), uniform(rng, -0.2, 0.2), uniform(rng, -3, 3)));
+    config.threads = scan % 2 ? 2 : 1;
+    const core::ScanResult& all = kept.castBundle(rs.scene, rs.poses, sensor, bundle, config);
+    const int count = bundle->subRays();
+    ASSERT_EQ(all.range.size(), bundle->beams() * count);
+    ASSERT_EQ(all.normal.size(), all.range.size());
+    ASSERT_EQ(all.cos_incidence.size(), all.range.size());
+    for (int k = 0; k < count; ++k) {
+      core::Caster one;
+      const core::ScanResult& own =
+          one.cast(rs.scene, rs.poses, sensor, bundle->patterns()[k], config);
+      ASSERT_EQ(own.range.size(), bundle->beams());
+      for (std::size_t i = 0; i < own.range.size(); ++i) {
+        const std::size_t s = i * count + k;
+        ++sub_rays;
+        hits += std::isfinite(own.range[i]);
+        ASSERT_TRUE(sameBits(all.range[s], own.range[i]) && all.body[s] == own.body[i] &&
+                    all.triangle[s] == own.triangle[i] && all.normal[s] == own.normal[i] &&
+                    sameBits(all.cos_incidence[s], own.cos_incidence[i]))
+            << "scan " << scan << " sub-ray " << k << " beam " << i << ": " << all.range[s]
+            << " (body " << all.body[s] << ") vs " << own.range[i] << " (body " << own.body[i]
+            << ")";
+        EXPECT_TRUE(bundle->directions()[s] == bundle->patterns()[k].directions()[i]);
+      }
+    }
+  }
+  EXPECT_GT(hits, sub_rays / 4);
+  core::Caster caster;
+  expectMentions(invalidMessage([&] {
+                   caster.castBundle(rs.scene, rs.poses, Eigen::Isometry3d::Identity(),
+                                     std::shared_ptr<const core::SubRayBundle>(), config);
+                 }),
+                 {"null"});
+}
+
 TEST(CastBundle, RefusesPatternsItCannotBundle) {
   const core::Scene scene = sceneWithFrame();
   const core::FramePoses poses = core::FramePoses::identity(scene);
@@ -114,6 +172,11 @@ TEST(CastBundle, RefusesPatternsItCannotBundle) {
                  {"pattern 1", "1 rings", "2 x 11"});
   expectMentions(refusal({core::ScanPattern(fan, {0.1, 0.2}), core::ScanPattern(fan, {0.3, 0.2})}),
                  {"pattern 1", "order"});
+  // A SubRayBundle checks the same when it is made.
+  expectMentions(invalidMessage([&] {
+                   core::SubRayBundle({core::ScanPattern(fan, {0.1}), core::ScanPattern(fan, {0.0})});
+                 }),
+                 {"pattern 1", "planar"});
 }
 
 }  // namespace

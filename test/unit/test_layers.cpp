@@ -112,6 +112,7 @@ const std::map<std::string, std::string>& publicHeaderLayers() {
       {"cast_config.h", "beams"},
       {"scan_result.h", "beams"},
       {"caster.h", "caster"},
+      {"sub_ray_bundle.h", "caster"},
       {"measurement_model.h", "measurement"},
       {"scan_spec.h", "measurement"},
       {"sensor_model.h", "measurement"},

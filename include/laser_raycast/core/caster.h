@@ -14,6 +14,7 @@
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scan_result.h"
 #include "laser_raycast/core/scene.h"
+#include "laser_raycast/core/sub_ray_bundle.h"
 
 namespace laser_raycast {
 namespace core {
@@ -81,6 +82,16 @@ class Caster {
                                             const Eigen::Isometry3d& world_from_sensor,
                                             const std::vector<ScanPattern>& patterns,
                                             const CastConfig& config);
+  // The same cast for a bundle the caller keeps and casts scan after scan (castReturns does), its
+  // results in one ScanResult beam by beam, as the walks keep them: sub-ray k of beam i at
+  // i * bundle->subRays() + k (ranges, bodies, triangles and, with compute_incidence, normals and
+  // incidence along bundle->directions()). Nothing is copied between the patterns' order and the
+  // walks', and the directions' float copy for the walks' pre-test is made once for as long as
+  // the same bundle is passed. Never reused. Throws std::invalid_argument for a null bundle.
+  const ScanResult& castBundle(const Scene& scene, const FramePoses& poses,
+                               const Eigen::Isometry3d& world_from_sensor,
+                               const std::shared_ptr<const SubRayBundle>& bundle,
+                               const CastConfig& config);
 
   // Drops the remembered inputs, so that the next cast() computes even if nothing moved (timing).
   // Kept slices of meshes by scan planes (CastConfig::keep_slices) stay: like the meshes' BVHs,

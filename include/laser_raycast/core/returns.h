@@ -6,10 +6,12 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <memory>
 #include <vector>
 
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/enum_names.h"
+#include "laser_raycast/core/sub_ray_bundle.h"
 #include "laser_raycast/core/surface_reflectance.h"
 
 namespace laser_raycast {
@@ -56,13 +58,16 @@ struct PulseReturns {
   ScanResult first, second;
   SurfaceSamples first_surface, second_surface;
   // The sub-ray patterns of the last call, which the next with the same fan, rings and footprint
-  // reuses (building them works out every sub-ray's direction).
+  // reuses (building them works out every sub-ray's direction): a 3D pattern's divergent beams'
+  // as one bundle (Caster::castBundle), the others' (a planar fan's, the ideal ray's) as patterns
+  // cast one at a time; the other of the two is empty.
   struct SubRays {
     FanSpec fan;
     std::vector<double> elevations;
     double divergence = 0;
     int samples = 0;
     std::vector<ScanPattern> patterns;
+    std::shared_ptr<const SubRayBundle> bundle;
   } sub_rays;
 };
 

@@ -10,6 +10,7 @@
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scan_result.h"
 #include "laser_raycast/core/scene.h"
+#include "laser_raycast/core/sub_ray_bundle.h"
 
 namespace laser_raycast {
 namespace core {
@@ -39,6 +40,12 @@ void sampleSurfaces(const Scene& scene, const FramePoses& poses,
 // origin along its own direction (beam_list.h), from world_from_sensor (a sweep's first pose).
 void sampleSurfaces(const Scene& scene, const FramePoses& poses,
                     const Eigen::Isometry3d& world_from_sensor, const BeamList& beams,
+                    const ScanResult& result, double reflectance_from_color,
+                    const std::vector<char>& label_fixed, SurfaceSamples* out);
+// The same for a bundle's sub-rays (Caster::castBundle's result beam by beam: entry s is sub-ray s
+// of bundle.directions()), all from world_from_sensor.
+void sampleSurfaces(const Scene& scene, const FramePoses& poses,
+                    const Eigen::Isometry3d& world_from_sensor, const SubRayBundle& bundle,
                     const ScanResult& result, double reflectance_from_color,
                     const std::vector<char>& label_fixed, SurfaceSamples* out);
 

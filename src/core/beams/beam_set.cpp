@@ -19,9 +19,10 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
   sub_rays_ = 0;
   if (!bundle) return;
   first_ = bundle->first;
-  sub_rays_ = static_cast<int>(bundle->directions.size());
+  sub_rays_ =
+      bundle->per_beam > 0 ? bundle->per_beam : static_cast<int>(bundle->directions.size());
   ScanResult* own = bundle->results.front();
-  if (first_ || sub_rays_ == 1) {
+  if (first_ || bundle->per_beam > 0 || sub_rays_ == 1) {
     // Already sub-ray by sub-ray: cast in place.
     sub_direction_ = bundle->directions.front()->data();
   } else {
@@ -45,7 +46,8 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
     }
     sub_direction_ = interleaved_directions_.data();
   }
-  if (bundle->from_origin) {
+  if (bundle->from_origin && !(bundle->owner && bundle->owner == float_owner_)) {
+    float_owner_ = bundle->owner;
     const std::size_t n = first_ ? first_->back() : pattern.size() * sub_rays_;
     for (std::vector<float>* axis :
          {&sub_direction_float_.x, &sub_direction_float_.y, &sub_direction_float_.z}) {
@@ -74,7 +76,7 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
 }
 
 void BeamSet::finish() {
-  if (!bundle_ || first_ || sub_rays_ == 1) return;  // cast in place
+  if (!bundle_ || first_ || bundle_->per_beam > 0 || sub_rays_ == 1) return;  // cast in place
   const std::size_t beams = grid_.pattern().size();
   for (int k = 0; k < sub_rays_; ++k) {
     ScanResult& r = *bundle_->results[k];

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <algorithm>
+#include <memory>
 #include <vector>
 
 #include "beams/beam_grid.h"
@@ -36,10 +37,16 @@ class BeamSet {
     std::vector<const std::vector<Eigen::Vector3d>*> directions;  // each indexed as the pattern's
     std::vector<ScanResult*> results;
     const std::vector<int>* first = nullptr;  // by grid beam, one more at the end
+    // Or, with per_beam > 0, the one `directions` and `results` hold per_beam sub-rays of each grid
+    // beam, beam by beam (sub-ray k of beam i at i * per_beam + k: a SubRayBundle's).
+    int per_beam = 0;
     // Every sub-ray leaves from the reference origin along its own direction, unturned (a cast
     // from one pose): the walks pre-test them against each triangle (walk/sub_ray_filter.h), four
     // at a time from their directions in float, which reset() then keeps.
     bool from_origin = false;
+    // What keeps `directions` alive and unchanged, or null: while reset() is passed the same owner,
+    // the float copy it made of them is kept rather than made again.
+    std::shared_ptr<const void> owner;
   };
   // Directions in float, one array per axis, indexed by sub-ray, with three zeros at the end.
   struct FloatDirections {
@@ -113,6 +120,7 @@ class BeamSet {
   // What the pointers above point into when the bundle's own arrays are not sub-ray by sub-ray.
   std::vector<Eigen::Vector3d> interleaved_directions_;
   FloatDirections sub_direction_float_;
+  std::shared_ptr<const void> float_owner_;  // the owner sub_direction_float_ was made for
   ScanResult interleaved_;
   ScanResult* result_ = nullptr;
   bool with_normals_ = false;

@@ -121,8 +121,7 @@ void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanR
   result->stats.bodies = bodies;
 }
 
-void computeIncidence(const ScanPattern& pattern, ScanResult* result) {
-  const auto& dirs = pattern.directions();
+void computeIncidence(const std::vector<Eigen::Vector3d>& dirs, ScanResult* result) {
   result->cos_incidence.assign(dirs.size(), 0.0);
   for (std::size_t i = 0; i < dirs.size(); ++i) {
     if (result->body[i] < 0) continue;
@@ -157,7 +156,7 @@ const ScanResult& Caster::cast(const Scene& scene, const FramePoses& poses,
   // The walks offer each hit to the BeamSet reset here on result_; BeamSet::keepNearestHit
   // (beams/beam_set.h) decides every beam's range, body and triangle.
   state_->castBodies(scene, pattern, config, &result_);
-  if (config.compute_incidence) computeIncidence(pattern, &result_);
+  if (config.compute_incidence) computeIncidence(pattern.directions(), &result_);
   state_->previous = std::move(key);
   return result_;
 }

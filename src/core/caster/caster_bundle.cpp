@@ -1,4 +1,5 @@
-// Caster::castBundle: the sub-ray patterns of divergent beams cast in one walk of the scene.
+// Caster::castBundle: the sub-ray patterns of divergent beams cast in one walk of the scene, and
+// SubRayBundle, the patterns made ready for it.
 //
 // A bundle is cast as a rotating sweep's block whose columns never move (every column's pose the
 // sensor's: beams/column_motion.h) but whose beams may turn from the culling pattern's directions
@@ -6,17 +7,21 @@
 // Spread of beams/beam_window.h), and wherever they would test a beam they test each of its
 // sub-rays exactly as a cast of the sub-ray's pattern tests it (BeamSet::Bundle), each keeping its
 // own nearest hit. So each result is that cast's, and the walk through the trees, the windows and
-// the occlusion culling are paid once for all the sub-rays.
+// the occlusion culling are paid once for all the sub-rays. The walks keep a beam's sub-rays side
+// by side (BeamSet: sub-ray k of beam i at i * sub-rays + k), as a SubRayBundle holds their
+// directions and its cast returns them; the patterns' form copies them in and out.
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "caster/caster_state.h"
 #include "laser_raycast/core/caster.h"
 #include "laser_raycast/core/pose.h"
+#include "laser_raycast/core/sub_ray_bundle.h"
 #include "walk/frame_walk.h"
 
 namespace laser_raycast {
@@ -73,36 +78,45 @@ double bundleTurn(const std::vector<ScanPattern>& patterns) {
 
 }  // namespace
 
-const std::vector<ScanResult>& Caster::castBundle(const Scene& scene, const FramePoses& poses,
-                                                  const Eigen::Isometry3d& world_from_sensor,
-                                                  const std::vector<ScanPattern>& patterns,
-                                                  const CastConfig& config) {
+SubRayBundle::SubRayBundle(std::vector<ScanPattern> patterns) : patterns_(std::move(patterns)) {
+  checkBundle(patterns_);
+  turn_ = bundleTurn(patterns_);
+  const std::size_t n = beams(), k_count = patterns_.size();
+  directions_.resize(n * k_count);
+  for (std::size_t k = 0; k < k_count; ++k) {
+    const std::vector<Eigen::Vector3d>& d = patterns_[k].directions();
+    for (std::size_t i = 0, s = k; i < n; ++i, s += k_count) directions_[s] = d[i];
+  }
+}
+
+const ScanResult& Caster::castBundle(const Scene& scene, const FramePoses& poses,
+                                     const Eigen::Isometry3d& world_from_sensor,
+                                     const std::shared_ptr<const SubRayBundle>& sub_rays,
+                                     const CastConfig& config) {
+  if (!sub_rays) throw std::invalid_argument("castBundle: the bundle is null");
   config.validate();
   checkFramePoses(scene, poses);
-  checkBundle(patterns);
   forget();  // result_ is only the bundle's culling ranges now
-  const ScanPattern& culling = patterns.front();
+  const ScanPattern& culling = sub_rays->patterns().front();
   const bool sensor_ok = isValidPose(world_from_sensor);
   const int bodies = static_cast<int>(scene.bodies().size());
-  std::vector<ScanResult>& results = state_->bundle;
-  results.resize(patterns.size());
-  for (ScanResult& r : results) {
-    resetResult(culling.size(), bodies, sensor_ok, config.compute_incidence, &r);
-  }
+  ScanResult& out = state_->bundle_result;
+  resetResult(static_cast<int>(sub_rays->directions().size()), bodies, sensor_ok,
+              config.compute_incidence, &out);
   resetResult(culling.size(), bodies, sensor_ok, false, &result_);
-  if (!sensor_ok) return results;
+  if (!sensor_ok) return out;
 
   const ReuseKey key = relativeInputs(scene, poses, world_from_sensor, culling, config);
   state_->placeGroups(scene, key, culling, &state_->placed, &result_.stats.bodies_skipped);
   const ColumnMotion motion(
       0, std::vector<Eigen::Isometry3d>(culling.azimuthCount(), Eigen::Isometry3d::Identity()),
-      steepestElevation(culling), bundleTurn(patterns));
+      steepestElevation(culling), sub_rays->turn());
   BeamSet::Bundle bundle;
   bundle.from_origin = true;
-  for (std::size_t k = 0; k < patterns.size(); ++k) {
-    bundle.directions.push_back(&patterns[k].directions());
-    bundle.results.push_back(&results[k]);
-  }
+  bundle.per_beam = sub_rays->subRays();
+  bundle.directions.push_back(&sub_rays->directions());
+  bundle.results.push_back(&out);
+  bundle.owner = sub_rays;
   state_->castOnThreads(
       scene, culling, config, &result_,
       [&](const BeamRect& within) {
@@ -112,9 +126,35 @@ const std::vector<ScanResult>& Caster::castBundle(const Scene& scene, const Fram
         }
       },
       &bundle);
-  for (std::size_t k = 0; k < patterns.size(); ++k) {
-    results[k].stats = result_.stats;
-    if (config.compute_incidence) computeIncidence(patterns[k], &results[k]);
+  out.stats = result_.stats;
+  if (config.compute_incidence) computeIncidence(sub_rays->directions(), &out);
+  return out;
+}
+
+const std::vector<ScanResult>& Caster::castBundle(const Scene& scene, const FramePoses& poses,
+                                                  const Eigen::Isometry3d& world_from_sensor,
+                                                  const std::vector<ScanPattern>& patterns,
+                                                  const CastConfig& config) {
+  const auto sub_rays = std::make_shared<const SubRayBundle>(patterns);
+  const ScanResult& all = castBundle(scene, poses, world_from_sensor, sub_rays, config);
+  const std::size_t n = sub_rays->beams(), k_count = patterns.size();
+  std::vector<ScanResult>& results = state_->bundle;
+  results.resize(k_count);
+  for (std::size_t k = 0; k < k_count; ++k) {
+    ScanResult& r = results[k];
+    r.range.resize(n);
+    r.body.resize(n);
+    r.triangle.resize(n);
+    r.normal.resize(all.normal.empty() ? 0 : n);
+    r.cos_incidence.resize(all.cos_incidence.empty() ? 0 : n);
+    for (std::size_t i = 0, s = k; i < n; ++i, s += k_count) {
+      r.range[i] = all.range[s];
+      r.body[i] = all.body[s];
+      r.triangle[i] = all.triangle[s];
+      if (!all.normal.empty()) r.normal[i] = all.normal[s];
+      if (!all.cos_incidence.empty()) r.cos_incidence[i] = all.cos_incidence[s];
+    }
+    r.stats = all.stats;
   }
   return results;
 }

@@ -77,7 +77,7 @@ int castThreads(const CastConfig& config, int beams, int min_per_thread);
 void resetResult(int beams, int bodies, bool sensor_ok, bool with_normals, ScanResult* result,
                  bool overwritten = false);
 // Each hit beam's |cos| of the angle between its direction and the hit's normal.
-void computeIncidence(const ScanPattern& pattern, ScanResult* result);
+void computeIncidence(const std::vector<Eigen::Vector3d>& directions, ScanResult* result);
 
 // A block of a rotating sweep's columns, cast as one scan from the poses at its reference time with
 // each column's beams from the column's own poses (column_motion.h): the frames relative to the
@@ -121,6 +121,7 @@ struct CasterState {
   std::unique_ptr<KeptSlices> planes;   // CastConfig::keep_slices
   std::optional<ReuseKey> previous;     // the inputs of the result, if it is complete
   std::vector<ScanResult> bundle;       // Caster::castBundle's results, one per sub-ray pattern
+  ScanResult bundle_result;             // its results beam by beam (a SubRayBundle's order)
   // A grid part's lines grouped by when they fire: lines of one class fire at one time in every
   // column (an Ouster's part is one class, each Velodyne laser its own, at its place in the firing
   // sequence). class_of_row by the rows of the part's grid (ascending elevation).

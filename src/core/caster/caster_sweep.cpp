@@ -363,7 +363,7 @@ const ScanResult& Caster::castSweep(const Scene& scene, const PoseSamples& sampl
   const ColumnPoses poses(scene, state_->indexOf(scene), samples, times, &state_->sweep_columns);
   std::vector<char> column_valid;
   state_->sweepColumns(scene, poses, 0, pattern, SweepBeams{}, config, &result_, &column_valid);
-  if (config.compute_incidence) computeIncidence(pattern, &result_);
+  if (config.compute_incidence) computeIncidence(pattern.directions(), &result_);
   return result_;
 }
 

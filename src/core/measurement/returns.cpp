@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace laser_raycast {
 namespace core {
@@ -47,25 +49,35 @@ void resetResult(std::size_t n, ScanResult* result, SurfaceSamples* surface) {
   surface->cos_incidence.assign(n, 0.0);
 }
 
-// subRayPatterns(fan, elevations, returns), built again only if one of them changed since the last
-// call with `kept`.
-const std::vector<ScanPattern>& keptSubRayPatterns(const FanSpec& fan,
-                                                   const std::vector<double>& elevations,
-                                                   const ReturnsConfig& returns,
-                                                   PulseReturns::SubRays* kept) {
+// The sub-rays of (fan, elevations, returns) in *kept, made again only if one of them changed
+// since the last call with `kept`: a 3D pattern's divergent beams as one bundle, else patterns.
+void keepSubRays(const FanSpec& fan, const std::vector<double>& elevations,
+                 const ReturnsConfig& returns, PulseReturns::SubRays* kept) {
   const bool same_fan = kept->fan.angle_min == fan.angle_min &&
                         kept->fan.angle_max == fan.angle_max &&
                         kept->fan.angle_increment == fan.angle_increment &&
                         kept->fan.samples == fan.samples;
-  if (!(same_fan && kept->elevations == elevations &&
-        kept->divergence == returns.beam_divergence && kept->samples == returns.beam_samples)) {
-    kept->patterns = subRayPatterns(fan, elevations, returns);
-    kept->fan = fan;
-    kept->elevations = elevations;
-    kept->divergence = returns.beam_divergence;
-    kept->samples = returns.beam_samples;
+  if (same_fan && kept->elevations == elevations && kept->divergence == returns.beam_divergence &&
+      kept->samples == returns.beam_samples && (kept->bundle || !kept->patterns.empty())) {
+    return;
   }
-  return kept->patterns;
+  std::vector<ScanPattern> patterns = subRayPatterns(fan, elevations, returns);
+  // A 3D pattern's sub-rays are cast as one bundle (Caster::castBundle: the same results as a cast
+  // of each pattern, in one walk of the scene); a planar fan's (whose sub-rays leave its plane)
+  // one pattern at a time.
+  bool bundled = returns.beam_samples > 1;
+  for (const ScanPattern& p : patterns) bundled = bundled && !p.planar();
+  kept->bundle.reset();
+  kept->patterns.clear();
+  if (bundled) {
+    kept->bundle = std::make_shared<const SubRayBundle>(std::move(patterns));
+  } else {
+    kept->patterns = std::move(patterns);
+  }
+  kept->fan = fan;
+  kept->elevations = elevations;
+  kept->divergence = returns.beam_divergence;
+  kept->samples = returns.beam_samples;
 }
 
 }  // namespace
@@ -116,54 +128,78 @@ void castReturns(Caster* caster, const Scene& scene, const FramePoses& poses,
   CastConfig cast = config;
   cast.compute_incidence = true;
   const int samples = returns.beam_samples;
-  const double weight = 1.0 / samples;
+  keepSubRays(fan, elevations, returns, &out->sub_rays);
+  const PulseReturns::SubRays& sub_rays = out->sub_rays;
+  // Every sub-ray's hit beam by beam (sub-ray k of beam i at i * samples + k), as a bundle's cast
+  // gives them, and its surface where asked.
   std::size_t n = 0;
-  // Beam i's sub-ray hits: hits[i * samples, i * samples + hit_count[i]).
-  std::vector<SubHit> hits;
-  std::vector<int> hit_count;
+  const ScanResult* all = nullptr;
   SurfaceSamples surface;
-  const std::vector<ScanPattern>& patterns =
-      keptSubRayPatterns(fan, elevations, returns, &out->sub_rays);
-  // A 3D pattern's sub-rays are cast as one bundle (Caster::castBundle: the same results as a cast
-  // of each pattern, in one walk of the scene); a planar fan's (whose sub-rays leave its plane)
-  // one pattern at a time.
-  bool bundled = samples > 1;
-  for (const ScanPattern& p : patterns) bundled = bundled && !p.planar();
-  const std::vector<ScanResult>* bundle =
-      bundled ? &caster->castBundle(scene, poses, world_from_sensor, patterns, cast) : nullptr;
-  for (int k = 0; k < samples; ++k) {
-    const ScanPattern& pattern = patterns[k];
-    const ScanResult& result =
-        bundle ? (*bundle)[k] : caster->cast(scene, poses, world_from_sensor, pattern, cast);
-    if (k == 0) {
-      n = result.range.size();
-      hits.resize(n * samples);
-      hit_count.assign(n, 0);
-    }
+  ScanResult gathered;
+  if (sub_rays.bundle) {
+    all = &caster->castBundle(scene, poses, world_from_sensor, sub_rays.bundle, cast);
+    n = sub_rays.bundle->beams();
     if (surface_reflectance) {
-      sampleSurfaces(scene, poses, world_from_sensor, pattern, result, reflectance_from_color,
-                     label_fixed, &surface);
+      sampleSurfaces(scene, poses, world_from_sensor, *sub_rays.bundle, *all,
+                     reflectance_from_color, label_fixed, &surface);
     }
-    for (std::size_t i = 0; i < n; ++i) {
-      const int body = result.body[i];
-      if (body < 0 || !std::isfinite(result.range[i])) continue;
-      const int label = scene.bodies()[body].label;
-      double rho = label < static_cast<int>(reflectivity.size()) ? reflectivity[label] : 1.0;
-      double cos_incidence = result.cos_incidence[i];
-      if (surface_reflectance) {
-        if (!std::isnan(surface.reflectance[i])) rho = surface.reflectance[i];
-        cos_incidence = surface.cos_incidence[i];
+  } else {
+    SurfaceSamples one_surface;
+    for (int k = 0; k < samples; ++k) {
+      const ScanPattern& pattern = sub_rays.patterns[k];
+      const ScanResult& result = caster->cast(scene, poses, world_from_sensor, pattern, cast);
+      if (k == 0) {
+        n = result.range.size();
+        gathered.range.resize(n * samples);
+        gathered.body.resize(n * samples);
+        gathered.triangle.resize(n * samples);
+        gathered.cos_incidence.resize(n * samples);
+        if (surface_reflectance) {
+          surface.reflectance.resize(n * samples);
+          surface.cos_incidence.resize(n * samples);
+        }
       }
-      hits[i * samples + hit_count[i]++] = {result.range[i], weight * rho * cos_incidence, body,
-                                            result.triangle[i], k};
+      if (surface_reflectance) {
+        sampleSurfaces(scene, poses, world_from_sensor, pattern, result, reflectance_from_color,
+                       label_fixed, &one_surface);
+      }
+      for (std::size_t i = 0, s = k; i < n; ++i, s += samples) {
+        gathered.range[s] = result.range[i];
+        gathered.body[s] = result.body[i];
+        gathered.triangle[s] = result.triangle[i];
+        // (An invalid sensor pose leaves no hit and no incidence.)
+        gathered.cos_incidence[s] = result.body[i] >= 0 ? result.cos_incidence[i] : 0.0;
+        if (surface_reflectance) {
+          surface.reflectance[s] = one_surface.reflectance[i];
+          surface.cos_incidence[s] = one_surface.cos_incidence[i];
+        }
+      }
     }
+    all = &gathered;
   }
   resetResult(n, &out->first, &out->first_surface);
   resetResult(n, &out->second, &out->second_surface);
+  const double weight = 1.0 / samples;
+  SubHit hits[64];  // a beam's (ReturnsConfig::validate: at most 64 sub-rays)
   std::vector<Return> groups;
   for (std::size_t i = 0; i < n; ++i) {
-    if (hit_count[i] == 0) continue;
-    const auto begin = hits.begin() + i * samples, end = begin + hit_count[i];
+    int hit_count = 0;
+    for (int k = 0; k < samples; ++k) {
+      const std::size_t s = i * samples + k;
+      const int body = all->body[s];
+      if (body < 0 || !std::isfinite(all->range[s])) continue;
+      const int label = scene.bodies()[body].label;
+      double rho = label < static_cast<int>(reflectivity.size()) ? reflectivity[label] : 1.0;
+      double cos_incidence = all->cos_incidence[s];
+      if (surface_reflectance) {
+        if (!std::isnan(surface.reflectance[s])) rho = surface.reflectance[s];
+        cos_incidence = surface.cos_incidence[s];
+      }
+      hits[hit_count++] = {all->range[s], weight * rho * cos_incidence, body, all->triangle[s], k};
+    }
+    if (hit_count == 0) continue;
+    SubHit* const begin = hits;
+    SubHit* const end = hits + hit_count;
     // By range, ties by sub-ray: the same order on every run.
     std::sort(begin, end, [](const SubHit& a, const SubHit& b) {
       return a.range < b.range || (a.range == b.range && a.sub < b.sub);

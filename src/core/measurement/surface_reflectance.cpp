@@ -118,5 +118,13 @@ void sampleSurfaces(const Scene& scene, const FramePoses& poses,
               reflectance_from_color, label_fixed, out);
 }
 
+void sampleSurfaces(const Scene& scene, const FramePoses& poses,
+                    const Eigen::Isometry3d& world_from_sensor, const SubRayBundle& bundle,
+                    const ScanResult& result, double reflectance_from_color,
+                    const std::vector<char>& label_fixed, SurfaceSamples* out) {
+  sampleBeams(scene, poses, world_from_sensor, bundle.directions(), {}, result,
+              reflectance_from_color, label_fixed, out);
+}
+
 }  // namespace core
 }  // namespace laser_raycast
