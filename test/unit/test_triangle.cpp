@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -141,6 +142,50 @@ TYPED_TEST(TriangleRandom, RaysAimedOutsideMiss) {
     }
     if (::testing::Test::HasFailure()) return;
   }
+}
+
+// The watertight test of a ray made from a kept shear of its direction (PreparedRay::shearOf, as
+// BeamSet keeps a divergent beam's sub-rays') is the test of the ray prepared as usual, bit for bit:
+// hits inside, near the edges and outside, directions along every axis of both signs (each
+// permutation and swap), culling on and off.
+TEST(WatertightShear, AKeptShearTestsAsTheRayPreparedFromItsDirection) {
+  using Prepared = PreparedRay<double, TriangleMethod::kWatertight>;
+  Rng rng(29);
+  const std::array<Vector3d, 6> axes = {Vector3d::UnitX(),  -Vector3d::UnitX(), Vector3d::UnitY(),
+                                        -Vector3d::UnitY(), Vector3d::UnitZ(),  -Vector3d::UnitZ()};
+  int hits = 0;
+  for (int i = 0; i < 6000; ++i) {
+    const double margin = i % 3 == 2 ? 0.2 : 1e-9;  // near the edges, or well inside or outside
+    AimedCase k = makeAimedCase(rng, i % 2 ? randomInsideBarycentrics(rng, margin)
+                                           : randomOutsideBarycentrics(rng, margin));
+    if (i % 10 == 0) {
+      // Along an axis, at the triangle's centroid.
+      k.dir = axes[(i / 10) % 6];
+      k.origin = (k.a + k.b + k.c) / 3 - uniform(rng, 0.5, 5) * k.dir;
+    }
+    // The shear itself: z the direction's largest component, x and y the others in the order
+    // that keeps the winding, and the shear mapping the direction to (0, 0, 1).
+    const Prepared::Shear shear = Prepared::shearOf(k.dir);
+    ASSERT_EQ(shear.kx + shear.ky + shear.kz, 3) << "case " << i;
+    ASSERT_TRUE(shear.kx != shear.ky && shear.ky != shear.kz && shear.kx != shear.kz);
+    EXPECT_EQ(std::abs(k.dir[shear.kz]), k.dir.cwiseAbs().maxCoeff()) << "case " << i;
+    EXPECT_EQ((shear.ky - shear.kx + 3) % 3, k.dir[shear.kz] > 0 ? 1 : 2) << "case " << i;
+    EXPECT_NEAR(shear.sz * k.dir[shear.kz], 1.0, 1e-15);
+    EXPECT_NEAR(k.dir[shear.kx] - shear.sx * k.dir[shear.kz], 0.0, 1e-15 * k.dir.norm());
+    EXPECT_NEAR(k.dir[shear.ky] - shear.sy * k.dir[shear.kz], 0.0, 1e-15 * k.dir.norm());
+    for (const bool cull : {false, true}) {
+      const RayT<double> ray = makeRay<double>(k.origin, k.dir);
+      const Prepared usual(ray, cull);
+      const Prepared kept(ray.origin, ray.tmin, cull, Prepared::shearOf(ray.dir));
+      const auto a = usual.intersect(k.a, k.b, k.c, 100.0);
+      const auto b = kept.intersect(k.a, k.b, k.c, 100.0);
+      ASSERT_EQ(a.has_value(), b.has_value()) << "case " << i << " cull " << cull;
+      if (!a) continue;
+      ++hits;
+      EXPECT_EQ(std::memcmp(&*a, &*b, sizeof *a), 0) << "case " << i << " cull " << cull;
+    }
+  }
+  EXPECT_GT(hits, 3000);
 }
 
 // A triangle behind the origin (t < tmin = 0) is not hit: the same rays as above, reversed.

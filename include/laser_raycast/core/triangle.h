@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <string>
@@ -368,22 +369,41 @@ class PreparedRay<T, TriangleMethod::kWatertight> {
   PreparedRay(const RayT<T>& ray, bool cull_backfaces, KnownValid)
       : PreparedRay(ray, cull_backfaces, ray.tmin) {}
 
+  // All that a prepared ray keeps of its direction: the permutation that makes z the direction's
+  // largest component and the shear that maps the direction to (0, 0, 1). Made once for a
+  // direction cast again and again (a divergent beam's sub-ray, scan after scan: BeamSet).
+  struct Shear {
+    T sx, sy, sz;
+    std::int8_t kx, ky, kz;
+  };
+  static Shear shearOf(const Vec3<T>& dir) {
+    // Swapping x and y when the largest component is negative keeps the winding (and so the front
+    // face) unchanged.
+    int kz = 0;
+    if (std::abs(dir.y()) > std::abs(dir[kz])) kz = 1;
+    if (std::abs(dir.z()) > std::abs(dir[kz])) kz = 2;
+    int kx = kz == 2 ? 0 : kz + 1;
+    int ky = kx == 2 ? 0 : kx + 1;
+    if (dir[kz] < 0) std::swap(kx, ky);
+    return Shear{dir[kx] / dir[kz], dir[ky] / dir[kz], T(1) / dir[kz], static_cast<std::int8_t>(kx),
+                 static_cast<std::int8_t>(ky), static_cast<std::int8_t>(kz)};
+  }
+  // The valid ray from origin along the direction shear was made of (shearOf), from tmin: the same
+  // as the ray prepared from it.
+  PreparedRay(const Vec3<T>& origin, T tmin, bool cull_backfaces, const Shear& shear)
+      : origin_(origin),
+        tmin_(tmin),
+        cull_(cull_backfaces),
+        kx_(shear.kx),
+        ky_(shear.ky),
+        kz_(shear.kz),
+        sx_(shear.sx),
+        sy_(shear.sy),
+        sz_(shear.sz) {}
+
  private:
   PreparedRay(const RayT<T>& ray, bool cull_backfaces, T tmin)
-      : origin_(ray.origin), tmin_(tmin), cull_(cull_backfaces) {
-    // Permute so that z is the dimension where the direction is largest; swapping x and y when that
-    // component is negative keeps the winding (and so the front face) unchanged.
-    kz_ = 0;
-    if (std::abs(ray.dir.y()) > std::abs(ray.dir[kz_])) kz_ = 1;
-    if (std::abs(ray.dir.z()) > std::abs(ray.dir[kz_])) kz_ = 2;
-    kx_ = kz_ == 2 ? 0 : kz_ + 1;
-    ky_ = kx_ == 2 ? 0 : kx_ + 1;
-    if (ray.dir[kz_] < 0) std::swap(kx_, ky_);
-    // Shear that maps the direction to (0, 0, 1).
-    sx_ = ray.dir[kx_] / ray.dir[kz_];
-    sy_ = ray.dir[ky_] / ray.dir[kz_];
-    sz_ = T(1) / ray.dir[kz_];
-  }
+      : PreparedRay(ray.origin, tmin, cull_backfaces, shearOf(ray.dir)) {}
 
  public:
   LASER_RAYCAST_HOT_INLINE std::optional<TriangleHitT<T>> intersect(const Vec3<T>& a,

@@ -17,6 +17,7 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
   tiles_.reset(grid_.rows(), grid_.cols(), floatAbove(config.tmax));
   first_ = nullptr;
   sub_rays_ = 0;
+  use_shears_ = false;
   if (!bundle) return;
   first_ = bundle->first;
   sub_rays_ =
@@ -57,6 +58,15 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
       sub_direction_float_.x[s] = static_cast<float>(sub_direction_[s].x());
       sub_direction_float_.y[s] = static_cast<float>(sub_direction_[s].y());
       sub_direction_float_.z[s] = static_cast<float>(sub_direction_[s].z());
+    }
+  }
+  use_shears_ = bundle->per_beam > 0 && bundle->from_origin && bundle->owner &&
+                config.method == TriangleMethod::kWatertight;
+  if (use_shears_ && bundle->owner != shear_owner_) {
+    shear_owner_ = bundle->owner;
+    sub_shears_.resize(pattern.size() * sub_rays_);
+    for (std::size_t s = 0; s < sub_shears_.size(); ++s) {
+      sub_shears_[s] = PreparedRay<double, TriangleMethod::kWatertight>::shearOf(sub_direction_[s]);
     }
   }
   sub_range_ = own->range.data();

@@ -17,6 +17,7 @@
 #include "laser_raycast/core/cast_config.h"
 #include "laser_raycast/core/scan_pattern.h"
 #include "laser_raycast/core/scan_result.h"
+#include "laser_raycast/core/triangle.h"
 #include "util/float_rounding.h"
 
 namespace laser_raycast {
@@ -38,7 +39,8 @@ class BeamSet {
     std::vector<ScanResult*> results;
     const std::vector<int>* first = nullptr;  // by grid beam, one more at the end
     // Or, with per_beam > 0, the one `directions` and `results` hold per_beam sub-rays of each grid
-    // beam, beam by beam (sub-ray k of beam i at i * per_beam + k: a SubRayBundle's).
+    // beam, beam by beam (sub-ray k of beam i at i * per_beam + k: a SubRayBundle's, which with
+    // from_origin leave from the sensor's origin itself).
     int per_beam = 0;
     // Every sub-ray leaves from the reference origin along its own direction, unturned (a cast
     // from one pose): the walks pre-test them against each triangle (walk/sub_ray_filter.h), four
@@ -91,6 +93,11 @@ class BeamSet {
   // Sub-ray s: its direction (sensor frame) and its range so far.
   const Eigen::Vector3d& subDirection(int s) const { return sub_direction_[s]; }
   double subRange(int s) const { return sub_range_[s]; }
+  // Each sub-ray's shear for the watertight test (PreparedRay::shearOf its direction), made once
+  // for the bundle's owner: for a bundle of per_beam sub-rays, from_origin (from the sensor's
+  // origin itself: a SubRayBundle's), with an owner, cast with the watertight test; else null.
+  using SubShear = PreparedRay<double, TriangleMethod::kWatertight>::Shear;
+  const SubShear* subShears() const { return use_shears_ ? sub_shears_.data() : nullptr; }
   // The sub-rays' directions in float for a bundle cast from_origin, else null.
   const FloatDirections* subDirectionsFloat() const {
     return bundle_ && bundle_->from_origin ? &sub_direction_float_ : nullptr;
@@ -121,6 +128,9 @@ class BeamSet {
   std::vector<Eigen::Vector3d> interleaved_directions_;
   FloatDirections sub_direction_float_;
   std::shared_ptr<const void> float_owner_;  // the owner sub_direction_float_ was made for
+  std::vector<SubShear> sub_shears_;
+  std::shared_ptr<const void> shear_owner_;  // the owner sub_shears_ was made for
+  bool use_shears_ = false;
   ScanResult interleaved_;
   ScanResult* result_ = nullptr;
   bool with_normals_ = false;

@@ -57,6 +57,13 @@ class BeamRays {
   // Sub-ray s of the bundle's beam at (row, col) for the triangle tests and the box tests, as a
   // cast of its pattern tests it (a divergent beam's block has the sensor's pose at every column).
   PreparedRay<double, M> subRay(int s, int row, int col) const {
+    if constexpr (M == TriangleMethod::kWatertight) {
+      // A SubRayBundle's sub-ray, from the sensor's origin: its shear made once for the bundle.
+      if (const BeamSet::SubShear* shears = beams_.subShears()) {
+        return PreparedRay<double, M>(Eigen::Vector3d::Zero(), config_.tmin,
+                                      config_.cull_backfaces, shears[s]);
+      }
+    }
     return rayAlong(row, col, beams_.subDirection(s));
   }
   WideBoxRay subBoxRay(int s, int row, int col) const {

@@ -37,9 +37,14 @@ class TriangleBatch {
 
   // The beam at (row, col), or its sub-ray sub (>= 0), out to tmax.
   LASER_RAYCAST_HOT_INLINE void add(int row, int col, int sub, double tmax) {
-    // A sub-ray's direction is read from the bundle's list (a calibrated head's 28,928, in the
-    // order the raster meets them): asked for now, it has arrived by the flush.
-    if (sub >= 0) __builtin_prefetch(&beams_.subDirection(sub));
+    // A sub-ray's direction (or its kept shear) is read from the bundle's list (a calibrated
+    // head's 28,928, in the order the raster meets them): asked for now, it has arrived by the
+    // flush.
+    if (sub >= 0) {
+      const BeamSet::SubShear* shears = beams_.subShears();
+      __builtin_prefetch(shears ? static_cast<const void*>(shears + sub)
+                                : static_cast<const void*>(&beams_.subDirection(sub)));
+    }
     pending_[n_++] = Pending{row, col, sub, tmax};
     if (n_ == kBatch) flush();
   }
