@@ -86,8 +86,10 @@ class Caster {
   // results in one ScanResult beam by beam, as the walks keep them: sub-ray k of beam i at
   // i * bundle->subRays() + k (ranges, bodies, triangles and, with compute_incidence, normals and
   // incidence along bundle->directions()). Nothing is copied between the patterns' order and the
-  // walks', and the directions' float copy for the walks' pre-test is made once for as long as
-  // the same bundle is passed. Never reused. Throws std::invalid_argument for a null bundle.
+  // walks', and what the walks derive from the directions (their float copy for the pre-test, the
+  // sub-rays' shears for the watertight test) is made once for as long as the same bundle is
+  // passed (the caster holds the last bundle it was passed until it is passed another). Never
+  // reused. Throws std::invalid_argument for a null bundle.
   const ScanResult& castBundle(const Scene& scene, const FramePoses& poses,
                                const Eigen::Isometry3d& world_from_sensor,
                                const std::shared_ptr<const SubRayBundle>& bundle,

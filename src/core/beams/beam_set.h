@@ -47,7 +47,8 @@ class BeamSet {
     // at a time from their directions in float, which reset() then keeps.
     bool from_origin = false;
     // What keeps `directions` alive and unchanged, or null: while reset() is passed the same owner,
-    // the float copy it made of them is kept rather than made again.
+    // what it made of them (their float copy, the sub-rays' shears) is kept rather than made again.
+    // The BeamSet holds the last owner it was passed until it is passed another.
     std::shared_ptr<const void> owner;
   };
   // Directions in float, one array per axis, indexed by sub-ray, with three zeros at the end.
