@@ -80,6 +80,109 @@ void keepSubRays(const FanSpec& fan, const std::vector<double>& elevations,
   kept->samples = returns.beam_samples;
 }
 
+
+// A beam's returns from its sub-ray hits [begin, end) (reordered), written at beam i of out's
+// results by the return mode; groups: room for the returns.
+void setBeamReturns(SubHit* begin, SubHit* end, const ReturnsConfig& returns, std::size_t i,
+                    std::vector<Return>* groups_out, PulseReturns* out) {
+  std::vector<Return>& groups = *groups_out;
+  // By range, ties by sub-ray: the same order on every run.
+  std::sort(begin, end, [](const SubHit& a, const SubHit& b) {
+    return a.range < b.range || (a.range == b.range && a.sub < b.sub);
+  });
+  groups.clear();
+  double group_start = 0;
+  for (auto it = begin; it != end; ++it) {
+    const SubHit& s = *it;
+    if (groups.empty() || s.range - group_start > returns.min_return_separation) {
+      groups.emplace_back();
+      group_start = s.range;
+    }
+    Return& g = groups.back();
+    // Power-weighted range; a member of zero power (black, or grazing) still counts a little, so
+    // that a group of only such hits has a range.
+    const double w = s.rho_cos / (s.range * s.range) + 1e-300;
+    g.range += w * s.range;
+    g.power += w;
+    g.rho_cos += s.rho_cos;
+    if (s.rho_cos > g.best) {
+      g.best = s.rho_cos;
+      g.body = s.body;
+      g.triangle = s.triangle;
+    }
+  }
+  for (Return& g : groups) g.range /= g.power;
+  // The received power of a return: its rho cos over its range squared.
+  auto power = [](const Return& g) { return g.rho_cos / (g.range * g.range); };
+  std::size_t strongest = 0;
+  for (std::size_t g = 1; g < groups.size(); ++g) {
+    if (power(groups[g]) > power(groups[strongest])) strongest = g;
+  }
+  const std::size_t last = groups.size() - 1;
+  switch (returns.return_mode) {
+    case ReturnMode::kStrongest:
+      setReturn(groups[strongest], i, &out->first, &out->first_surface);
+      break;
+    case ReturnMode::kLast:
+      setReturn(groups[last], i, &out->first, &out->first_surface);
+      break;
+    case ReturnMode::kFirst:
+      setReturn(groups[0], i, &out->first, &out->first_surface);
+      break;
+    case ReturnMode::kDual:
+      setReturn(groups[strongest], i, &out->first, &out->first_surface);
+      if (last != strongest) setReturn(groups[last], i, &out->second, &out->second_surface);
+      break;
+  }
+}
+
+// Casts each of patterns on its own (a planar fan's sub-rays, or the ideal ray) and gathers the
+// results, with their surfaces where asked, beam by beam as a bundle's cast gives them (sub-ray k
+// of beam i at i * patterns.size() + k): ranges, bodies, triangles, incidence. Returns the beams.
+std::size_t castEachPattern(Caster* caster, const Scene& scene, const FramePoses& poses,
+                            const Eigen::Isometry3d& world_from_sensor,
+                            const std::vector<ScanPattern>& patterns, const CastConfig& cast,
+                            bool surface_reflectance, double reflectance_from_color,
+                            const std::vector<char>& label_fixed, ScanResult* gathered_out,
+                            SurfaceSamples* surface_out) {
+  ScanResult& gathered = *gathered_out;
+  SurfaceSamples& surface = *surface_out;
+  const int samples = static_cast<int>(patterns.size());
+  std::size_t n = 0;
+  SurfaceSamples one_surface;
+  for (int k = 0; k < samples; ++k) {
+    const ScanPattern& pattern = patterns[k];
+    const ScanResult& result = caster->cast(scene, poses, world_from_sensor, pattern, cast);
+    if (k == 0) {
+      n = result.range.size();
+      gathered.range.resize(n * samples);
+      gathered.body.resize(n * samples);
+      gathered.triangle.resize(n * samples);
+      gathered.cos_incidence.resize(n * samples);
+      if (surface_reflectance) {
+        surface.reflectance.resize(n * samples);
+        surface.cos_incidence.resize(n * samples);
+      }
+    }
+    if (surface_reflectance) {
+      sampleSurfaces(scene, poses, world_from_sensor, pattern, result, reflectance_from_color,
+                     label_fixed, &one_surface);
+    }
+    for (std::size_t i = 0, s = k; i < n; ++i, s += samples) {
+      gathered.range[s] = result.range[i];
+      gathered.body[s] = result.body[i];
+      gathered.triangle[s] = result.triangle[i];
+      // (An invalid sensor pose leaves no hit and no incidence.)
+      gathered.cos_incidence[s] = result.body[i] >= 0 ? result.cos_incidence[i] : 0.0;
+      if (surface_reflectance) {
+        surface.reflectance[s] = one_surface.reflectance[i];
+        surface.cos_incidence[s] = one_surface.cos_incidence[i];
+      }
+    }
+  }
+  return n;
+}
+
 }  // namespace
 
 void ReturnsConfig::validate() const {
@@ -144,37 +247,9 @@ void castReturns(Caster* caster, const Scene& scene, const FramePoses& poses,
                      reflectance_from_color, label_fixed, &surface);
     }
   } else {
-    SurfaceSamples one_surface;
-    for (int k = 0; k < samples; ++k) {
-      const ScanPattern& pattern = sub_rays.patterns[k];
-      const ScanResult& result = caster->cast(scene, poses, world_from_sensor, pattern, cast);
-      if (k == 0) {
-        n = result.range.size();
-        gathered.range.resize(n * samples);
-        gathered.body.resize(n * samples);
-        gathered.triangle.resize(n * samples);
-        gathered.cos_incidence.resize(n * samples);
-        if (surface_reflectance) {
-          surface.reflectance.resize(n * samples);
-          surface.cos_incidence.resize(n * samples);
-        }
-      }
-      if (surface_reflectance) {
-        sampleSurfaces(scene, poses, world_from_sensor, pattern, result, reflectance_from_color,
-                       label_fixed, &one_surface);
-      }
-      for (std::size_t i = 0, s = k; i < n; ++i, s += samples) {
-        gathered.range[s] = result.range[i];
-        gathered.body[s] = result.body[i];
-        gathered.triangle[s] = result.triangle[i];
-        // (An invalid sensor pose leaves no hit and no incidence.)
-        gathered.cos_incidence[s] = result.body[i] >= 0 ? result.cos_incidence[i] : 0.0;
-        if (surface_reflectance) {
-          surface.reflectance[s] = one_surface.reflectance[i];
-          surface.cos_incidence[s] = one_surface.cos_incidence[i];
-        }
-      }
-    }
+    n = castEachPattern(caster, scene, poses, world_from_sensor, sub_rays.patterns, cast,
+                        surface_reflectance, reflectance_from_color, label_fixed, &gathered,
+                        &surface);
     all = &gathered;
   }
   resetResult(n, &out->first, &out->first_surface);
@@ -197,57 +272,7 @@ void castReturns(Caster* caster, const Scene& scene, const FramePoses& poses,
       }
       hits[hit_count++] = {all->range[s], weight * rho * cos_incidence, body, all->triangle[s], k};
     }
-    if (hit_count == 0) continue;
-    SubHit* const begin = hits;
-    SubHit* const end = hits + hit_count;
-    // By range, ties by sub-ray: the same order on every run.
-    std::sort(begin, end, [](const SubHit& a, const SubHit& b) {
-      return a.range < b.range || (a.range == b.range && a.sub < b.sub);
-    });
-    groups.clear();
-    double group_start = 0;
-    for (auto it = begin; it != end; ++it) {
-      const SubHit& s = *it;
-      if (groups.empty() || s.range - group_start > returns.min_return_separation) {
-        groups.emplace_back();
-        group_start = s.range;
-      }
-      Return& g = groups.back();
-      // Power-weighted range; a member of zero power (black, or grazing) still counts a little, so
-      // that a group of only such hits has a range.
-      const double w = s.rho_cos / (s.range * s.range) + 1e-300;
-      g.range += w * s.range;
-      g.power += w;
-      g.rho_cos += s.rho_cos;
-      if (s.rho_cos > g.best) {
-        g.best = s.rho_cos;
-        g.body = s.body;
-        g.triangle = s.triangle;
-      }
-    }
-    for (Return& g : groups) g.range /= g.power;
-    // The received power of a return: its rho cos over its range squared.
-    auto power = [](const Return& g) { return g.rho_cos / (g.range * g.range); };
-    std::size_t strongest = 0;
-    for (std::size_t g = 1; g < groups.size(); ++g) {
-      if (power(groups[g]) > power(groups[strongest])) strongest = g;
-    }
-    const std::size_t last = groups.size() - 1;
-    switch (returns.return_mode) {
-      case ReturnMode::kStrongest:
-        setReturn(groups[strongest], i, &out->first, &out->first_surface);
-        break;
-      case ReturnMode::kLast:
-        setReturn(groups[last], i, &out->first, &out->first_surface);
-        break;
-      case ReturnMode::kFirst:
-        setReturn(groups[0], i, &out->first, &out->first_surface);
-        break;
-      case ReturnMode::kDual:
-        setReturn(groups[strongest], i, &out->first, &out->first_surface);
-        if (last != strongest) setReturn(groups[last], i, &out->second, &out->second_surface);
-        break;
-    }
+    if (hit_count > 0) setBeamReturns(hits, hits + hit_count, returns, i, &groups, out);
   }
 }
 
