@@ -239,8 +239,8 @@ TEST(SubRayFilter, InFloatLetsThroughEveryHitAndEverySubRayTheDoubleTestDoes) {
   core::CastConfig config;
   for (const bool from_origin : {true, false}) {
     core::BeamSet::Bundle bundle;
-    bundle.directions.push_back(&directions);
-    bundle.results.push_back(&own);
+    bundle.directions = &directions;
+    bundle.result = &own;
     bundle.from_origin = from_origin;
     long long hits = 0, double_misses = 0, float_misses = 0;
     for (int i = 0; i < 400; ++i) {

@@ -10,7 +10,7 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
   grid_.reset(pattern, config);
   result_ = result;
   bundle_ = bundle;
-  with_normals_ = bundle ? !bundle->results.front()->normal.empty() : !result->normal.empty();
+  with_normals_ = bundle ? !bundle->result->normal.empty() : !result->normal.empty();
   occlusion_culling_ = config.occlusion_culling;
   // resetResult left every range +inf (or NaN for a sensor pose that is not valid, and then
   // nothing is cast): the farthest hit a beam keeps is tmax.
@@ -20,33 +20,8 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
   use_shears_ = false;
   if (!bundle) return;
   first_ = bundle->first;
-  sub_rays_ =
-      bundle->per_beam > 0 ? bundle->per_beam : static_cast<int>(bundle->directions.size());
-  ScanResult* own = bundle->results.front();
-  if (first_ || bundle->per_beam > 0 || sub_rays_ == 1) {
-    // Already sub-ray by sub-ray: cast in place.
-    sub_direction_ = bundle->directions.front()->data();
-  } else {
-    const std::size_t beams = pattern.size(), n = beams * sub_rays_;
-    interleaved_directions_.resize(n);
-    own = &interleaved_;
-    own->range.resize(n);
-    own->body.resize(n);
-    own->triangle.resize(n);
-    own->normal.resize(with_normals_ ? n : 0);
-    for (int k = 0; k < sub_rays_; ++k) {
-      const std::vector<Eigen::Vector3d>& directions = *bundle->directions[k];
-      const ScanResult& r = *bundle->results[k];
-      for (std::size_t i = 0, s = k; i < beams; ++i, s += sub_rays_) {
-        interleaved_directions_[s] = directions[i];
-        own->range[s] = r.range[i];
-        own->body[s] = r.body[i];
-        own->triangle[s] = r.triangle[i];
-        if (with_normals_) own->normal[s] = r.normal[i];
-      }
-    }
-    sub_direction_ = interleaved_directions_.data();
-  }
+  sub_rays_ = bundle->per_beam;
+  sub_direction_ = bundle->directions->data();
   if (bundle->from_origin && !(bundle->owner && bundle->owner == float_owner_)) {
     float_owner_ = bundle->owner;
     const std::size_t n = first_ ? first_->back() : pattern.size() * sub_rays_;
@@ -60,7 +35,7 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
       sub_direction_float_.z[s] = static_cast<float>(sub_direction_[s].z());
     }
   }
-  use_shears_ = bundle->per_beam > 0 && bundle->from_origin && bundle->owner &&
+  use_shears_ = bundle->per_beam > 1 && bundle->from_origin && bundle->owner &&
                 config.method == TriangleMethod::kWatertight;
   if (use_shears_ && bundle->owner != shear_owner_) {
     shear_owner_ = bundle->owner;
@@ -69,10 +44,10 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
       sub_shears_[s] = PreparedRay<double, TriangleMethod::kWatertight>::shearOf(sub_direction_[s]);
     }
   }
-  sub_range_ = own->range.data();
-  sub_body_ = own->body.data();
-  sub_triangle_ = own->triangle.data();
-  sub_normal_ = own->normal.data();
+  sub_range_ = bundle->result->range.data();
+  sub_body_ = bundle->result->body.data();
+  sub_triangle_ = bundle->result->triangle.data();
+  sub_normal_ = bundle->result->normal.data();
   // A grid beam without sub-rays is never open.
   if (!first_) return;
   for (int row = 0; row < grid_.rows(); ++row) {
@@ -81,20 +56,6 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
       if ((*first_)[i] != (*first_)[i + 1]) continue;
       result_->range[i] = -std::numeric_limits<double>::infinity();
       tiles_.lower(row, col, -std::numeric_limits<float>::infinity());
-    }
-  }
-}
-
-void BeamSet::finish() {
-  if (!bundle_ || first_ || bundle_->per_beam > 0 || sub_rays_ == 1) return;  // cast in place
-  const std::size_t beams = grid_.pattern().size();
-  for (int k = 0; k < sub_rays_; ++k) {
-    ScanResult& r = *bundle_->results[k];
-    for (std::size_t i = 0, s = k; i < beams; ++i, s += sub_rays_) {
-      r.range[i] = interleaved_.range[s];
-      r.body[i] = interleaved_.body[s];
-      r.triangle[i] = interleaved_.triangle[s];
-      if (with_normals_) r.normal[i] = interleaved_.normal[s];
     }
   }
 }

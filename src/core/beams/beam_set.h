@@ -25,23 +25,22 @@ namespace core {
 
 class BeamSet {
  public:
-  // A bundle: each beam of the grid stands for the beams at its index in each of `directions`
-  // (its sub-rays: a divergent beam's, Caster::castBundle, or a calibrated lidar's own beam,
-  // Caster::castBeams), each kept in its own result. The sub-rays leave from the sensor, or with a
-  // ColumnMotion from their column's origin as the grid's beams do. The grid's own ranges then
-  // hold the farthest of a beam's sub-ray ranges, which is what culling reads, and the walks test
-  // each sub-ray where they would test the beam.
+  // A bundle: each beam of the grid stands for sub-rays of its own in `directions`, each kept in
+  // `result` at the same index: per_beam of them a beam, beam by beam (sub-ray k of beam i at
+  // i * per_beam + k: a divergent beam's, a SubRayBundle's, Caster::castBundle, which with
+  // from_origin leave from the sensor's origin itself; or one, a calibrated lidar's own beam,
+  // Caster::castBeams). The sub-rays leave from the sensor, or with a ColumnMotion from their
+  // column's origin as the grid's beams do. The grid's own ranges then hold the farthest of a
+  // beam's sub-ray ranges, which is what culling reads, and the walks test each sub-ray where
+  // they would test the beam.
   // With `first`, each grid beam stands for a list of its own instead (a cell of an angular grid
-  // over beams off any grid, beams/beam_cells.h): sub-rays first[i] to first[i + 1] - 1 of
-  // the one `directions` and `results` (indexed by sub-ray); a grid beam with none is never open.
+  // over beams off any grid, beams/beam_cells.h): sub-rays first[i] to first[i + 1] - 1; a grid
+  // beam with none is never open.
   struct Bundle {
-    std::vector<const std::vector<Eigen::Vector3d>*> directions;  // each indexed as the pattern's
-    std::vector<ScanResult*> results;
+    const std::vector<Eigen::Vector3d>* directions = nullptr;  // by sub-ray
+    ScanResult* result = nullptr;                             // by sub-ray
+    int per_beam = 1;
     const std::vector<int>* first = nullptr;  // by grid beam, one more at the end
-    // Or, with per_beam > 0, the one `directions` and `results` hold per_beam sub-rays of each grid
-    // beam, beam by beam (sub-ray k of beam i at i * per_beam + k: a SubRayBundle's, which with
-    // from_origin leave from the sensor's origin itself).
-    int per_beam = 0;
     // Every sub-ray leaves from the reference origin along its own direction, unturned (a cast
     // from one pose): the walks pre-test them against each triangle (walk/sub_ray_filter.h), four
     // at a time from their directions in float, which reset() then keeps.
@@ -57,8 +56,8 @@ class BeamSet {
   };
 
   // Starts a scan: every beam open (result's ranges as resetResult left them, and a bundle's
-  // results'), the grid prepared for pattern and config. A bundle's results are complete only
-  // after finish().
+  // result's), the grid prepared for pattern and config. The walks write a bundle's sub-ray hits
+  // into its result in place.
   void reset(const ScanPattern& pattern, const CastConfig& config, ScanResult* result,
              const Bundle* bundle = nullptr);
 
@@ -95,8 +94,9 @@ class BeamSet {
   const Eigen::Vector3d& subDirection(int s) const { return sub_direction_[s]; }
   double subRange(int s) const { return sub_range_[s]; }
   // Each sub-ray's shear for the watertight test (PreparedRay::shearOf its direction), made once
-  // for the bundle's owner: for a bundle of per_beam sub-rays, from_origin (from the sensor's
-  // origin itself: a SubRayBundle's), with an owner, cast with the watertight test; else null.
+  // for the bundle's owner: for a bundle of more than one sub-ray a beam, from_origin (from the
+  // sensor's origin itself: a SubRayBundle's), with an owner, cast with the watertight test; else
+  // null.
   using SubShear = PreparedRay<double, TriangleMethod::kWatertight>::Shear;
   const SubShear* subShears() const { return use_shears_ ? sub_shears_.data() : nullptr; }
   // The sub-rays' directions in float for a bundle cast from_origin, else null.
@@ -108,31 +108,26 @@ class BeamSet {
   template <class Normal>
   bool keepNearestSubHit(int s, int row, int col, double t, int body, int triangle,
                          Normal&& normal);
-  // Ends a scan: a bundle's sub-ray hits written into its results.
-  void finish();
 
  private:
   int firstSub(int beam) const { return first_ ? (*first_)[beam] : beam * sub_rays_; }
 
   BeamGrid grid_;
   const Bundle* bundle_ = nullptr;
-  // The sub-rays while a bundle is cast, sub-ray by sub-ray: a fixed number a beam (sub_rays_)
-  // kept beam by beam (sub-ray k of beam i at i * sub_rays_ + k), so that a beam's sub-rays share
-  // cache lines, or a bundle's own lists (first_).
+  // The sub-rays while a bundle is cast (its arrays): a fixed number a beam (sub_rays_) kept beam
+  // by beam (sub-ray k of beam i at i * sub_rays_ + k), so that a beam's sub-rays share cache
+  // lines, or a bundle's own lists (first_).
   const std::vector<int>* first_ = nullptr;
   int sub_rays_ = 0;
   const Eigen::Vector3d* sub_direction_ = nullptr;
   double* sub_range_ = nullptr;
   int *sub_body_ = nullptr, *sub_triangle_ = nullptr;
   Eigen::Vector3d* sub_normal_ = nullptr;
-  // What the pointers above point into when the bundle's own arrays are not sub-ray by sub-ray.
-  std::vector<Eigen::Vector3d> interleaved_directions_;
   FloatDirections sub_direction_float_;
   std::shared_ptr<const void> float_owner_;  // the owner sub_direction_float_ was made for
   std::vector<SubShear> sub_shears_;
   std::shared_ptr<const void> shear_owner_;  // the owner sub_shears_ was made for
   bool use_shears_ = false;
-  ScanResult interleaved_;
   ScanResult* result_ = nullptr;
   bool with_normals_ = false;
   bool occlusion_culling_ = true;

@@ -239,7 +239,6 @@ void CasterState::castOnThreads(const Scene& scene, const ScanPattern& pattern,
         cutPieces(beams.grid().all().row_hi + 1, pattern.azimuthCount(), threads);
     pool->run(static_cast<int>(pieces.size()), [&](int i) { castWithin(pieces[i]); });
   }
-  beams.finish();
   int cast_count = 0;
   for (const auto& mark : cast) cast_count += mark.load(std::memory_order_relaxed);
   result->stats.bodies_culled = static_cast<int>(bodies) - result->stats.bodies_skipped - cast_count;

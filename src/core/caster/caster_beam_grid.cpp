@@ -196,8 +196,8 @@ void CasterState::castBeamGrids(const Scene& scene, const FramePoses& poses,
     resetResult(part.culling.size(), bodies, true, false, &culling);
     resetResult(part.culling.size(), bodies, true, config.compute_incidence, &own);
     BeamSet::Bundle sub_rays;
-    sub_rays.directions.push_back(&part.directions);
-    sub_rays.results.push_back(&own);
+    sub_rays.directions = &part.directions;
+    sub_rays.result = &own;
     sub_rays.from_origin = motion.spread().shift == 0;  // a Velodyne's columns, not an Ouster's
     castOnThreads(
         scene, part.culling, config, &culling,
@@ -231,8 +231,8 @@ void CasterState::castBeamCells(const Scene& scene, const FramePoses& poses,
   resetResult(cells.culling.size(), bodies, true, false, &culling);
   resetResult(list.size(), bodies, true, config.compute_incidence, &own);
   BeamSet::Bundle sub_rays;
-  sub_rays.directions.push_back(&cells.directions);
-  sub_rays.results.push_back(&own);
+  sub_rays.directions = &cells.directions;
+  sub_rays.result = &own;
   sub_rays.first = &cells.first;
   sub_rays.from_origin = true;
   castOnThreads(
@@ -273,8 +273,8 @@ void CasterState::castBeamGridsSweep(const Scene& scene, const PoseSamples& samp
     resetResult(part.culling.size(), bodies, true, false, &grid_culling);
     resetResult(part.culling.size(), bodies, true, config.compute_incidence, &grid_own);
     BeamSet::Bundle sub_rays;
-    sub_rays.directions.push_back(&part.directions);
-    sub_rays.results.push_back(&grid_own);
+    sub_rays.directions = &part.directions;
+    sub_rays.result = &grid_own;
     SweepBeams beams_of_part;
     beams_of_part.origins = offset ? &origins : nullptr;
     beams_of_part.bundle = &sub_rays;

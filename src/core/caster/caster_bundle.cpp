@@ -114,8 +114,8 @@ const ScanResult& Caster::castBundle(const Scene& scene, const FramePoses& poses
   BeamSet::Bundle bundle;
   bundle.from_origin = true;
   bundle.per_beam = sub_rays->subRays();
-  bundle.directions.push_back(&sub_rays->directions());
-  bundle.results.push_back(&out);
+  bundle.directions = &sub_rays->directions();
+  bundle.result = &out;
   bundle.owner = sub_rays;
   state_->castOnThreads(
       scene, culling, config, &result_,
