@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "fan_specs.h"
@@ -39,6 +41,30 @@ TEST(BeamWindow, ApproxAtan2IsWithinItsBound) {
   }
   EXPECT_LE(worst, kBearingError);
   EXPECT_GT(worst, 0.0);  // it is an approximation: the bound is what matters
+}
+
+// approxAtan2Pair gives each point approxAtan2's bits (it makes the same operations two at a time):
+// random points over twelve decades, the axes, the diagonals, signed zeros, the origin, infinities
+// and NaN, in both places of the pair.
+TEST(BeamWindow, ApproxAtan2PairGivesApproxAtan2sBits) {
+  Rng rng(47);
+  std::vector<double> values = {0.0, -0.0, 1.0, -1.0, 1e-300, -1e-300, INFINITY, -INFINITY, NAN};
+  for (int i = 0; i < 2000; ++i) {
+    values.push_back(std::pow(10.0, uniform(rng, -6, 6)) * (uniform(rng, -1, 1) < 0 ? -1 : 1));
+  }
+  auto bits = [](double v) {
+    std::uint64_t b;
+    std::memcpy(&b, &v, sizeof b);
+    return b;
+  };
+  for (int i = 0; i < 40000; ++i) {
+    const auto pick = [&] { return values[rng() % values.size()]; };
+    const double y0 = pick(), x0 = pick(), y1 = pick(), x1 = pick();
+    double r0, r1;
+    approxAtan2Pair(y0, x0, y1, x1, &r0, &r1);
+    ASSERT_EQ(bits(r0), bits(approxAtan2(y0, x0))) << y0 << ", " << x0;
+    ASSERT_EQ(bits(r1), bits(approxAtan2(y1, x1))) << y1 << ", " << x1;
+  }
 }
 
 TEST(BeamWindow, AzimuthWindowContainsTheSphere) {

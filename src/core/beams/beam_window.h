@@ -4,6 +4,8 @@
 // functions only decide how much work is done, never a range.
 #pragma once
 
+#include <emmintrin.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -77,6 +79,34 @@ inline double approxAtan2(double y, double x) {
   if (ay > ax) r = M_PI / 2 - r;
   if (x < 0) r = M_PI - r;
   return y < 0 ? -r : r;
+}
+
+// approxAtan2 of two points at once, (y0, x0) into *r0 and (y1, x1) into *r1: the same operations
+// in the same order on SSE2's two doubles, so the same bits, with one division for both (a
+// segment's two ends, forSegmentColumns in slice/slicer.h).
+inline void approxAtan2Pair(double y0, double x0, double y1, double x1, double* r0, double* r1) {
+  const __m128d sign = _mm_set1_pd(-0.0);
+  const __m128d x = _mm_set_pd(x1, x0), y = _mm_set_pd(y1, y0);
+  const __m128d ax = _mm_andnot_pd(sign, x), ay = _mm_andnot_pd(sign, y);
+  // std::max(ax, ay) and std::min(ax, ay), NaN included: (ax < ay ? ay : ax), (ay < ax ? ay : ax).
+  const __m128d big = _mm_max_pd(ay, ax), small = _mm_min_pd(ay, ax);
+  const __m128d nonzero = _mm_cmpgt_pd(big, _mm_setzero_pd());
+  const __m128d a = _mm_div_pd(small, big);
+  const __m128d z = _mm_mul_pd(a, a);
+  __m128d p = _mm_mul_pd(z, _mm_set1_pd(0.0208351));
+  p = _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(-0.0851330), p));
+  p = _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(0.1801410), p));
+  p = _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(-0.3302995), p));
+  __m128d r = _mm_mul_pd(a, _mm_add_pd(_mm_set1_pd(0.9998660), p));
+  auto select = [](__m128d mask, __m128d if_set, __m128d if_clear) {
+    return _mm_or_pd(_mm_and_pd(mask, if_set), _mm_andnot_pd(mask, if_clear));
+  };
+  r = select(_mm_cmpgt_pd(ay, ax), _mm_sub_pd(_mm_set1_pd(M_PI / 2), r), r);
+  r = select(_mm_cmplt_pd(x, _mm_setzero_pd()), _mm_sub_pd(_mm_set1_pd(M_PI), r), r);
+  r = _mm_xor_pd(r, _mm_and_pd(_mm_cmplt_pd(y, _mm_setzero_pd()), sign));
+  r = _mm_and_pd(nonzero, r);  // 0 where !(big > 0)
+  _mm_storel_pd(r0, r);
+  _mm_storeh_pd(r1, r);
 }
 
 // angle wrapped into [0, 2 pi).

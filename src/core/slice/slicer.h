@@ -221,11 +221,12 @@ void forSegmentColumns(const ScanPattern& fan, const Eigen::Vector2d& p, const E
   // hit something nearer needs no test.
   const Eigen::Vector2d pq = q - p;
   const double along = -p.dot(pq), length2 = pq.squaredNorm();
+  // (The rounding's bound takes |x| + |y| for each end's norm, which is no less.)
   const double reference_near =
       (along > 0 && along < length2 ? std::abs(p.x() * pq.y() - p.y() * pq.x()) / std::sqrt(length2)
                                     : std::sqrt(std::min(p.squaredNorm(), q.squaredNorm()))) *
           (1 - 16 * std::numeric_limits<double>::epsilon()) -
-      16 * std::numeric_limits<double>::epsilon() * (p.norm() + q.norm());
+      16 * std::numeric_limits<double>::epsilon() * (p.cwiseAbs().sum() + q.cwiseAbs().sum());
   const double near =
       shift > 0 ? std::max(0.0, reference_near - shift * (1 + 1e-9)) : reference_near;
   auto clipped = [&](int lo, int hi) {
@@ -237,8 +238,8 @@ void forSegmentColumns(const ScanPattern& fan, const Eigen::Vector2d& p, const E
     clipped(first, last);
     return;
   }
-  const double bearing_p = approxAtan2(p.y(), p.x());
-  const double bearing_q = approxAtan2(q.y(), q.x());
+  double bearing_p, bearing_q;
+  approxAtan2Pair(p.y(), p.x(), q.y(), q.x(), &bearing_p, &bearing_q);
   double sweep = bearing_q - bearing_p;
   if (sweep > M_PI) sweep -= 2 * M_PI;
   if (sweep < -M_PI) sweep += 2 * M_PI;

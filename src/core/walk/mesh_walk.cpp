@@ -52,6 +52,7 @@ class MeshWalk {
       : beams_(beams),
         wide_(mesh.wideBvh()),
         ids_(mesh.bvh().triangleIds()),
+        slots_(mesh.bvh().triangleVertices()),
         active_(active),
         config_(config),
         rot_(active.sensor_from_body.linear()),
@@ -151,7 +152,16 @@ class MeshWalk {
       });
     }
     sortFarthestFirst(children, n);
-    for (int j = 0; j < n; ++j) push(children[j]);
+    for (int j = 0; j < n; ++j) {
+      // A leaf to be sliced: its triangles are asked for now, to be in the cache when it is popped
+      // (on a tilted fan in the warehouse, loading a triangle's vertices took 40% of its cut).
+      if (slicing_ && children[j].ref.isLeaf()) prefetchLeaf(children[j].ref);
+      push(children[j]);
+    }
+  }
+
+  void prefetchLeaf(WideBvh::Ref leaf) const {
+    slots_.prefetch(leaf.index, leaf.count);
   }
 
   // The nearest hit of one beam so far in this walk: a hit improves it if nearer, or as near on a
@@ -481,7 +491,9 @@ class MeshWalk {
       const WideBvh::Node& node = wide_.nodes()[ref.index];
       const int mask = planeMask(node, basis_);
       for (int k = 0; k < WideBvh::kWidth; ++k) {
-        if (mask & (1 << k)) stack[top++] = node.child(k);
+        if (!(mask & (1 << k))) continue;
+        stack[top++] = node.child(k);
+        if (node.child(k).isLeaf()) prefetchLeaf(node.child(k));
       }
     }
   }
@@ -504,6 +516,7 @@ class MeshWalk {
   BeamSet& beams_;
   const WideBvh& wide_;
   const std::vector<std::uint32_t>& ids_;
+  const SlotVertices<double>& slots_;
   const PlacedBody& active_;
   const CastConfig& config_;
   const Eigen::Matrix3d rot_, abs_rot_;
