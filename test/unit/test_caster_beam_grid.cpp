@@ -493,5 +493,48 @@ TEST(CastBeamCells, ListsInCellsGiveTheRayByRayCast) {
   }
 }
 
+// A caster keeps what its BeamSet makes of a list's directions (their float copy, each beam's shear
+// for the watertight test) while the list stays the same, and makes them anew for another: lists
+// cast in turn by one caster, a grid's (a VLP-16) and a list in cells (the rosette), each a second
+// list of the same kind between (its beams turned by 0.01 rad), give each list's ray-by-ray cast
+// bit for bit every time.
+TEST(CastBeamCells, ListsCastInTurnEachGiveTheirOwnCast) {
+  const core::PatternFile rosette =
+      core::PatternFile::load(LASER_RAYCAST_SOURCE_DIR "/config/patterns/rosette_4line.csv");
+  Rng rng(61);
+  const RandomScene s = randomScene(rng);
+  const Eigen::Isometry3d sensor = pose(Eigen::Vector3d(0.3, -0.2, 0.3), yaw(0.7));
+  core::CastConfig c = config(true, 25.0);
+  c.compute_incidence = true;
+  auto turned = [](core::BeamList beams) {
+    for (Eigen::Vector3d& d : beams.directions) d = yaw(0.01) * d;
+    return beams;
+  };
+  const core::BeamList vlp16 = core::nominalVlp16().scan(0.1);
+  const core::BeamList in_cells = rosette.scan(0, rosette.size(), 1.0);
+  ASSERT_TRUE(core::fitBeamGrid(vlp16));
+  ASSERT_TRUE(core::fitBeamCells(in_cells));
+  for (const core::BeamList& first : {vlp16, in_cells}) {
+    const core::BeamList second = turned(first);
+    std::vector<int> order;
+    const core::BeamList first_shuffled = shuffled(first, rng, &order);
+    core::Caster rays;
+    const core::ScanResult first_rays = rayByRay(rays, s, sensor, first_shuffled, c);
+    const core::ScanResult second_rays = rayByRay(rays, s, sensor, turned(first_shuffled), c);
+    core::Caster caster;
+    for (int pass = 0; pass < 2; ++pass) {
+      expectSameResult(caster.castBeams(s.scene, s.poses, sensor, first, c), first_rays, order,
+                       0.0);
+      expectSameResult(caster.castBeams(s.scene, s.poses, sensor, second, c), second_rays, order,
+                       0.0);
+    }
+    const auto shared = std::make_shared<const core::BeamList>(first);
+    for (int pass = 0; pass < 2; ++pass) {
+      expectSameResult(caster.castBeams(s.scene, s.poses, sensor, shared, c), first_rays, order,
+                       0.0);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace laser_raycast_test

@@ -35,11 +35,11 @@ void BeamSet::reset(const ScanPattern& pattern, const CastConfig& config, ScanRe
       sub_direction_float_.z[s] = static_cast<float>(sub_direction_[s].z());
     }
   }
-  use_shears_ = bundle->per_beam > 1 && bundle->from_origin && bundle->owner &&
-                config.method == TriangleMethod::kWatertight;
+  use_shears_ =
+      bundle->from_origin && bundle->owner && config.method == TriangleMethod::kWatertight;
   if (use_shears_ && bundle->owner != shear_owner_) {
     shear_owner_ = bundle->owner;
-    sub_shears_.resize(pattern.size() * sub_rays_);
+    sub_shears_.resize(first_ ? first_->back() : pattern.size() * sub_rays_);
     for (std::size_t s = 0; s < sub_shears_.size(); ++s) {
       sub_shears_[s] = PreparedRay<double, TriangleMethod::kWatertight>::shearOf(sub_direction_[s]);
     }

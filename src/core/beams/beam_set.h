@@ -94,9 +94,9 @@ class BeamSet {
   const Eigen::Vector3d& subDirection(int s) const { return sub_direction_[s]; }
   double subRange(int s) const { return sub_range_[s]; }
   // Each sub-ray's shear for the watertight test (PreparedRay::shearOf its direction), made once
-  // for the bundle's owner: for a bundle of more than one sub-ray a beam, from_origin (from the
-  // sensor's origin itself: a SubRayBundle's), with an owner, cast with the watertight test; else
-  // null.
+  // for the bundle's owner: for a bundle from_origin (from the sensor's origin itself: a
+  // SubRayBundle's, a calibrated Velodyne's parts, a beam list's cells) with an owner, cast with
+  // the watertight test; else null.
   using SubShear = PreparedRay<double, TriangleMethod::kWatertight>::Shear;
   const SubShear* subShears() const { return use_shears_ ? sub_shears_.data() : nullptr; }
   // The sub-rays' directions in float for a bundle cast from_origin, else null.

@@ -141,8 +141,14 @@ const BeamListGrid* CasterState::gridOf(const BeamList& beams,
     fitted.reset();
     beams.validate();
     fitted = FittedList{beams.directions, origins, beams.lines, beams.times, fitBeamGrid(beams),
-                        {}, {}, {}};
+                        {}, {}, {}, {}, {}};
     if (!fitted->grid) fitted->cells = fitBeamCells(beams);
+    if (fitted->grid) {
+      for (std::size_t p = 0; p < fitted->grid->parts.size(); ++p) {
+        fitted->part_owner.push_back(std::make_shared<const int>(0));
+      }
+    }
+    if (fitted->cells) fitted->cells_owner = std::make_shared<const int>(0);
   }
   fitted->source = shared ? *shared : nullptr;
   return fitted->grid ? &*fitted->grid : nullptr;
@@ -182,7 +188,8 @@ void CasterState::castBeamGrids(const Scene& scene, const FramePoses& poses,
   CastBodies cast_any(bodies);
   ScanResult& culling = grid_culling;
   ScanResult& own = grid_own;
-  for (const BeamListGrid::Part& part : grid.parts) {
+  for (std::size_t p = 0; p < grid.parts.size(); ++p) {
+    const BeamListGrid::Part& part = grid.parts[p];
     const ReuseKey key = relativeInputs(scene, poses, world_from_ref, part.culling, config);
     result->stats.bodies_skipped = 0;
     placeGroups(scene, key, part.culling, &placed, &result->stats.bodies_skipped);
@@ -199,6 +206,9 @@ void CasterState::castBeamGrids(const Scene& scene, const FramePoses& poses,
     sub_rays.directions = &part.directions;
     sub_rays.result = &own;
     sub_rays.from_origin = motion.spread().shift == 0;  // a Velodyne's columns, not an Ouster's
+    if (fitted && fitted->grid && &grid == &*fitted->grid) {
+      sub_rays.owner = fitted->part_owner[p];  // the same parts scan after scan
+    }
     castOnThreads(
         scene, part.culling, config, &culling,
         [&](const BeamRect& within) {
@@ -235,6 +245,7 @@ void CasterState::castBeamCells(const Scene& scene, const FramePoses& poses,
   sub_rays.result = &own;
   sub_rays.first = &cells.first;
   sub_rays.from_origin = true;
+  if (&cells == cellsOf()) sub_rays.owner = fitted->cells_owner;
   castOnThreads(
       scene, cells.culling, config, &culling,
       [&](const BeamRect& within) {

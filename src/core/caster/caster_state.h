@@ -146,6 +146,10 @@ struct CasterState {
     std::optional<BeamListGrid> grid;
     std::optional<BeamCells> cells;
     std::shared_ptr<const BeamList> source;
+    // The owners (BeamSet::Bundle::owner) of the grid's parts' directions and of the cells',
+    // made with them: while the list is the same, the BeamSet keeps what it made of them.
+    std::vector<std::shared_ptr<const int>> part_owner;
+    std::shared_ptr<const int> cells_owner;
     // The grid's sweep times, made when first swept: [0] each beam at its time, [1] all at once.
     std::optional<SweepTimes> sweep_times[2];
   };
