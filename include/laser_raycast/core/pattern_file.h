@@ -41,6 +41,9 @@ class PatternFile {
 
  private:
   std::vector<Row> rows_;
+  // Each row's zenithDirection, made once when read (a scan takes thousands, each a sine and a
+  // cosine twice).
+  std::vector<Eigen::Vector3d> directions_;
   bool has_lines_ = false;
 };
 

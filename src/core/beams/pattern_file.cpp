@@ -90,6 +90,8 @@ PatternFile PatternFile::parse(std::istream& in, const std::string& name) {
     fail("empty, expected the header 'Time/s,Azimuth/deg,Zenith/deg'");
   }
   if (out.rows_.empty()) fail("no rows after the header");
+  out.directions_.reserve(out.rows_.size());
+  for (const Row& r : out.rows_) out.directions_.push_back(zenithDirection(r.azimuth, r.zenith));
   return out;
 }
 
@@ -101,10 +103,9 @@ BeamList PatternFile::scan(std::int64_t start, int count, double point_rate) con
   const std::int64_t n = size();
   std::int64_t row = ((start % n) + n) % n;
   for (int k = 0; k < count; ++k) {
-    const Row& r = rows_[row];
-    beams.directions.push_back(zenithDirection(r.azimuth, r.zenith));
+    beams.directions.push_back(directions_[row]);
     beams.times.push_back(k / point_rate);
-    beams.lines.push_back(r.line);
+    beams.lines.push_back(rows_[row].line);
     if (++row == n) row = 0;
   }
   return beams;
