@@ -176,10 +176,21 @@ core::PoseSamples sweepSamples(const PathArgs& path, const Eigen::Isometry3d& st
 
 core::PoseSamples sweepSamplesAt(const PathArgs& path, const Eigen::Isometry3d& start,
                                  const core::FramePoses& frames, std::vector<double> times) {
-  std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
   core::PoseSamples samples;
-  for (const double t : times) {
+  if (times.empty()) return samples;
+  const auto [lowest, highest] = std::minmax_element(times.begin(), times.end());
+  const double first = *lowest, last = *highest, span = last - first;
+  // Evenly from the first beam's time to the last's, at most kSampleStep s and kSampleTurn rad of
+  // the twist's turn apart (so that each interval turns far less than the half turn beyond which
+  // a slerp would take the other way round).
+  constexpr double kSampleStep = 0.01, kSampleTurn = 0.05;
+  const double intervals =
+      span > 0 ? std::max({1.0, std::ceil(span / kSampleStep),
+                           std::ceil(path.twist.angular.norm() * span / kSampleTurn)})
+               : 0.0;
+  const int count = static_cast<int>(std::min(intervals, 1e6)) + 1;
+  for (int k = 0; k < count; ++k) {
+    const double t = k + 1 == count ? last : first + span * k / (count - 1);
     samples.times.push_back(t);
     samples.world_from_sensor.push_back(poseAfter(start, path.twist, t));
     samples.frames.push_back(frames);

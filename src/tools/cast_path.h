@@ -73,13 +73,15 @@ double timeIncrement(const PathArgs& path, double angle_increment);
 // turn w t about the fixed frame's axes, applied on the left).
 Eigen::Isometry3d poseAfter(const Eigen::Isometry3d& start, const Twist& twist, double t);
 
-// A rotating sweep's poses from start: a sample at each azimuth column's time c * time_increment,
-// so that the caster takes each column's pose as it is, interpolating none; the frames stay where
-// they are.
+// A rotating sweep's poses from start, for the azimuth columns at times c * time_increment: samples
+// from the first column's time to the last's, at most 10 ms and 0.05 rad of the twist's turn
+// apart, between which the caster interpolates each column's pose as it does TF's samples (for a
+// constant twist, the motion itself: linear in position, a slerp at a constant rate about one axis
+// in rotation); the frames stay where they are.
 core::PoseSamples sweepSamples(const PathArgs& path, const Eigen::Isometry3d& start,
                                const core::FramePoses& frames, const core::ScanPattern& pattern);
-// The same with a sample at each distinct time of `times` (s, >= 0, any order): the beams of a
-// pattern file, each cast from the pose at its own time.
+// The same over the times of `times` (s, >= 0, any order): the beams of a pattern file or of a
+// calibrated head, each cast from the pose at its own time.
 core::PoseSamples sweepSamplesAt(const PathArgs& path, const Eigen::Isometry3d& start,
                                  const core::FramePoses& frames, std::vector<double> times);
 

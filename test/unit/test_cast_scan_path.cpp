@@ -178,6 +178,36 @@ TEST(CastScanPath, RotatingSweepTurnsAboutTheFixedAxes) {
   EXPECT_NEAR(std::stod(rows[6].range), 2.43434749, 1e-8);  // 2 / (cos 0.6 cos(0.3 / pi))
 }
 
+// A turn of more than half a turn within one sweep (40 rad/s over 0.1 s: 4 rad): the sweep's
+// samples lie close enough that each beam's pose is interpolated the way the sensor turns (two
+// samples a sweep apart would be slerped the short way round, backwards). A level beam at az,
+// cast t s after the first, points at world bearing b = az + 40 t and meets the wall at
+// 2 / cos b where cos b > 0 and |tan b| < 5 (the wall is 20 m wide), and nothing where cos b < 0.
+TEST(CastScanPath, RotatingSweepTurnsBeyondHalfATurn) {
+  const int samples = 64;
+  const double lo = -3.0, hi = 3.0, increment = (hi - lo) / (samples - 1);
+  const CliRun run = runCli("--urdf " + kRings + " --sensor 0,0,0,0,0,0 --angle-min -3 " +
+                            "--angle-max 3 --samples 64 --range-max 30 --sweep rotating " +
+                            "--scan-time 0.1 --twist 0,0,0,0,0,40");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto rows = parseSweep(run.out);
+  ASSERT_EQ(rows.size(), static_cast<std::size_t>(samples));
+  int hits = 0, misses = 0;
+  for (int c = 0; c < samples; ++c) {
+    const double az = lo + c * increment, t = c * increment * 0.1 / (2 * M_PI), b = az + 40 * t;
+    EXPECT_NEAR(rows[c].time, t, 1e-10) << c;
+    if (std::cos(b) > 0.1 && std::abs(std::tan(b)) < 4.5) {
+      EXPECT_NEAR(std::stod(rows[c].range), 2 / std::cos(b), 1e-8) << c;
+      ++hits;
+    } else if (std::cos(b) < -0.1) {
+      EXPECT_EQ(rows[c].range, "inf") << c;
+      ++misses;
+    }
+  }
+  EXPECT_GT(hits, 10);
+  EXPECT_GT(misses, 10);
+}
+
 // Without motion a rotating sweep is the instant scan, with the time column; planar and in rings.
 TEST(CastScanPath, SweepWithoutTwistIsTheInstantScan) {
   const std::string base = "--urdf " + kRings +
