@@ -171,11 +171,12 @@ core::PoseSamples sweepSamples(const PathArgs& path, const Eigen::Isometry3d& st
   for (int c = 0; c < pattern.azimuthCount(); ++c) {
     times.push_back(c * increment);  // as Caster::castSweep reckons a column's time
   }
-  return sweepSamplesAt(path, start, frames, std::move(times));
+  return sweepSamplesAt(path, start, frames, times);
 }
 
 core::PoseSamples sweepSamplesAt(const PathArgs& path, const Eigen::Isometry3d& start,
-                                 const core::FramePoses& frames, std::vector<double> times) {
+                                 const core::FramePoses& frames,
+                                 const std::vector<double>& times) {
   core::PoseSamples samples;
   if (times.empty()) return samples;
   const auto [lowest, highest] = std::minmax_element(times.begin(), times.end());

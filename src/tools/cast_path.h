@@ -83,7 +83,8 @@ core::PoseSamples sweepSamples(const PathArgs& path, const Eigen::Isometry3d& st
 // The same over the times of `times` (s, >= 0, any order): the beams of a pattern file or of a
 // calibrated head, each cast from the pose at its own time.
 core::PoseSamples sweepSamplesAt(const PathArgs& path, const Eigen::Isometry3d& start,
-                                 const core::FramePoses& frames, std::vector<double> times);
+                                 const core::FramePoses& frames,
+                                 const std::vector<double>& times);
 
 }  // namespace tools
 }  // namespace laser_raycast

@@ -1,9 +1,7 @@
 // Beam lists that lie on grids (beams/beam_list_grid.h): what fitBeamGrid finds in a calibrated
 // Velodyne's and an Ouster's lists and what it turns down, and Caster::castBeams through the grid's
 // walks against the same beams cast one ray at a time (the list shuffled, which lies on no grid,
-// cast in lists too short for cells). Lists off any grid in cells (beams/beam_cells.h): what
-// fitBeamCells makes of a rosette, random beams and a shuffled VLP-16, and their casts against the
-// same beams one ray at a time.
+// cast in lists too short for cells: beam_list_cast.h). Lists in cells: test_caster_beam_cells.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,7 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "beams/beam_cells.h"
+#include "beam_list_cast.h"
 #include "beams/beam_list_grid.h"
 #include "cast_reference.h"
 #include "laser_raycast/core/ouster_beams.h"
@@ -40,16 +38,6 @@ core::OusterHead ouster() {
   head.columns = 512;
   head.last_column = 511;
   return head;
-}
-
-// The list's beams in a random order (beam k of the result is beams' order[k]).
-core::BeamList shuffled(const core::BeamList& beams, Rng& rng, std::vector<int>* order) {
-  order->resize(beams.size());
-  std::iota(order->begin(), order->end(), 0);
-  std::shuffle(order->begin(), order->end(), rng);
-  core::BeamList out;
-  for (int i : *order) out.append(beams, i);
-  return out;
 }
 
 // Every beam of the list stands at exactly one grid beam, with its own direction.
@@ -124,47 +112,6 @@ TEST(FitBeamGrid, ListsOnNoGridAreTurnedDown) {
   core::OusterHead spread = ouster();
   for (int r = 0; r < spread.rows(); ++r) spread.azimuths_deg[r] = 2.0 * r;
   EXPECT_FALSE(core::fitBeamGrid(spread.scan(0.1)));
-}
-
-// castBeams of beams one ray at a time: in lists shorter than the cells take (kMinCellBeams), each
-// cast by caster; beams must lie on no grid (a shuffled list).
-core::ScanResult rayByRay(core::Caster& caster, const RandomScene& s,
-                          const Eigen::Isometry3d& sensor, const core::BeamList& beams,
-                          const core::CastConfig& c) {
-  core::ScanResult out;
-  for (int start = 0; start < beams.size(); start += core::kMinCellBeams - 1) {
-    core::BeamList part;
-    for (int i = start; i < std::min(beams.size(), start + core::kMinCellBeams - 1); ++i) {
-      part.append(beams, i);
-    }
-    const core::ScanResult& r = caster.castBeams(s.scene, s.poses, sensor, part, c);
-    out.range.insert(out.range.end(), r.range.begin(), r.range.end());
-    out.body.insert(out.body.end(), r.body.begin(), r.body.end());
-    out.triangle.insert(out.triangle.end(), r.triangle.begin(), r.triangle.end());
-    out.normal.insert(out.normal.end(), r.normal.begin(), r.normal.end());
-    out.cos_incidence.insert(out.cos_incidence.end(), r.cos_incidence.begin(),
-                             r.cos_incidence.end());
-  }
-  return out;
-}
-
-void expectSameResult(const core::ScanResult& a, const core::ScanResult& b,
-                      const std::vector<int>& order, double tolerance) {
-  int differing = 0;
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const int i = order[k];
-    const bool same_range = tolerance == 0 ? a.range[i] == b.range[k]
-                                           : near(a.range[i], b.range[k], tolerance);
-    const bool same = same_range && a.body[i] == b.body[k] && a.triangle[i] == b.triangle[k] &&
-                      (tolerance > 0 || (a.normal[i] == b.normal[k] &&
-                                         a.cos_incidence[i] == b.cos_incidence[k]));
-    if (!same && differing++ < 5) {
-      ADD_FAILURE() << "beam " << i << ": range " << a.range[i] << " vs " << b.range[k]
-                    << ", body " << a.body[i] << " vs " << b.body[k] << ", triangle "
-                    << a.triangle[i] << " vs " << b.triangle[k];
-    }
-  }
-  EXPECT_EQ(differing, 0);
 }
 
 // Through the grid's walks each beam is its own ray: a Velodyne's (from the sensor's origin) gives
@@ -366,174 +313,6 @@ TEST(CastBeamGrid, ASharedListIsKnownByItsPointerAndOthersAreCompared) {
   const std::shared_ptr<const core::BeamList> none;
   EXPECT_THROW(caster.castBeams(s.scene, s.poses, sensor, none, c), std::invalid_argument);
   EXPECT_THROW(caster.castBeamsSweep(s.scene, samples, none, c), std::invalid_argument);
-}
-
-}  // namespace
-}  // namespace laser_raycast_test
-
-namespace laser_raycast_test {
-namespace {
-
-// n random unit directions: within `cone` rad of azimuth `toward`, or (cone 0) over the sphere up
-// to 70 degrees from the horizontal.
-core::BeamList randomBeams(Rng& rng, int n, double cone, double toward = 0) {
-  core::BeamList beams;
-  for (int i = 0; i < n; ++i) {
-    const double azimuth =
-        cone > 0 ? toward + uniform(rng, -cone, cone) : uniform(rng, -M_PI, M_PI);
-    const double elevation = cone > 0 ? uniform(rng, -cone, cone) : uniform(rng, -1.2, 1.2);
-    beams.directions.push_back(core::beamDirection(azimuth, elevation));
-  }
-  return beams;
-}
-
-// Every beam in exactly one cell, with its own direction, no farther from its cell's direction
-// than the turn, and the turn no more than a cell's diagonal.
-void expectCellsHoldEachBeam(const core::BeamCells& cells, const core::BeamList& beams) {
-  ASSERT_EQ(cells.first.size(), cells.culling.directions().size() + 1);
-  EXPECT_EQ(cells.first.front(), 0);
-  EXPECT_EQ(cells.first.back(), beams.size());
-  std::vector<int> seen(beams.size(), 0);
-  for (std::size_t c = 0; c + 1 < cells.first.size(); ++c) {
-    ASSERT_LE(cells.first[c], cells.first[c + 1]);
-    for (int k = cells.first[c]; k < cells.first[c + 1]; ++k) {
-      ++seen[cells.beam[k]];
-      EXPECT_EQ(cells.directions[k], beams.directions[cells.beam[k]]);
-      const double angle = std::acos(std::min(1.0, cells.directions[k].dot(
-                                                       cells.culling.directions()[c])));
-      EXPECT_LE(angle, cells.turn + 1e-9);
-    }
-  }
-  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), beams.size());
-  const double step = std::abs(cells.culling.angleIncrement());
-  const auto& e = cells.culling.elevations();
-  const double row_step = e.size() > 1 ? e[1] - e[0] : step;
-  EXPECT_LE(cells.turn, std::hypot(step, row_step));
-}
-
-// A rosette, random beams in a cone (ahead, and behind: across azimuth +-pi) and all round, and a
-// VLP-16's beams shuffled go into cells of about three beams each; a list too short, from several
-// origins or too steep for the column raster is turned down.
-TEST(FitBeamCells, ListsOffAnyGridGoIntoCells) {
-  Rng rng(11);
-  const core::PatternFile rosette =
-      core::PatternFile::load(LASER_RAYCAST_SOURCE_DIR "/config/patterns/rosette_4line.csv");
-  std::vector<int> order;
-  const core::BeamList lists[] = {rosette.scan(0, rosette.size(), 1.0),
-                                  randomBeams(rng, 3000, 0.6), randomBeams(rng, 3000, 0.3, M_PI),
-                                  randomBeams(rng, 3000, 0),
-                                  shuffled(core::nominalVlp16().scan(0.1), rng, &order)};
-  const double cones[] = {0.62, 0.6, 0.3, M_PI, M_PI};  // each list's half width in azimuth
-  for (int l = 0; l < 5; ++l) {
-    const core::BeamList& beams = lists[l];
-    const std::optional<core::BeamCells> cells = core::fitBeamCells(beams);
-    ASSERT_TRUE(cells);
-    expectCellsHoldEachBeam(*cells, beams);
-    // The grid's columns span the beams' arc only (behind too, across +-pi).
-    const double step = std::abs(cells->culling.angleIncrement());
-    EXPECT_LE((cells->culling.azimuthCount() - 1) * step, 2 * cones[l] + 2 * step) << l;
-    EXPECT_GT(cells->culling.size(), beams.size() / 6);
-    EXPECT_LT(cells->culling.size(), beams.size());
-  }
-  EXPECT_FALSE(core::fitBeamCells(randomBeams(rng, core::kMinCellBeams - 1, 0.5)));
-  core::BeamList origins = randomBeams(rng, 1000, 0.5);
-  origins.origins.assign(1000, Eigen::Vector3d::Zero());
-  ASSERT_TRUE(core::fitBeamCells(origins));
-  origins.origins[7].x() = 0.01;
-  EXPECT_FALSE(core::fitBeamCells(origins));
-  core::BeamList steep = randomBeams(rng, 1000, 0.5);
-  steep.directions[3] = Eigen::Vector3d(0.1, 0, 1).normalized();
-  EXPECT_FALSE(core::fitBeamCells(steep));
-}
-
-// Cast in cells, each beam is still its own ray: ranges, bodies, triangles, normals and incidence
-// bit for bit those of the beams cast one ray at a time, for any thread count, from a sensor at an
-// origin of its own too.
-TEST(CastBeamCells, ListsInCellsGiveTheRayByRayCast) {
-  const core::PatternFile rosette =
-      core::PatternFile::load(LASER_RAYCAST_SOURCE_DIR "/config/patterns/rosette_4line.csv");
-  for (unsigned seed = 1; seed <= 3; ++seed) {
-    Rng rng(seed + 40);
-    const RandomScene s = randomScene(rng);
-    const Eigen::Isometry3d sensor =
-        pose(Eigen::Vector3d(uniform(rng, -1, 1), 0, 0.3), randomRotation(rng).toRotationMatrix());
-    core::CastConfig c = config(true, 25.0);
-    c.compute_incidence = true;
-    std::vector<int> order;
-    core::BeamList away = randomBeams(rng, 2000, 0.4);
-    away.origins.assign(away.size(), Eigen::Vector3d(0.05, -0.02, 0.1));
-    // From an origin of its own, the cells are cast from a reference there: ranges to the
-    // rounding of the origin.
-    struct Case {
-      core::BeamList beams;
-      double tolerance;
-    };
-    const Case cases[] = {{rosette.scan(0, rosette.size(), 1.0), 0.0},
-                          {randomBeams(rng, 4000, 0), 0.0},
-                          {randomBeams(rng, 2000, 0.3, M_PI), 0.0},
-                          {away, 1e-12},
-                          {shuffled(core::nominalVlp16().scan(0.1), rng, &order), 0.0}};
-    for (const Case& k : cases) {
-      const core::BeamList& beams = k.beams;
-      ASSERT_TRUE(core::fitBeamCells(beams));
-      order.resize(beams.size());
-      std::iota(order.begin(), order.end(), 0);
-      core::Caster cells, rays, threaded;
-      const core::ScanResult expected = rayByRay(rays, s, sensor, beams, c);
-      int hits = 0;
-      for (int b : expected.body) hits += b >= 0;
-      EXPECT_GT(hits, 20);  // the random scene is sparse in some directions
-      expectSameResult(cells.castBeams(s.scene, s.poses, sensor, beams, c), expected, order,
-                       k.tolerance);
-      c.threads = 3;
-      expectSameResult(threaded.castBeams(s.scene, s.poses, sensor, beams, c), expected, order,
-                       k.tolerance);
-      c.threads = 1;
-    }
-  }
-}
-
-// A caster keeps what its BeamSet makes of a list's directions (their float copy, each beam's shear
-// for the watertight test) while the list stays the same, and makes them anew for another: lists
-// cast in turn by one caster, a grid's (a VLP-16) and a list in cells (the rosette), each a second
-// list of the same kind between (its beams turned by 0.01 rad), give each list's ray-by-ray cast
-// bit for bit every time.
-TEST(CastBeamCells, ListsCastInTurnEachGiveTheirOwnCast) {
-  const core::PatternFile rosette =
-      core::PatternFile::load(LASER_RAYCAST_SOURCE_DIR "/config/patterns/rosette_4line.csv");
-  Rng rng(61);
-  const RandomScene s = randomScene(rng);
-  const Eigen::Isometry3d sensor = pose(Eigen::Vector3d(0.3, -0.2, 0.3), yaw(0.7));
-  core::CastConfig c = config(true, 25.0);
-  c.compute_incidence = true;
-  auto turned = [](core::BeamList beams) {
-    for (Eigen::Vector3d& d : beams.directions) d = yaw(0.01) * d;
-    return beams;
-  };
-  const core::BeamList vlp16 = core::nominalVlp16().scan(0.1);
-  const core::BeamList in_cells = rosette.scan(0, rosette.size(), 1.0);
-  ASSERT_TRUE(core::fitBeamGrid(vlp16));
-  ASSERT_TRUE(core::fitBeamCells(in_cells));
-  for (const core::BeamList& first : {vlp16, in_cells}) {
-    const core::BeamList second = turned(first);
-    std::vector<int> order;
-    const core::BeamList first_shuffled = shuffled(first, rng, &order);
-    core::Caster rays;
-    const core::ScanResult first_rays = rayByRay(rays, s, sensor, first_shuffled, c);
-    const core::ScanResult second_rays = rayByRay(rays, s, sensor, turned(first_shuffled), c);
-    core::Caster caster;
-    for (int pass = 0; pass < 2; ++pass) {
-      expectSameResult(caster.castBeams(s.scene, s.poses, sensor, first, c), first_rays, order,
-                       0.0);
-      expectSameResult(caster.castBeams(s.scene, s.poses, sensor, second, c), second_rays, order,
-                       0.0);
-    }
-    const auto shared = std::make_shared<const core::BeamList>(first);
-    for (int pass = 0; pass < 2; ++pass) {
-      expectSameResult(caster.castBeams(s.scene, s.poses, sensor, shared, c), first_rays, order,
-                       0.0);
-    }
-  }
 }
 
 }  // namespace

@@ -68,14 +68,16 @@ void forEachBeamRange(const ScanPattern& fan, double start, double width, F&& f)
 // kBearingError is twice that, which leaves room for the rounding of the division and the octant
 // reflections (a few ulps of pi).
 inline constexpr double kBearingError = 2e-5;
+// The polynomial's coefficients, from a's on (approxAtan2 and approxAtan2Pair).
+inline constexpr double kAtanPoly[5] = {0.9998660, -0.3302995, 0.1801410, -0.0851330, 0.0208351};
 inline double approxAtan2(double y, double x) {
   const double ax = std::abs(x), ay = std::abs(y);
   const double big = std::max(ax, ay);
   if (!(big > 0)) return 0;
   const double a = std::min(ax, ay) / big;
   const double z = a * a;
-  double r =
-      a * (0.9998660 + z * (-0.3302995 + z * (0.1801410 + z * (-0.0851330 + z * 0.0208351))));
+  const double* c = kAtanPoly;
+  double r = a * (c[0] + z * (c[1] + z * (c[2] + z * (c[3] + z * c[4]))));
   if (ay > ax) r = M_PI / 2 - r;
   if (x < 0) r = M_PI - r;
   return y < 0 ? -r : r;
@@ -93,11 +95,9 @@ inline void approxAtan2Pair(double y0, double x0, double y1, double x1, double* 
   const __m128d nonzero = _mm_cmpgt_pd(big, _mm_setzero_pd());
   const __m128d a = _mm_div_pd(small, big);
   const __m128d z = _mm_mul_pd(a, a);
-  __m128d p = _mm_mul_pd(z, _mm_set1_pd(0.0208351));
-  p = _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(-0.0851330), p));
-  p = _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(0.1801410), p));
-  p = _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(-0.3302995), p));
-  __m128d r = _mm_mul_pd(a, _mm_add_pd(_mm_set1_pd(0.9998660), p));
+  __m128d p = _mm_mul_pd(z, _mm_set1_pd(kAtanPoly[4]));
+  for (int k = 3; k >= 1; --k) p = _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(kAtanPoly[k]), p));
+  __m128d r = _mm_mul_pd(a, _mm_add_pd(_mm_set1_pd(kAtanPoly[0]), p));
   auto select = [](__m128d mask, __m128d if_set, __m128d if_clear) {
     return _mm_or_pd(_mm_and_pd(mask, if_set), _mm_andnot_pd(mask, if_clear));
   };

@@ -80,7 +80,6 @@ void keepSubRays(const FanSpec& fan, const std::vector<double>& elevations,
   kept->samples = returns.beam_samples;
 }
 
-
 // A beam's returns from its sub-ray hits [begin, end) (reordered), written at beam i of out's
 // results by the return mode; groups: room for the returns.
 void setBeamReturns(SubHit* begin, SubHit* end, const ReturnsConfig& returns, std::size_t i,

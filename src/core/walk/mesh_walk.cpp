@@ -52,7 +52,6 @@ class MeshWalk {
       : beams_(beams),
         wide_(mesh.wideBvh()),
         ids_(mesh.bvh().triangleIds()),
-        slots_(mesh.bvh().triangleVertices()),
         active_(active),
         config_(config),
         rot_(active.sensor_from_body.linear()),
@@ -161,7 +160,7 @@ class MeshWalk {
   }
 
   void prefetchLeaf(WideBvh::Ref leaf) const {
-    slots_.prefetch(leaf.index, leaf.count);
+    wide_.binary().triangleVertices().prefetch(leaf.index, leaf.count);
   }
 
   // The nearest hit of one beam so far in this walk: a hit improves it if nearer, or as near on a
@@ -516,7 +515,6 @@ class MeshWalk {
   BeamSet& beams_;
   const WideBvh& wide_;
   const std::vector<std::uint32_t>& ids_;
-  const SlotVertices<double>& slots_;
   const PlacedBody& active_;
   const CastConfig& config_;
   const Eigen::Matrix3d rot_, abs_rot_;
