@@ -86,6 +86,7 @@ void ColumnMotion::measure(const Reach& reach, double steepest, double extra_tur
   const double turn = 2 * std::asin(std::min(1.0, std::sqrt(frobenius2) / (2 * std::sqrt(2.0))));
   const double tilt = 2 * std::asin(std::min(1.0, std::sqrt(z_move2) / 2));
   spread_ = Spread::of(std::sqrt(shift2), turn + extra_turn, tilt, steepest);
+  sin_turn_ = std::sin(std::min(M_PI / 2, spread_.turn));
 }
 
 }  // namespace core

@@ -145,6 +145,9 @@ class ColumnMotion {
   int colHi() const { return col_lo_ + columns_ - 1; }
   const Pose& refFromColumn(int col) const { return poses_[col - col_lo_]; }
   const Spread& spread() const { return spread_; }
+  // sin(spread().turn), at most 1: how far a turned beam's unit direction may leave a plane through
+  // the sensor that the unturned one lies on (the column raster's widening, per triangle).
+  double sinTurn() const { return sin_turn_; }
   // True if every column's pose differs from the reference by a turn about the sensor's z axis and
   // a move in its xy plane, exactly (as a level sensor driving on a floor gives): every column scans
   // the reference's plane.
@@ -163,19 +166,26 @@ class ColumnMotion {
   // Beam d at (row, col), from its row's class's pose.
   LASER_RAYCAST_HOT_INLINE Ray ray(int row, int col, const Eigen::Vector3d& d,
                                    double tmin) const {
-    if (class_of_row_.empty()) return rayFrom(refFromColumn(col), d, tmin);
-    const Pose& m = refFromColumn(col);
-    const ClassDelta& x = deltaOf(row, col);
     Ray r;
-    r.origin = m.translation() + x.offset;
-    if (translations_only_) {
-      r.dir = d;
-    } else {
-      // The class's turn first, then the column's (util/turn.h: inlined, Eigen's sums).
-      r.dir = turn(m.linear(), turn(x.rot, d));
-    }
+    beam(row, col, d, &r.origin, &r.dir);
     r.tmin = tmin;
     return r;
+  }
+  // The same as where it leaves from and its direction, without a Ray to fill (the walks' exact
+  // tests prepare one from them, for every beam a triangle's raster lets through).
+  LASER_RAYCAST_HOT_INLINE void beam(int row, int col, const Eigen::Vector3d& d,
+                                     Eigen::Vector3d* origin, Eigen::Vector3d* dir) const {
+    const Pose& m = refFromColumn(col);
+    if (class_of_row_.empty()) {
+      *origin = m.translation();
+      // Turning by the identity gives d's bits: skipped where no column turns.
+      *dir = translations_only_ ? d : turn(m.linear(), d);
+      return;
+    }
+    const ClassDelta& x = deltaOf(row, col);
+    *origin = m.translation() + x.offset;
+    // The class's turn first, then the column's (util/turn.h: inlined, Eigen's sums).
+    *dir = translations_only_ ? d : turn(m.linear(), turn(x.rot, d));
   }
   // The direction of beam d at (row, col) in the reference sensor frame (ray(row, col, d).dir).
   LASER_RAYCAST_HOT_INLINE Eigen::Vector3d direction(int row, int col,
@@ -226,6 +236,7 @@ class ColumnMotion {
   std::vector<ClassDelta> deltas_;  // by set and class
   std::vector<int> delta_set_;      // by column
   Spread spread_;
+  double sin_turn_ = 0;
   LASER_RAYCAST_HOT_INLINE Ray rayFrom(const Pose& m, const Eigen::Vector3d& d,
                                        double tmin) const {
     Ray r;

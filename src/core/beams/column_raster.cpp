@@ -32,13 +32,13 @@ ColumnRaster::ColumnRaster(const BeamSet& beams, const Eigen::Vector3d& a, const
   if (shift == 0) {
     // Every beam from the sensor (a bundle's sub-rays, or a turn alone): the reference's edge
     // planes, widened by the turn.
-    init(beams, a, b, c, m, std::sin(std::min(M_PI / 2, turn)), 0, turn);
+    init(beams, a, b, c, m, motion.sinTurn(), 0, turn);
     return;
   }
   const double plane = std::abs(a.dot(m[0])) / (m[0] + m[1] + m[2]).norm() * (1 - 1e-9);
   if (std::isfinite(plane) && plane > 2 * shift) {
     motion_ = &motion;
-    init(beams, a, b, c, m, std::sin(std::min(M_PI / 2, turn)), shift, turn, motion.deviation());
+    init(beams, a, b, c, m, motion.sinTurn(), shift, turn, motion.deviation());
     return;
   }
   // The plane passes near the sensor: every edge test widened by the shift, from the triangle's

@@ -73,15 +73,22 @@ class BeamRays {
   // sensor, or for a sweep's block from the beam's pose, in the reference sensor frame.
   LASER_RAYCAST_HOT_INLINE PreparedRay<double, M> rayAlong(int row, int col,
                                                            const Eigen::Vector3d& d) const {
-    Ray ray{Eigen::Vector3d::Zero(), d, config_.tmin};
-    if (motion_) ray = motion_->ray(row, col, d, config_.tmin);
     if constexpr (M == TriangleMethod::kWatertight) {
       // Valid: the beam directions are finite unit vectors (a list's are checked when it is
       // validated, a pattern's when it is made), and a sweep casts only from poses that are
-      // (ColumnPoses: isValidPose at both samples).
-      return PreparedRay<double, M>(ray, config_.cull_backfaces,
-                                    typename PreparedRay<double, M>::KnownValid{});
+      // (ColumnPoses: isValidPose at both samples). Prepared from the beam's origin and direction
+      // as from its ray, without the ray in between.
+      using Prepared = PreparedRay<double, M>;
+      if (!motion_) {
+        return Prepared(Eigen::Vector3d::Zero(), config_.tmin, config_.cull_backfaces,
+                        Prepared::shearOf(d));
+      }
+      Eigen::Vector3d origin, dir;
+      motion_->beam(row, col, d, &origin, &dir);
+      return Prepared(origin, config_.tmin, config_.cull_backfaces, Prepared::shearOf(dir));
     } else {
+      Ray ray{Eigen::Vector3d::Zero(), d, config_.tmin};
+      if (motion_) ray = motion_->ray(row, col, d, config_.tmin);
       return PreparedRay<double, M>(ray, config_.cull_backfaces);
     }
   }

@@ -206,8 +206,17 @@ class MeshWalk {
     double tmax;
     Best best;
     WideBoxRay box_ray;
-    std::optional<PreparedRay<double, M>> ray;  // for the 3D tests (not when slicing)
+    // For the 3D tests (not when slicing): made when the trace first reaches a triangle (many
+    // traces cross boxes alone, and on a sweep a beam's ray costs two turns and three divisions).
+    std::optional<PreparedRay<double, M>> ray;
   };
+
+  // The traced beam's ray for the exact tests, made the first time it is asked for.
+  const PreparedRay<double, M>& rayOf(Traced* b) const {
+    if (!b->ray) b->ray.emplace(b->sub >= 0 ? rays_.subRay(b->sub, b->row, b->col)
+                                            : rays_.beamRay(b->row, b->col));
+    return *b->ray;
+  }
 
   // What a traced beam does with each triangle slot of a leaf it enters: its segment in the scan
   // plane (slicing), or the exact 3D test.
@@ -217,7 +226,7 @@ class MeshWalk {
       if (slicing_) {
         sliceOne(slot, b->col, &b->tmax, &b->best);
       } else {
-        testSlot(*b->ray, slot, &b->tmax, &b->best);
+        testSlot(rayOf(b), slot, &b->tmax, &b->best);
       }
     };
   }
@@ -243,7 +252,7 @@ class MeshWalk {
         b.tmax = std::min(config_.tmax, range);
         b.best = Best{};
         b.box_ray = rays_.boxRay(row, col);
-        if (!slicing_) b.ray.emplace(rays_.beamRay(row, col));
+        b.ray.reset();
         if (n == 2) tracePair(e, pair, [this](Traced* t) { return leafOf(t); });
         n %= 2;
       }
@@ -300,9 +309,11 @@ class MeshWalk {
           double tmax = std::min(config_.tmax, beams_.subRange(s));
           if (!(tmax >= e.near)) continue;
           Best best;
-          const PreparedRay<double, M> ray = rays_.subRay(s, row, col);
+          std::optional<PreparedRay<double, M>> ray;  // made at the first triangle, as rayOf()
           traceWide(wide_, e.ref, rays_.subBoxRay(s, row, col), &tmax, [&](std::uint32_t slot) {
-            if (!hidden(slot)) testSlot(ray, slot, &tmax, &best);
+            if (hidden(slot)) return;
+            if (!ray) ray.emplace(rays_.subRay(s, row, col));
+            testSlot(*ray, slot, &tmax, &best);
           });
           if (best.found()) offerSub(s, row, col, best);
         }
@@ -327,7 +338,7 @@ class MeshWalk {
           b.tmax = tmax;
           b.best = Best{};
           b.box_ray = rays_.subBoxRay(s, row, col);
-          b.ray.emplace(rays_.subRay(s, row, col));
+          b.ray.reset();
           if (n == 2) tracePair(e, pair, [this](Traced* t) { return subLeafOf(t); });
           n %= 2;
         }
@@ -339,7 +350,7 @@ class MeshWalk {
   // What a traced sub-ray does with each triangle slot of a leaf it enters: the exact 3D test.
   auto subLeafOf(Traced* b) {
     return [this, b](std::uint32_t slot) LASER_RAYCAST_HOT_LAMBDA {
-      if (!hidden(slot)) testSlot(*b->ray, slot, &b->tmax, &b->best);
+      if (!hidden(slot)) testSlot(rayOf(b), slot, &b->tmax, &b->best);
     };
   }
 
