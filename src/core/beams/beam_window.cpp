@@ -86,5 +86,13 @@ View boxView(const Eigen::Vector3d& center, const Eigen::Vector3d& half, const E
   return v;
 }
 
+View triangleView(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                  double angle_min, bool elevations, const Spread& spread) {
+  const Eigen::Vector3d lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+  const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+  return boxView((lo + hi) * 0.5, (hi - lo) * 0.5, identity, identity, Eigen::Vector3d::Zero(),
+                 angle_min, elevations, spread);
+}
+
 }  // namespace core
 }  // namespace laser_raycast

@@ -185,6 +185,9 @@ View sphereView(const Eigen::Vector3d& center, double radius, double angle_min);
 View boxView(const Eigen::Vector3d& center, const Eigen::Vector3d& half, const Eigen::Matrix3d& rot,
              const Eigen::Matrix3d& abs_rot, const Eigen::Vector3d& trans, double angle_min,
              bool elevations, const Spread& spread = Spread());
+// The view of a triangle given in the sensor frame: its bounding box's.
+View triangleView(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                  double angle_min, bool elevations, const Spread& spread = Spread());
 
 }  // namespace core
 }  // namespace laser_raycast

@@ -1,10 +1,13 @@
 // A mesh body's triangles as a walk (mesh_walk.cpp) tests them: each slot moved into the sensor
-// frame, and the back faces that no beam can meet first (hiddenBackFace), both kept by slot.
+// frame, and the back faces that no beam can meet first (hiddenBackFace), both kept by slot; and
+// a hit triangle's normal in its beam's frame.
 #pragma once
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <limits>
 
+#include "beams/column_motion.h"
 #include "beams/placed_body.h"
 #include "laser_raycast/core/mesh.h"
 #include "walk/slot_cache.h"
@@ -45,6 +48,16 @@ class BodyTriangles {
   Eigen::Vector3d sensorNormal(std::uint32_t triangle) const {
     return rot_ * mesh_.normal(triangle);
   }
+  // The triangle's unit normal in the frame of the beam at (row, col): the sensor's, or for a
+  // sweep's block the beam's own pose's. The last one is kept: a bundle's sub-rays of one beam
+  // that keep hits on one triangle ask for it one after another.
+  Eigen::Vector3d beamNormal(int row, int col, std::uint32_t triangle) {
+    if (triangle != normal_kept_.triangle || row != normal_kept_.row || col != normal_kept_.col) {
+      const Eigen::Vector3d n = sensorNormal(triangle);
+      normal_kept_ = {triangle, row, col, active_.motion ? active_.motion->toBeam(row, col, n) : n};
+    }
+    return normal_kept_.normal;
+  }
 
   // A back face of a closed component that the sensor sees from outside: never the nearest hit of a
   // beam (hiddenBackFace), so never tested. The answer depends on the slot alone for the whole
@@ -69,6 +82,11 @@ class BodyTriangles {
   const bool closed_;  // the mesh has closed components, and the walk hides their back faces
   SlotCache<Triangle, 64> triangles_;
   SlotCache<bool, 256> hidden_;
+  struct KeptNormal {
+    std::uint32_t triangle = std::numeric_limits<std::uint32_t>::max();
+    int row = -1, col = -1;
+    Eigen::Vector3d normal;
+  } normal_kept_;  // beamNormal's last
 };
 
 }  // namespace core

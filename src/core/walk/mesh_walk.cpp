@@ -11,10 +11,10 @@
 #include "beams/column_raster.h"
 #include "beams/edge_filter.h"
 #include "geometry/hit_order.h"
-#include "slice/slicer.h"
 #include "util/walk_stack.h"
 #include "walk/beam_rays.h"
 #include "walk/body_triangles.h"
+#include "walk/mesh_slices.h"
 #include "walk/slot_cache.h"
 #include "walk/sub_ray_filter.h"
 #include "walk/triangle_batch.h"
@@ -38,10 +38,6 @@ constexpr long long kBeamsPerTriangle = 2;
 // A leaf whose window holds at most this many beams has them tested against each of its triangles;
 // more are rasterised (3D) against each triangle's edge planes first.
 constexpr long long kLeafDirectBeams = 8;
-// A subtree with at most this many triangles and at least this many beams per triangle in its
-// window is sliced whole (planar fans), without windows or occlusion tests on the way.
-constexpr std::uint32_t kPlainSliceTriangles = 64;
-constexpr double kPlainSliceBeamsPerTriangle = 0.5;
 
 template <TriangleMethod M>
 class MeshWalk {
@@ -67,16 +63,7 @@ class MeshWalk {
         basis_(active.sensor_from_body, planar_, config.tmax, spread_),
         triangles_(mesh, active, config.tmin, spread_.shift, !slicing_),
         rays_(beams, active, mesh.bvh().bounds(), config) {
-    if (slicing_) {
-      // Cut in the frame's plane coordinates when the walk gives them (as a kept slice is).
-      if (active.plane) {
-        slicer_.emplace(mesh, *active.plane, active.frame_from_body, active.sensor_from_body,
-                        beams.grid().pattern(), config.tmin, config.tmax, config.cull_backfaces);
-      } else {
-        slicer_.emplace(mesh, active.sensor_from_body, beams.grid().pattern(), config.tmin,
-                        config.tmax, config.cull_backfaces);
-      }
-    }
+    if (slicing_) slices_.emplace(beams, mesh, active, config);
   }
 
   void run(const BeamRect& within) {
@@ -117,15 +104,14 @@ class MeshWalk {
     const long long beams = e.rect.beams();
     if (e.ref.isLeaf()) {
       if (slicing_) {
-        sliceLeaf(e.ref, e.rect, e.near);
+        slices_->sliceLeaf(e.ref, e.rect, e.near);
       } else if (beams <= kLeafDirectBeams) {
         testLeaf(e);
       } else {
         rasterLeaf(e);
       }
-    } else if (slicing_ && e.triangles <= kPlainSliceTriangles &&
-               beams >= kPlainSliceBeamsPerTriangle * e.triangles) {
-      sliceSubtree(e);
+    } else if (slicing_ && MeshSlices::slicedWhole(e.triangles, beams)) {
+      slices_->sliceSubtree(e.ref, e.rect, e.near, basis_);
     } else if (beams <= kTraceBeams || (!planar_ && beams <= kTraceBeamsDense &&
                                         e.triangles * kBeamsPerTriangle >= beams)) {
       traceRect(e);
@@ -152,15 +138,10 @@ class MeshWalk {
     }
     sortFarthestFirst(children, n);
     for (int j = 0; j < n; ++j) {
-      // A leaf to be sliced: its triangles are asked for now, to be in the cache when it is popped
-      // (on a tilted fan in the warehouse, loading a triangle's vertices took 40% of its cut).
-      if (slicing_ && children[j].ref.isLeaf()) prefetchLeaf(children[j].ref);
+      // A leaf to be sliced: its triangles are asked for now, to be in the cache when it is popped.
+      if (slicing_ && children[j].ref.isLeaf()) slices_->prefetchLeaf(children[j].ref);
       push(children[j]);
     }
-  }
-
-  void prefetchLeaf(WideBvh::Ref leaf) const {
-    wide_.binary().triangleVertices().prefetch(leaf.index, leaf.count);
   }
 
   // The nearest hit of one beam so far in this walk: a hit improves it if nearer, or as near on a
@@ -175,27 +156,17 @@ class MeshWalk {
     }
   };
 
-  // A triangle's unit normal in the frame of the beam at (row, col): the sensor's, or for a
-  // sweep's block the beam's own pose's. The last one is kept: a bundle's sub-rays of one beam
-  // that keep hits on one triangle ask for it one after another.
-  Eigen::Vector3d beamNormal(int row, int col, std::uint32_t triangle) {
-    if (triangle != normal_kept_.triangle || row != normal_kept_.row || col != normal_kept_.col) {
-      const Eigen::Vector3d n = triangles_.sensorNormal(triangle);
-      normal_kept_ = {triangle, row, col, motion_ ? motion_->toBeam(row, col, n) : n};
-    }
-    return normal_kept_.normal;
-  }
-
   void offer(int row, int col, const Best& best) {
     beams_.keepNearestHit(row, col, best.t, active_.index, static_cast<int>(best.triangle), [&] {
-      return slicing_ ? slicer_->sensorNormal(best.slot) : beamNormal(row, col, best.triangle);
+      return slicing_ ? slices_->sensorNormal(best.slot)
+                      : triangles_.beamNormal(row, col, best.triangle);
     });
   }
 
   // Sub-ray s of a bundle's beam: as offer() for the beam.
   void offerSub(int s, int row, int col, const Best& best) {
     beams_.keepNearestSubHit(s, row, col, best.t, active_.index, static_cast<int>(best.triangle),
-                             [&] { return beamNormal(row, col, best.triangle); });
+                             [&] { return triangles_.beamNormal(row, col, best.triangle); });
   }
 
   // A beam (or a bundle's sub-ray) traced on its own through a subtree: its rays, its far limit
@@ -374,7 +345,7 @@ class MeshWalk {
   // The slot's segment in the scan plane against one beam, as slicing tests it.
   void sliceOne(std::uint32_t slot, int col, double* tmax, Best* best) const {
     double t;
-    if (slicer_->sliceBeam(slot, col, &t) && t <= *tmax && best->improves(t, ids_[slot])) {
+    if (slices_->sliceBeam(slot, col, &t) && t <= *tmax && best->improves(t, ids_[slot])) {
       *best = Best{t, ids_[slot], slot};
       *tmax = t;
     }
@@ -431,7 +402,9 @@ class MeshWalk {
       std::optional<SubRayFilter> filter;
       if (bundle_ && sub_rays_from_origin_) filter.emplace(s.a, s.b, s.c);
       TriangleBatch batch(beams_, rays_, s, active_.index, static_cast<int>(triangle),
-                          [&](int row, int col) { return beamNormal(row, col, triangle); });
+                          [&](int row, int col) {
+                            return triangles_.beamNormal(row, col, triangle);
+                          });
       auto test = [&](int row, int col) {
         // The range rounded up to float (compact, so cheaper to read here than the result's): a
         // hit it lets through beyond the exact range is turned down by keepNearestHit().
@@ -472,55 +445,14 @@ class MeshWalk {
   // the sweep block's spread): f(row, col) for each.
   template <class F>
   void forEachInWindow(const SensorTriangle& s, const BeamRect& rect, F&& f) const {
-    const Eigen::Vector3d lo = s.a.cwiseMin(s.b).cwiseMin(s.c),
-                          hi = s.a.cwiseMax(s.b).cwiseMax(s.c);
-    const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
     const View view =
-        boxView((lo + hi) * 0.5, (hi - lo) * 0.5, identity, identity, Eigen::Vector3d::Zero(),
-                beams_.grid().pattern().angleMin(), !planar_, spread_);
+        triangleView(s.a, s.b, s.c, beams_.grid().pattern().angleMin(), !planar_, spread_);
     if (!(view.near <= config_.tmax) || (planar_ && !view.crosses)) return;
     beams_.grid().forEachRect(view, rect, [&](const BeamRect& r) {
       for (int row = r.row_lo; row <= r.row_hi; ++row) {
         for (int col = r.col_lo; col <= r.col_hi; ++col) f(row, col);
       }
     });
-  }
-
-  // Every leaf below the entry that meets the scan plane, sliced into the entry's beams, with no
-  // windows or occlusion tests on the way: for a small subtree they cost more than they save.
-  void sliceSubtree(const Entry& e) {
-    WideBvh::Ref stack[64 * (WideBvh::kWidth - 1) + 1];
-    int top = 0;
-    stack[top++] = e.ref;
-    while (top > 0) {
-      const WideBvh::Ref ref = stack[--top];
-      if (ref.isLeaf()) {
-        sliceLeaf(ref, e.rect, e.near);
-        continue;
-      }
-      const WideBvh::Node& node = wide_.nodes()[ref.index];
-      const int mask = planeMask(node, basis_);
-      for (int k = 0; k < WideBvh::kWidth; ++k) {
-        if (!(mask & (1 << k))) continue;
-        stack[top++] = node.child(k);
-        if (node.child(k).isLeaf()) prefetchLeaf(node.child(k));
-      }
-    }
-  }
-
-  void sliceLeaf(WideBvh::Ref leaf, const BeamRect& rect, double near) {
-    for (std::uint32_t slot = leaf.index; slot < leaf.index + leaf.count; ++slot) {
-      if (hidden(slot)) continue;
-      slicer_->sliceSlot(
-          slot, rect.col_lo, rect.col_hi,
-          [&](int col, double t) {
-            beams_.keepNearestHit(0, col, t, active_.index, static_cast<int>(ids_[slot]),
-                                  [&] { return slicer_->sensorNormal(slot); });
-          },
-          [&](int col, double segment_near) {
-            return beams_.range(0, col) >= std::max(near, segment_near);
-          });
-    }
   }
 
   BeamSet& beams_;
@@ -540,13 +472,8 @@ class MeshWalk {
   const ViewBasis basis_;
   BodyTriangles triangles_;
   const BeamRays<M> rays_;
-  std::optional<Slicer> slicer_;
+  std::optional<MeshSlices> slices_;  // a planar fan's cuts, where the walk slices
   WalkStack<Entry> stack_;
-  struct KeptNormal {
-    std::uint32_t triangle = std::numeric_limits<std::uint32_t>::max();
-    int row = -1, col = -1;
-    Eigen::Vector3d normal;
-  } normal_kept_;  // beamNormal's last
 };
 
 }  // namespace
