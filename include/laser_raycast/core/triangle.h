@@ -376,7 +376,7 @@ class PreparedRay<T, TriangleMethod::kWatertight> {
     T sx, sy, sz;
     std::int8_t kx, ky, kz;
   };
-  static Shear shearOf(const Vec3<T>& dir) {
+  LASER_RAYCAST_HOT_INLINE static Shear shearOf(const Vec3<T>& dir) {
     // Swapping x and y when the largest component is negative keeps the winding (and so the front
     // face) unchanged.
     int kz = 0;

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "beams/beam_grid.h"
@@ -108,6 +109,12 @@ class BeamSet {
   template <class Normal>
   bool keepNearestSubHit(int s, int row, int col, double t, int body, int triangle,
                          Normal&& normal);
+  // The same in two steps, for a walk that tests several of a beam's sub-rays against one
+  // triangle: each sub-ray's hit (keepSubHit), then once for the beam (settleSubHits) its
+  // culling range. The same ranges as keepNearestSubHit for each.
+  template <class Normal>
+  bool keepSubHit(int s, double t, int body, int triangle, Normal&& normal);
+  void settleSubHits(int row, int col);
 
  private:
   int firstSub(int beam) const { return first_ ? (*first_)[beam] : beam * sub_rays_; }
@@ -152,11 +159,22 @@ bool BeamSet::keepNearestHit(int row, int col, double t, int body, int triangle,
 template <class Normal>
 bool BeamSet::keepNearestSubHit(int s, int row, int col, double t, int body, int triangle,
                                 Normal&& normal) {
+  if (!keepSubHit(s, t, body, triangle, std::forward<Normal>(normal))) return false;
+  settleSubHits(row, col);
+  return true;
+}
+
+template <class Normal>
+bool BeamSet::keepSubHit(int s, double t, int body, int triangle, Normal&& normal) {
   if (!hitBefore(t, body, triangle, sub_range_[s], sub_body_[s], sub_triangle_[s])) return false;
   sub_range_[s] = t;
   sub_body_[s] = body;
   sub_triangle_[s] = triangle;
   if (with_normals_) sub_normal_[s] = normal();
+  return true;
+}
+
+inline void BeamSet::settleSubHits(int row, int col) {
   const int i = grid_.beam(row, col);
   double farthest = 0;
   for (int j = firstSub(i), end = firstSub(i + 1); j < end; ++j) {
@@ -166,7 +184,6 @@ bool BeamSet::keepNearestSubHit(int s, int row, int col, double t, int body, int
     result_->range[i] = farthest;
     tiles_.lower(row, col, floatAbove(farthest));
   }
-  return true;
 }
 
 }  // namespace core

@@ -42,7 +42,9 @@ class OcclusionTiles {
   // The ranges of one row, padded to whole fine tiles (the padding holds 0: never open).
   const float* row(int r) const { return ranges() + static_cast<std::size_t>(r) * padded_cols_; }
   // The beam at (row, col) hit something at `range` (rounded up), nearer than before.
-  void lower(int row, int col, float range) {
+  // (Always inlined: the few lines run for every hit kept, and GCC left them out of line once a
+  // third caller came.)
+  __attribute__((always_inline)) void lower(int row, int col, float range) {
     ranges()[static_cast<std::size_t>(row) * padded_cols_ + col] = range;
     const int tile = quotient(col, kFineWidth);
     Block& b = block(row, tile);

@@ -49,9 +49,15 @@ class BeamRays {
   // through small boxes enter many more of them.)
   WideBoxRay boxRayAlong(int row, int col, const Eigen::Vector3d& d) const {
     if (!motion_) return WideBoxRay(origin_, turn(active_.body_from_sensor_rot, d));
-    const Eigen::Vector3d dir = turn(active_.body_from_sensor_rot, motion_->direction(row, col, d));
-    if (shift_ == 0) return WideBoxRay(origin_, dir);
-    return WideBoxRay(originOf(motion_->refFromColumn(col)), dir);
+    return WideBoxRay(boxOrigin(col), boxDirection(row, col, d));
+  }
+  // Its two parts: where the box tests of column col's beams start, and the direction of the beam
+  // at (row, col) along sensor-frame d, in the body's frame.
+  const WideBoxRay::Origin& boxOrigin(int col) const {
+    return motion_ && shift_ != 0 ? originOf(motion_->refFromColumn(col)) : origin_;
+  }
+  Eigen::Vector3d boxDirection(int row, int col, const Eigen::Vector3d& d) const {
+    return turn(active_.body_from_sensor_rot, motion_ ? motion_->direction(row, col, d) : d);
   }
 
   // Sub-ray s of the bundle's beam at (row, col) for the triangle tests and the box tests, as a

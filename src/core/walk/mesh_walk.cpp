@@ -17,6 +17,7 @@
 #include "walk/mesh_slices.h"
 #include "walk/slot_cache.h"
 #include "walk/sub_ray_filter.h"
+#include "walk/sub_ray_walk.h"
 #include "walk/triangle_batch.h"
 
 namespace laser_raycast {
@@ -255,17 +256,19 @@ class MeshWalk {
     }
   }
 
-  // Each open beam's sub-rays (a bundle's) through the node's subtree, each on its own ray (the
-  // boxes each enters are its own): two at a time as traceRect traces beams where a beam's
-  // sub-rays lie close together (a divergent beam's, a calibrated lidar's one), one at a time for
-  // a cell's list of beams (beams/beam_cells.h), where side by side gained nothing (the rosette's
-  // still poses, bench --quick: warehouse 0.47-0.49 of Embree's speed against 0.50-0.51, forest
-  // and million the same either way). A sub-ray's walk reads and lowers only its own far limit, so
-  // pairing them changes no test. (One loop for both, pairing or not, cost the rosette 6.6% more
-  // instructions and the divergent rings 1.7%.)
+  // Each open beam's sub-rays (a bundle's) through the node's subtree: a divergent beam's walked
+  // together (SubRayWalk::traceBeam: one walk for all, where a walk each cost the forest's
+  // divergent rings 8% and million's 26% more instructions in Caster::cast*); otherwise each on
+  // its own ray, two at a time as traceRect traces beams (a calibrated lidar's one a beam), or
+  // one at a time for a cell's list of beams (beams/beam_cells.h), where side by side gained
+  // nothing (the rosette's still poses, bench --quick: warehouse 0.47-0.49 of Embree's speed
+  // against 0.50-0.51). A sub-ray's walk reads and lowers only its own far limit, so pairing them
+  // changes no test.
   void traceSubRays(const Entry& e) {
     if (bundle_->first) {
       traceEachSubRay(e);
+    } else if (subs_.tracesTogether()) {
+      subs_.traceRect(wide_, e.ref, e.rect, e.near);
     } else {
       traceSubRayPairs(e);
     }
@@ -411,6 +414,10 @@ class MeshWalk {
         const double range = beams_.rangeAbove(row)[col];
         if (!(range >= e.near)) return;
         if (bundle_) {
+          if (subs_.shearsKept()) {
+            subs_.testRasterBeam(filter ? &*filter : nullptr, row, col, s, triangle);
+            return;
+          }
           const auto add = [&](int j) {
             batch.add(row, col, j, std::min(config_.tmax, beams_.subRange(j)));
           };
@@ -472,6 +479,8 @@ class MeshWalk {
   const ViewBasis basis_;
   BodyTriangles triangles_;
   const BeamRays<M> rays_;
+  SubRayWalk<M> subs_{beams_, triangles_, ids_, rays_, config_, active_.index,
+                      sub_rays_from_origin_};  // a bundle's sub-rays
   std::optional<MeshSlices> slices_;  // a planar fan's cuts, where the walk slices
   WalkStack<Entry> stack_;
 };
