@@ -174,7 +174,7 @@ bool BeamSet::keepSubHit(int s, double t, int body, int triangle, Normal&& norma
   return true;
 }
 
-inline void BeamSet::settleSubHits(int row, int col) {
+__attribute__((always_inline)) inline void BeamSet::settleSubHits(int row, int col) {
   const int i = grid_.beam(row, col);
   double farthest = 0;
   for (int j = firstSub(i), end = firstSub(i + 1); j < end; ++j) {

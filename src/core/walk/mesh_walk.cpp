@@ -267,7 +267,7 @@ class MeshWalk {
   void traceSubRays(const Entry& e) {
     if (bundle_->first) {
       traceEachSubRay(e);
-    } else if (subs_.tracesTogether()) {
+    } else if (subs_.together()) {
       subs_.traceRect(wide_, e.ref, e.rect, e.near);
     } else {
       traceSubRayPairs(e);
@@ -414,7 +414,7 @@ class MeshWalk {
         const double range = beams_.rangeAbove(row)[col];
         if (!(range >= e.near)) return;
         if (bundle_) {
-          if (subs_.shearsKept()) {
+          if (subs_.shearsKept() && subs_.together()) {
             subs_.testRasterBeam(filter ? &*filter : nullptr, row, col, s, triangle);
             return;
           }
