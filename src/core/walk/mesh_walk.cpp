@@ -258,7 +258,7 @@ class MeshWalk {
 
   // Each open beam's sub-rays (a bundle's) through the node's subtree: a divergent beam's walked
   // together (SubRayWalk::traceBeam: one walk for all, where a walk each cost the forest's
-  // divergent rings 8% and million's 26% more instructions in Caster::cast*); otherwise each on
+  // divergent rings about 10% and million's about 30% more instructions in Caster::cast*); otherwise each on
   // its own ray, two at a time as traceRect traces beams (a calibrated lidar's one a beam), or
   // one at a time for a cell's list of beams (beams/beam_cells.h), where side by side gained
   // nothing (the rosette's still poses, bench --quick: warehouse 0.47-0.49 of Embree's speed
@@ -479,8 +479,8 @@ class MeshWalk {
   const ViewBasis basis_;
   BodyTriangles triangles_;
   const BeamRays<M> rays_;
-  SubRayWalk<M> subs_{beams_, triangles_, ids_, rays_, config_, active_.index,
-                      sub_rays_from_origin_};  // a bundle's sub-rays
+  // A bundle's sub-rays, a beam's at a time.
+  SubRayWalk<M> subs_{beams_, triangles_, ids_, rays_, config_, active_.index};
   std::optional<MeshSlices> slices_;  // a planar fan's cuts, where the walk slices
   WalkStack<Entry> stack_;
 };

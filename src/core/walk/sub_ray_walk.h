@@ -31,17 +31,15 @@ class SubRayWalk {
   // Beams of up to this many sub-rays are walked together (traceBeam).
   static constexpr int kMaxTogether = 16;
 
-  // body: the walked body's index; from_origin: every sub-ray leaves from the reference sensor's
-  // origin, unturned (SubRayFilter applies).
+  // body: the walked body's index.
   SubRayWalk(BeamSet& beams, BodyTriangles& triangles, const std::vector<std::uint32_t>& ids,
-             const BeamRays<M>& rays, const CastConfig& config, int body, bool from_origin)
+             const BeamRays<M>& rays, const CastConfig& config, int body)
       : beams_(beams),
         triangles_(triangles),
         ids_(ids),
         rays_(rays),
         config_(config),
         body_(body),
-        from_origin_(from_origin),
         // The kept shears are the watertight test's, from the origin (BeamRays::subRay).
         shears_(M == TriangleMethod::kWatertight && beams.bundle() ? beams.subShears() : nullptr) {}
 
@@ -125,6 +123,7 @@ class SubRayWalk {
         }
       };
       if (shears_) {
+        // Kept shears are rays from the origin, unturned: the pre-test applies.
         const SubRayFilter filter(s.a, s.b, s.c);
         forEachPassing(
             &filter, begin, end, s,
@@ -213,7 +212,6 @@ class SubRayWalk {
   const BeamRays<M>& rays_;
   const CastConfig& config_;
   const int body_;
-  const bool from_origin_;
   const BeamSet::SubShear* const shears_;
 };
 
